@@ -1,0 +1,388 @@
+//! [`Cloth`]: the state of one simulated cloth, its model, and [`Cloth::step`].
+//!
+//! A step is atomic: it either advances to a sound state or returns an error and
+//! leaves positions, velocities, pins, colliders and history exactly as they were.
+//! "Sound" means every position and velocity is finite and no particle is faster
+//! than [`ClothConfig::max_speed`] (an underwater cloth never moves at 100 m/s; a
+//! state that does has exploded).
+
+use crate::error::{check_finite_vec, check_positive, Error};
+use crate::forces::{self, Collider, ForceInput, ForceScratch, Sphere};
+use crate::history::{HalfDerivative, History, Scheme};
+use crate::integrate::{explicit_euler, Integrator};
+use crate::model::Model;
+use crate::topology::Topology;
+use crate::Vec3;
+
+/// Everything that configures a cloth besides its topology.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClothConfig {
+    pub model: Model,
+    /// How D^{1/2}x is evaluated. Ignored (no history kept) when the model has no fractional term.
+    pub scheme: Scheme,
+    pub integrator: Integrator,
+    /// Speed (m/s) above which a step is declared unstable. Default 100.
+    pub max_speed: f64,
+}
+
+impl Default for ClothConfig {
+    fn default() -> Self {
+        Self {
+            model: Model::default(),
+            scheme: Scheme::PAPER,
+            integrator: Integrator::default(),
+            max_speed: 100.0,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+struct Scratch {
+    v_step: Vec<Vec3>,
+    v_rel: Vec<Vec3>,
+    half: Vec<Vec3>,
+    force: Vec<Vec3>,
+    x_new: Vec<Vec3>,
+    v_new: Vec<Vec3>,
+    forces: ForceScratch,
+}
+
+/// One cloth: topology, configuration and state.
+#[derive(Clone, Debug)]
+pub struct Cloth {
+    topology: Topology,
+    config: ClothConfig,
+    x: Vec<Vec3>,
+    v: Vec<Vec3>,
+    pinned: Vec<bool>,
+    pin_list: Vec<u32>,
+    pin_target: Vec<Vec3>,
+    collider_slots: Vec<Option<Collider>>,
+    colliders: Vec<Collider>,
+    history: History,
+    time: f64,
+    steps: u64,
+    scratch: Scratch,
+}
+
+impl Cloth {
+    /// Builds a cloth at rest in its rest positions.
+    pub fn new(topology: Topology, config: ClothConfig) -> Result<Self, Error> {
+        config.model.validate()?;
+        check_positive("max_speed", config.max_speed)?;
+        if let Scheme::Truncated { u } = config.scheme {
+            if u == 0 {
+                return Err(Error::invalid("truncated history needs u >= 1"));
+            }
+        }
+        let n = topology.vertex_count();
+        let scheme = if config.model.uses_half_derivative() {
+            config.scheme
+        } else {
+            Scheme::Off
+        };
+        let x = topology.rest_positions.clone();
+        Ok(Self {
+            v: vec![Vec3::zeros(); n],
+            pinned: vec![false; n],
+            pin_list: Vec::new(),
+            pin_target: x.clone(),
+            x,
+            collider_slots: Vec::new(),
+            colliders: Vec::new(),
+            history: History::new(scheme, n),
+            time: 0.0,
+            steps: 0,
+            scratch: Scratch::default(),
+            topology,
+            config,
+        })
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.x.len()
+    }
+    pub fn topology(&self) -> &Topology {
+        &self.topology
+    }
+    pub fn config(&self) -> &ClothConfig {
+        &self.config
+    }
+    pub fn model(&self) -> &Model {
+        &self.config.model
+    }
+    /// Positions, m.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.x
+    }
+    /// Velocities, m/s.
+    pub fn velocities(&self) -> &[Vec3] {
+        &self.v
+    }
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+    /// Steps taken.
+    pub fn step_count(&self) -> u64 {
+        self.steps
+    }
+    /// The half-derivative history state.
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+    /// Pinned vertex indices, in the order they were given.
+    pub fn pinned(&self) -> &[u32] {
+        &self.pin_list
+    }
+
+    fn check_index(&self, i: u32) -> Result<usize, Error> {
+        let n = self.vertex_count();
+        if (i as usize) < n {
+            Ok(i as usize)
+        } else {
+            Err(Error::out_of_range(format!(
+                "vertex index {i} out of range (cloth has {n} vertices)"
+            )))
+        }
+    }
+
+    /// Replaces the pinned set. Pins hold their current positions until moved.
+    pub fn set_pinned(&mut self, indices: &[u32]) -> Result<(), Error> {
+        for &i in indices {
+            self.check_index(i)?;
+        }
+        self.pinned.fill(false);
+        self.pin_list.clear();
+        for &i in indices {
+            if !self.pinned[i as usize] {
+                self.pinned[i as usize] = true;
+                self.pin_list.push(i);
+                self.pin_target[i as usize] = self.x[i as usize];
+            }
+        }
+        Ok(())
+    }
+
+    /// Moves pinned vertices: at the end of the next step vertex `indices[k]` sits at
+    /// `targets[k]`. Every index must be pinned.
+    pub fn set_pin_targets(&mut self, indices: &[u32], targets: &[Vec3]) -> Result<(), Error> {
+        if indices.len() != targets.len() {
+            return Err(Error::invalid(format!(
+                "{} indices but {} targets",
+                indices.len(),
+                targets.len()
+            )));
+        }
+        for (&i, t) in indices.iter().zip(targets) {
+            let i = self.check_index(i)?;
+            if !self.pinned[i] {
+                return Err(Error::invalid(format!("vertex {i} is not pinned")));
+            }
+            check_finite_vec("pin target", t)?;
+        }
+        for (&i, t) in indices.iter().zip(targets) {
+            self.pin_target[i as usize] = *t;
+        }
+        Ok(())
+    }
+
+    /// Teleports every vertex (velocities and history are kept); pins move with it.
+    pub fn set_positions(&mut self, x: &[Vec3]) -> Result<(), Error> {
+        self.check_len(x.len())?;
+        for p in x {
+            check_finite_vec("position", p)?;
+        }
+        self.x.copy_from_slice(x);
+        for &i in &self.pin_list {
+            self.pin_target[i as usize] = x[i as usize];
+        }
+        Ok(())
+    }
+
+    /// Sets every velocity (m/s).
+    pub fn set_velocities(&mut self, v: &[Vec3]) -> Result<(), Error> {
+        self.check_len(v.len())?;
+        for p in v {
+            check_finite_vec("velocity", p)?;
+        }
+        self.v.copy_from_slice(v);
+        Ok(())
+    }
+
+    fn check_len(&self, len: usize) -> Result<(), Error> {
+        if len == self.vertex_count() {
+            Ok(())
+        } else {
+            Err(Error::invalid(format!(
+                "expected {} vertices, got {len}",
+                self.vertex_count()
+            )))
+        }
+    }
+
+    /// Sets the uniform water current (m/s).
+    pub fn set_current(&mut self, current: Vec3) -> Result<(), Error> {
+        check_finite_vec("current", &current)?;
+        self.config.model.current = current;
+        Ok(())
+    }
+
+    /// Adds a sphere collider and returns its id.
+    pub fn add_sphere(&mut self, sphere: Sphere) -> Result<u32, Error> {
+        check_sphere(&sphere)?;
+        let id = match self.collider_slots.iter().position(Option::is_none) {
+            Some(free) => {
+                self.collider_slots[free] = Some(Collider::Sphere(sphere));
+                free
+            }
+            None => {
+                self.collider_slots.push(Some(Collider::Sphere(sphere)));
+                self.collider_slots.len() - 1
+            }
+        };
+        self.rebuild_colliders();
+        Ok(id as u32)
+    }
+
+    /// Moves or resizes sphere `id`.
+    pub fn set_sphere(&mut self, id: u32, sphere: Sphere) -> Result<(), Error> {
+        check_sphere(&sphere)?;
+        let slot = self.collider_slot(id)?;
+        *slot = Some(Collider::Sphere(sphere));
+        self.rebuild_colliders();
+        Ok(())
+    }
+
+    /// Removes collider `id`; its id may be reused.
+    pub fn remove_collider(&mut self, id: u32) -> Result<(), Error> {
+        *self.collider_slot(id)? = None;
+        self.rebuild_colliders();
+        Ok(())
+    }
+
+    /// The collider with id `id`.
+    pub fn collider(&self, id: u32) -> Option<&Collider> {
+        self.collider_slots.get(id as usize).and_then(Option::as_ref)
+    }
+
+    fn collider_slot(&mut self, id: u32) -> Result<&mut Option<Collider>, Error> {
+        match self.collider_slots.get_mut(id as usize) {
+            Some(slot @ Some(_)) => Ok(slot),
+            _ => Err(Error::out_of_range(format!("no collider with id {id}"))),
+        }
+    }
+
+    fn rebuild_colliders(&mut self) {
+        self.colliders = self.collider_slots.iter().flatten().copied().collect();
+    }
+
+    /// Advances by `dt` seconds with the configured integrator. Atomic.
+    pub fn step(&mut self, dt: f64) -> Result<(), Error> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::invalid(format!(
+                "dt must be finite and > 0 seconds, got {dt}"
+            )));
+        }
+        let n = self.vertex_count();
+        let s = &mut self.scratch;
+        for buf in [&mut s.v_step, &mut s.v_rel, &mut s.half, &mut s.force, &mut s.x_new, &mut s.v_new] {
+            buf.resize(n, Vec3::zeros());
+        }
+        // Pins move in a straight line to their targets over the step; that is their velocity.
+        s.v_step.copy_from_slice(&self.v);
+        for &i in &self.pin_list {
+            let i = i as usize;
+            s.v_step[i] = (self.pin_target[i] - self.x[i]) / dt;
+        }
+        let current = self.config.model.current;
+        for (r, v) in s.v_rel.iter_mut().zip(&s.v_step) {
+            *r = v - current;
+        }
+        // D^{1/2}x_n = w0 v_n + H_n.
+        if !self.history.is_off() {
+            self.history.prepare(dt);
+            self.history.past(&mut s.half);
+            let w0 = self.history.current_weight();
+            for (d, r) in s.half.iter_mut().zip(&s.v_rel) {
+                *d += w0 * r;
+            }
+        }
+        let input = ForceInput {
+            model: &self.config.model,
+            topology: &self.topology,
+            x: &self.x,
+            v: &s.v_step,
+            half_derivative: &s.half,
+            colliders: &self.colliders,
+        };
+        forces::accumulate(&input, &mut s.forces, &mut s.force);
+        match self.config.integrator {
+            Integrator::ExplicitEuler => explicit_euler(
+                dt,
+                &self.x,
+                &s.v_step,
+                &s.force,
+                &self.topology.masses,
+                &mut s.x_new,
+                &mut s.v_new,
+            ),
+        }
+        for &i in &self.pin_list {
+            let i = i as usize;
+            s.x_new[i] = self.pin_target[i];
+            s.v_new[i] = s.v_step[i];
+        }
+        self.check_sound(dt)?;
+        let s = &mut self.scratch;
+        std::mem::swap(&mut self.x, &mut s.x_new);
+        std::mem::swap(&mut self.v, &mut s.v_new);
+        self.history.push(&s.v_rel);
+        self.time += dt;
+        self.steps += 1;
+        Ok(())
+    }
+
+    fn check_sound(&self, dt: f64) -> Result<(), Error> {
+        let s = &self.scratch;
+        let vmax2 = self.config.max_speed * self.config.max_speed;
+        for (i, (x, v)) in s.x_new.iter().zip(&s.v_new).enumerate() {
+            let finite = x.iter().chain(v.iter()).all(|c| c.is_finite());
+            if !finite || v.norm_squared() > vmax2 {
+                return Err(Error::unstable(format!(
+                    "{} with dt = {dt} s is unstable at step {}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s); state left unchanged, retry with a smaller dt",
+                    self.config.integrator.name(),
+                    self.steps,
+                    v.norm(),
+                    self.config.max_speed
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Total mechanical energy (J): kinetic + spring + potential of the net weight in water.
+    pub fn energy(&self) -> f64 {
+        let m = &self.config.model;
+        let mut e = 0.0;
+        for ((x, v), &mass) in self.x.iter().zip(&self.v).zip(&self.topology.masses) {
+            e += 0.5 * mass * v.norm_squared() - forces::body_force(m, mass).dot(x);
+        }
+        for s in &self.topology.springs {
+            let k = match s.kind {
+                crate::topology::SpringKind::Stretch => m.stretch_stiffness,
+                crate::topology::SpringKind::Shear => m.shear_stiffness,
+                crate::topology::SpringKind::Bend => m.bend_stiffness,
+            };
+            let d = (self.x[s.i as usize] - self.x[s.j as usize]).norm() - s.rest;
+            e += 0.5 * k * d * d;
+        }
+        e
+    }
+}
+
+fn check_sphere(s: &Sphere) -> Result<(), Error> {
+    check_finite_vec("sphere center", &s.center)?;
+    check_finite_vec("sphere velocity", &s.velocity)?;
+    check_positive("sphere radius", s.radius)
+}

@@ -1,0 +1,259 @@
+//! Cloth lifetime, pins, positions and stepping.
+
+use crate::{Cloth, Vec3};
+
+use super::desc::FcClothDesc;
+use super::status::{guard, guard_value, FcStatus, FfiError};
+
+/// Opaque handle to one simulated cloth. Create with `fc_cloth_create_grid`,
+/// free with `fc_cloth_destroy`.
+pub struct FcCloth {
+    pub(crate) cloth: Cloth,
+}
+
+/// Borrows `len` elements at `ptr`; NULL is accepted only when `len` is 0.
+///
+/// # Safety
+/// Non-NULL `ptr` must point to `len` readable elements.
+pub(crate) unsafe fn slice_in<'a, T>(ptr: *const T, len: usize, what: &str) -> Result<&'a [T], FfiError> {
+    if len == 0 {
+        return Ok(&[]);
+    }
+    if ptr.is_null() {
+        return Err(FfiError::null(what));
+    }
+    // SAFETY: non-NULL, and the caller promises `len` readable elements.
+    Ok(unsafe { std::slice::from_raw_parts(ptr, len) })
+}
+
+/// # Safety
+/// Non-NULL `cloth` must be a live handle.
+pub(crate) unsafe fn handle<'a>(cloth: *const FcCloth) -> Result<&'a Cloth, FfiError> {
+    // SAFETY: the caller promises a live handle or NULL.
+    unsafe { cloth.as_ref() }.map(|c| &c.cloth).ok_or_else(|| FfiError::null("cloth"))
+}
+
+/// # Safety
+/// Non-NULL `cloth` must be a live handle not used elsewhere during the call.
+pub(crate) unsafe fn handle_mut<'a>(cloth: *mut FcCloth) -> Result<&'a mut Cloth, FfiError> {
+    // SAFETY: the caller promises a live, unaliased handle or NULL.
+    unsafe { cloth.as_mut() }.map(|c| &mut c.cloth).ok_or_else(|| FfiError::null("cloth"))
+}
+
+/// Converts float xyz triples to vectors, rejecting NaN and infinities.
+pub(crate) fn triples(xyz: &[f32], what: &str) -> Result<Vec<Vec3>, FfiError> {
+    xyz.chunks_exact(3)
+        .enumerate()
+        .map(|(k, c)| {
+            if c.iter().all(|v| v.is_finite()) {
+                Ok(Vec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])))
+            } else {
+                Err(FfiError::invalid(format!(
+                    "{what} {k} is not finite: ({}, {}, {})",
+                    c[0], c[1], c[2]
+                )))
+            }
+        })
+        .collect()
+}
+
+fn check_float_count(cloth: &Cloth, float_count: usize) -> Result<(), FfiError> {
+    let want = 3 * cloth.vertex_count();
+    if float_count == want {
+        Ok(())
+    } else {
+        Err(FfiError::invalid(format!(
+            "float_count must be 3 * vertex_count = {want}, got {float_count}"
+        )))
+    }
+}
+
+/// Creates a grid cloth at rest from `*desc` and writes the handle to `*out_cloth`
+/// (only on success). Bad fields give `FC_ERROR_INVALID_ARGUMENT` and a message naming them.
+///
+/// # Safety
+/// `desc` must be NULL or point to an initialised `FcClothDesc`; `out_cloth` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_create_grid(desc: *const FcClothDesc, out_cloth: *mut *mut FcCloth) -> FcStatus {
+    guard(|| {
+        if out_cloth.is_null() {
+            return Err(FfiError::null("out_cloth"));
+        }
+        // SAFETY: the caller promises a valid description or NULL.
+        let desc = unsafe { desc.as_ref() }.ok_or_else(|| FfiError::null("desc"))?;
+        let config = desc.config()?;
+        let topology = desc.grid_spec().build()?;
+        let cloth = Cloth::new(topology, config)?;
+        let raw = Box::into_raw(Box::new(FcCloth { cloth }));
+        // SAFETY: checked non-NULL; the caller promises it is writable.
+        unsafe { *out_cloth = raw };
+        Ok(())
+    })
+}
+
+/// Frees a cloth. NULL is fine. Using the handle afterwards is the host's bug.
+///
+/// # Safety
+/// `cloth` must be NULL or a handle from `fc_cloth_create_grid` not yet destroyed.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_destroy(cloth: *mut FcCloth) {
+    guard_value((), || {
+        if !cloth.is_null() {
+            // SAFETY: the caller promises a live handle created by Box::into_raw.
+            drop(unsafe { Box::from_raw(cloth) });
+        }
+    })
+}
+
+/// Number of vertices (particles); 0 for NULL.
+///
+/// # Safety
+/// `cloth` must be NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_vertex_count(cloth: *const FcCloth) -> usize {
+    // SAFETY: forwarded caller promise.
+    guard_value(0, || unsafe { handle(cloth) }.map_or(0, |c| c.vertex_count()))
+}
+
+/// Simulated time in seconds; 0 for NULL.
+///
+/// # Safety
+/// `cloth` must be NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_time(cloth: *const FcCloth) -> f64 {
+    // SAFETY: forwarded caller promise.
+    guard_value(0.0, || unsafe { handle(cloth) }.map_or(0.0, |c| c.time()))
+}
+
+/// Replaces the set of pinned vertices with `indices[0..count]` (count 0 unpins all).
+/// Pins hold their current positions until moved with `fc_cloth_set_pin_targets`.
+///
+/// # Safety
+/// `cloth` NULL or live; `indices` NULL or `count` readable values.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_pinned(cloth: *mut FcCloth, indices: *const u32, count: usize) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        let indices = unsafe { slice_in(indices, count, "indices") }?;
+        Ok(cloth.set_pinned(indices)?)
+    })
+}
+
+/// Moves pinned vertices: after the next step, vertex `indices[k]` sits exactly at
+/// `(xyz[3k], xyz[3k+1], xyz[3k+2])` (m). Every index must be pinned; the pin
+/// travels in a straight line over the step, which is its velocity.
+///
+/// # Safety
+/// `cloth` NULL or live; `indices` `count` readable values; `xyz` `3 * count` readable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_pin_targets(
+    cloth: *mut FcCloth,
+    indices: *const u32,
+    xyz: *const f32,
+    count: usize,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        let indices = unsafe { slice_in(indices, count, "indices") }?;
+        let floats = count.checked_mul(3).ok_or_else(|| FfiError::invalid("count too large"))?;
+        let xyz = unsafe { slice_in(xyz, floats, "xyz") }?;
+        let targets = triples(xyz, "target")?;
+        Ok(cloth.set_pin_targets(indices, &targets)?)
+    })
+}
+
+/// Sets every vertex position from float xyz triples (m); `float_count` must be
+/// 3 * vertex_count. Velocities and history are kept; pinned vertices are re-pinned there.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `float_count` readable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_positions(cloth: *mut FcCloth, xyz: *const f32, float_count: usize) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        check_float_count(cloth, float_count)?;
+        let xyz = unsafe { slice_in(xyz, float_count, "xyz") }?;
+        Ok(cloth.set_positions(&triples(xyz, "position")?)?)
+    })
+}
+
+fn write_triples(values: &[Vec3], out: &mut [f32]) {
+    for (o, v) in out.chunks_exact_mut(3).zip(values) {
+        o[0] = v.x as f32;
+        o[1] = v.y as f32;
+        o[2] = v.z as f32;
+    }
+}
+
+/// Copies every vertex position (m) into `xyz` as float triples; `float_count` must be 3 * vertex_count.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_positions(cloth: *const FcCloth, xyz: *mut f32, float_count: usize) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle(cloth) }?;
+        check_float_count(cloth, float_count)?;
+        if xyz.is_null() {
+            return Err(FfiError::null("xyz"));
+        }
+        // SAFETY: non-NULL and the caller promises `float_count` writable floats.
+        let out = unsafe { std::slice::from_raw_parts_mut(xyz, float_count) };
+        write_triples(cloth.positions(), out);
+        Ok(())
+    })
+}
+
+/// Copies every vertex velocity (m/s) into `xyz` as float triples; `float_count` must be 3 * vertex_count.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_velocities(cloth: *const FcCloth, xyz: *mut f32, float_count: usize) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle(cloth) }?;
+        check_float_count(cloth, float_count)?;
+        if xyz.is_null() {
+            return Err(FfiError::null("xyz"));
+        }
+        // SAFETY: non-NULL and the caller promises `float_count` writable floats.
+        let out = unsafe { std::slice::from_raw_parts_mut(xyz, float_count) };
+        write_triples(cloth.velocities(), out);
+        Ok(())
+    })
+}
+
+/// Sets the uniform water current (m/s), effective from the next step.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or 3 readable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_current(cloth: *mut FcCloth, xyz: *const f32) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        let xyz = unsafe { slice_in(xyz, 3, "xyz") }?;
+        let c = triples(xyz, "current")?;
+        Ok(cloth.set_current(c[0])?)
+    })
+}
+
+/// Advances the cloth by `dt` seconds (finite, > 0). Atomic: on any error
+/// (`FC_ERROR_INVALID_ARGUMENT` for a bad dt, `FC_ERROR_UNSTABLE` when the result
+/// would be non-finite or faster than `max_speed`) the cloth is exactly as before.
+///
+/// # Safety
+/// `cloth` NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_step(cloth: *mut FcCloth, dt: f64) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        Ok(cloth.step(dt)?)
+    })
+}

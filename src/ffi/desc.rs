@@ -1,0 +1,259 @@
+//! `FcClothDesc`: everything a cloth is made of, filled by `fc_cloth_desc_default`.
+//!
+//! Following Box2D v3, hosts start from the defaults and change what they need, so
+//! fields added later never break old callers. Configuration crosses as `double`;
+//! per-frame geometry (positions, targets, collider centres) crosses as `float`.
+//! Enumerated fields are plain `uint32_t` holding an `FcHistoryScheme`,
+//! `FcIntegrator` or `FcSpringDamping` value and are checked on use.
+
+use crate::cloth::ClothConfig;
+use crate::history::Scheme;
+use crate::integrate::Integrator;
+use crate::model::{Model, RegularDrag, SpringDamping};
+use crate::topology::GridSpec;
+use crate::Vec3;
+
+use super::status::{guard, FcStatus, FfiError};
+
+/// Values of `FcClothDesc::history_scheme`: how D^{1/2}x is evaluated.
+#[allow(non_camel_case_types)]
+#[repr(C)]
+pub enum FcHistoryScheme {
+    /// No fractional terms (they evaluate to zero); no history is kept.
+    FC_HISTORY_OFF = 0,
+    /// The paper's Eq. 6 truncated to the last `history_u` states.
+    FC_HISTORY_TRUNCATED = 1,
+}
+
+/// Values of `FcClothDesc::integrator`.
+#[allow(non_camel_case_types)]
+#[repr(C)]
+pub enum FcIntegrator {
+    /// The paper's Eq. 7.
+    FC_INTEGRATOR_EXPLICIT_EULER = 0,
+}
+
+/// Values of `FcClothDesc::spring_damping_mode`.
+#[allow(non_camel_case_types)]
+#[repr(C)]
+pub enum FcSpringDamping {
+    /// Purely elastic springs.
+    FC_SPRING_DAMPING_NONE = 0,
+    /// Classic damped springs, `-k_d [(v_i - v_j) . l_hat] l_hat` (regular cloth).
+    FC_SPRING_DAMPING_VELOCITY = 1,
+    /// Fractional viscoelastic springs, Eq. 5: `-k_d [(D^{1/2}x_i - D^{1/2}x_j) . l_hat] l_hat`.
+    FC_SPRING_DAMPING_FRACTIONAL = 2,
+}
+
+/// Values for `fc_cloth_desc_preset`.
+#[allow(non_camel_case_types)]
+#[repr(C)]
+pub enum FcPreset {
+    /// The paper's fractional cloth (Eq. 2-7, u = 3, explicit Euler). Same as the defaults.
+    FC_PRESET_FRACTIONAL_PAPER = 0,
+    /// Regular cloth of Fig. 7, first column: damped springs, viscous and normal drag.
+    FC_PRESET_REGULAR_VISCOUS_NORMAL = 1,
+    /// Regular cloth of Fig. 7, second column: damped springs, viscous drag.
+    FC_PRESET_REGULAR_VISCOUS = 2,
+    /// Regular cloth of Fig. 7, third column: damped springs, normal drag.
+    FC_PRESET_REGULAR_NORMAL = 3,
+}
+
+/// Description of a cloth. Units are SI (m, kg, s, N). Obtain with
+/// `fc_cloth_desc_default()` and change fields as needed.
+///
+/// Drag coefficients act per particle; the defaults suit a spacing of 1 cm.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FcClothDesc {
+    /// Grid columns (>= 2). Vertex (column i, row j) has index j * width + i; row 0 is the top edge.
+    pub width: u32,
+    /// Grid rows (>= 2).
+    pub height: u32,
+    /// Distance between neighbouring particles, m (> 0). Default 0.01.
+    pub spacing: f32,
+    /// Mass of the whole cloth, kg. If <= 0, `areal_density` is used instead. Default 0.
+    pub total_mass: f64,
+    /// Mass per unit area, kg/m^2, used when `total_mass` <= 0. Default 1 (a wet towel).
+    pub areal_density: f64,
+    /// Density of a wet cloth particle rho_c, kg/m^3 (> 0). Default 1100.
+    pub cloth_density: f64,
+    /// Density of the water rho_w, kg/m^3 (>= 0). Default 1000.
+    pub water_density: f64,
+    /// Gravity, m/s^2. Default (0, -9.81, 0): y is up.
+    pub gravity: [f64; 3],
+    /// Uniform water current, m/s. Default 0.
+    pub current: [f64; 3],
+    /// Stretch spring constant, N/m. Default 10.
+    pub stretch_stiffness: f64,
+    /// Shear spring constant, N/m. Default 2.
+    pub shear_stiffness: f64,
+    /// Bend spring constant, N/m. Default 0.5.
+    pub bend_stiffness: f64,
+    /// Spring damping k_d: N s^(1/2)/m when fractional (default 0.35), N s/m when velocity damping.
+    pub spring_damping: f64,
+    /// An `FcSpringDamping` value. Default `FC_SPRING_DAMPING_FRACTIONAL`.
+    pub spring_damping_mode: u32,
+    /// Viscous drag k_vd (Eq. 3), N s/m per particle. Default 1e-3.
+    pub viscous_drag: f64,
+    /// History (Basset) drag k_hd (Eq. 4), N s^(1/2)/m per particle. Default 2e-3.
+    pub history_drag: f64,
+    /// Linear normal drag k_nd, N s/m per particle. Default 0.
+    pub normal_drag: f64,
+    /// An `FcHistoryScheme` value. Default `FC_HISTORY_TRUNCATED`.
+    pub history_scheme: u32,
+    /// Past states kept by `FC_HISTORY_TRUNCATED` (>= 1). Default 3, as in the paper.
+    pub history_u: u32,
+    /// An `FcIntegrator` value. Default `FC_INTEGRATOR_EXPLICIT_EULER`.
+    pub integrator: u32,
+    /// Collision penalty stiffness, N/m. Default 50.
+    pub collision_stiffness: f64,
+    /// Collision approach damping, N s/m. Default 0.05.
+    pub collision_damping: f64,
+    /// Collision margin (distance from a collider surface where repulsion starts), m. Default 0.01.
+    pub collision_margin: f64,
+    /// Speed above which a step is declared unstable, m/s (> 0). Default 100.
+    pub max_speed: f64,
+}
+
+fn v3(a: [f64; 3]) -> Vec3 {
+    Vec3::new(a[0], a[1], a[2])
+}
+
+impl FcClothDesc {
+    fn from_model(model: &Model, config: &ClothConfig) -> Self {
+        let (scheme, u) = match config.scheme {
+            Scheme::Off => (FcHistoryScheme::FC_HISTORY_OFF as u32, 3),
+            Scheme::Truncated { u } => (FcHistoryScheme::FC_HISTORY_TRUNCATED as u32, u),
+        };
+        Self {
+            width: 61,
+            height: 41,
+            spacing: 0.01,
+            total_mass: 0.0,
+            areal_density: 1.0,
+            cloth_density: model.cloth_density,
+            water_density: model.water_density,
+            gravity: model.gravity.into(),
+            current: model.current.into(),
+            stretch_stiffness: model.stretch_stiffness,
+            shear_stiffness: model.shear_stiffness,
+            bend_stiffness: model.bend_stiffness,
+            spring_damping: model.spring_damping,
+            spring_damping_mode: match model.spring_damping_mode {
+                SpringDamping::None => FcSpringDamping::FC_SPRING_DAMPING_NONE,
+                SpringDamping::Velocity => FcSpringDamping::FC_SPRING_DAMPING_VELOCITY,
+                SpringDamping::Fractional => FcSpringDamping::FC_SPRING_DAMPING_FRACTIONAL,
+            } as u32,
+            viscous_drag: model.viscous_drag,
+            history_drag: model.history_drag,
+            normal_drag: model.normal_drag,
+            history_scheme: scheme,
+            history_u: u,
+            integrator: FcIntegrator::FC_INTEGRATOR_EXPLICIT_EULER as u32,
+            collision_stiffness: model.collision_stiffness,
+            collision_damping: model.collision_damping,
+            collision_margin: model.collision_margin,
+            max_speed: config.max_speed,
+        }
+    }
+
+    /// The grid this description asks for (checked by `GridSpec::build`).
+    pub fn grid_spec(&self) -> GridSpec {
+        let spacing = f64::from(self.spacing);
+        let total_mass = if self.total_mass > 0.0 {
+            self.total_mass
+        } else {
+            self.areal_density
+                * f64::from(self.width.saturating_sub(1))
+                * f64::from(self.height.saturating_sub(1))
+                * spacing
+                * spacing
+        };
+        GridSpec {
+            width: self.width,
+            height: self.height,
+            spacing,
+            total_mass,
+        }
+    }
+
+    /// The configuration this description asks for; enumerated fields are checked here,
+    /// coefficients by `Cloth::new`.
+    pub fn config(&self) -> Result<ClothConfig, FfiError> {
+        if self.total_mass.is_nan() {
+            return Err(FfiError::invalid("total_mass is NaN"));
+        }
+        let spring_damping_mode = match self.spring_damping_mode {
+            0 => SpringDamping::None,
+            1 => SpringDamping::Velocity,
+            2 => SpringDamping::Fractional,
+            x => return Err(FfiError::invalid(format!("spring_damping_mode {x} is not an FcSpringDamping value"))),
+        };
+        let scheme = match self.history_scheme {
+            0 => Scheme::Off,
+            1 if self.history_u >= 1 => Scheme::Truncated { u: self.history_u },
+            1 => return Err(FfiError::invalid("history_u must be >= 1")),
+            x => return Err(FfiError::invalid(format!("history_scheme {x} is not an FcHistoryScheme value"))),
+        };
+        let integrator = match self.integrator {
+            0 => Integrator::ExplicitEuler,
+            x => return Err(FfiError::invalid(format!("integrator {x} is not an FcIntegrator value"))),
+        };
+        Ok(ClothConfig {
+            model: Model {
+                cloth_density: self.cloth_density,
+                water_density: self.water_density,
+                gravity: v3(self.gravity),
+                current: v3(self.current),
+                stretch_stiffness: self.stretch_stiffness,
+                shear_stiffness: self.shear_stiffness,
+                bend_stiffness: self.bend_stiffness,
+                spring_damping: self.spring_damping,
+                spring_damping_mode,
+                viscous_drag: self.viscous_drag,
+                history_drag: self.history_drag,
+                normal_drag: self.normal_drag,
+                collision_stiffness: self.collision_stiffness,
+                collision_damping: self.collision_damping,
+                collision_margin: self.collision_margin,
+            },
+            scheme,
+            integrator,
+            max_speed: self.max_speed,
+        })
+    }
+}
+
+/// The default description: a 61 x 41 grid of 1 cm spacing (0.6 m x 0.4 m, 0.24 kg)
+/// with the paper's fractional model (Eq. 2-7, u = 3, explicit Euler).
+#[no_mangle]
+pub extern "C" fn fc_cloth_desc_default() -> FcClothDesc {
+    let config = ClothConfig::default();
+    FcClothDesc::from_model(&config.model, &config)
+}
+
+/// Fills `*out_desc` with a preset (an `FcPreset` value) on the default grid.
+/// Returns `FC_ERROR_INVALID_ARGUMENT` for an unknown preset.
+///
+/// # Safety
+/// `out_desc` must be NULL or point to writable memory for one `FcClothDesc`.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_desc_preset(preset: u32, out_desc: *mut FcClothDesc) -> FcStatus {
+    guard(|| {
+        if out_desc.is_null() {
+            return Err(FfiError::null("out_desc"));
+        }
+        let model = match preset {
+            0 => Model::fractional(),
+            1 => Model::regular(RegularDrag::ViscousAndNormal),
+            2 => Model::regular(RegularDrag::Viscous),
+            3 => Model::regular(RegularDrag::Normal),
+            x => return Err(FfiError::invalid(format!("preset {x} is not an FcPreset value"))),
+        };
+        let config = ClothConfig::default();
+        // SAFETY: checked non-NULL; the caller promises it is writable.
+        unsafe { *out_desc = FcClothDesc::from_model(&model, &config) };
+        Ok(())
+    })
+}

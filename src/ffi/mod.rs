@@ -1,0 +1,27 @@
+//! The C ABI: a thin, checked, panic-safe shell over [`crate::Cloth`].
+//!
+//! One file per header area: [`status`] (status codes, last error, the panic
+//! boundary), [`desc`] (the description struct and its defaults), [`cloth`]
+//! (lifetime, pins, positions, stepping), [`collider`] (colliders), [`version`].
+//!
+//! Rules every export follows:
+//! - it runs inside a panic boundary; a panic becomes `FC_ERROR_PANIC`;
+//! - NULL pointers give `FC_ERROR_NULL_ARGUMENT`, never a crash;
+//! - a failing call writes no output and leaves the cloth exactly as it was;
+//! - `const` pointers are never written through.
+//!
+//! Threads: one handle must not be used from two threads at once; different handles
+//! may be used on different threads concurrently. `fc_last_error_message` is per thread.
+
+#[macro_use]
+pub mod status;
+pub mod cloth;
+pub mod collider;
+pub mod desc;
+pub mod version;
+
+pub use cloth::*;
+pub use collider::*;
+pub use desc::*;
+pub use status::*;
+pub use version::*;

@@ -1,0 +1,24 @@
+//! Explicit (forward) Euler, exactly the paper's Eq. 7:
+//! `x(t+h) = x(t) + h v(t)`, `v(t+h) = v(t) + h a(t)`, with a(t) from all forces at t.
+//!
+//! Chosen as the paper's reference; it is only conditionally stable (the damping
+//! must be large enough for the stiffest mode: h ω² < c), see `docs/`.
+
+use crate::Vec3;
+
+/// One explicit Euler step for free particles. `force` holds F(t_n); pinned particles
+/// are overwritten by the caller.
+pub fn explicit_euler(
+    h: f64,
+    x: &[Vec3],
+    v: &[Vec3],
+    force: &[Vec3],
+    masses: &[f64],
+    x_new: &mut [Vec3],
+    v_new: &mut [Vec3],
+) {
+    for i in 0..x.len() {
+        x_new[i] = x[i] + h * v[i];
+        v_new[i] = v[i] + (h / masses[i]) * force[i];
+    }
+}

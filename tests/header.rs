@@ -1,0 +1,44 @@
+//! The committed header must be exactly what cbindgen generates from the sources now.
+//! Regenerate deliberately with `FC_BLESS_HEADER=1 cargo test --test header`.
+
+use std::path::Path;
+
+fn generate() -> String {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let mut config = cbindgen::Config::from_file(Path::new(root).join("cbindgen.toml"))
+        .expect("cbindgen.toml parses");
+    let (major, minor, patch) = (
+        env!("CARGO_PKG_VERSION_MAJOR"),
+        env!("CARGO_PKG_VERSION_MINOR"),
+        env!("CARGO_PKG_VERSION_PATCH"),
+    );
+    config.after_includes = Some(format!(
+        "\n#define FC_VERSION_MAJOR {major}\n#define FC_VERSION_MINOR {minor}\n#define FC_VERSION_PATCH {patch}\n\
+         /* Equals fc_version() of the library this header belongs to. */\n\
+         #define FC_VERSION (FC_VERSION_MAJOR * 1000000 + FC_VERSION_MINOR * 1000 + FC_VERSION_PATCH)\n"
+    ));
+    let bindings = cbindgen::Builder::new()
+        .with_crate(root)
+        .with_config(config)
+        .generate()
+        .expect("cbindgen generates the header");
+    let mut out = Vec::new();
+    bindings.write(&mut out);
+    String::from_utf8(out).expect("header is UTF-8")
+}
+
+#[test]
+fn committed_header_matches_cbindgen() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("include/fraccloth.h");
+    let fresh = generate();
+    if std::env::var_os("FC_BLESS_HEADER").is_some() {
+        std::fs::write(&path, &fresh).expect("write header");
+        return;
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        committed == fresh,
+        "include/fraccloth.h differs from what cbindgen generates now; \
+         regenerate with FC_BLESS_HEADER=1 cargo test --test header and commit it"
+    );
+}
