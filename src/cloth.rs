@@ -286,7 +286,14 @@ impl Cloth {
         }
         let n = self.vertex_count();
         let s = &mut self.scratch;
-        for buf in [&mut s.v_step, &mut s.v_rel, &mut s.half, &mut s.force, &mut s.x_new, &mut s.v_new] {
+        for buf in [
+            &mut s.v_step,
+            &mut s.v_rel,
+            &mut s.half,
+            &mut s.force,
+            &mut s.x_new,
+            &mut s.v_new,
+        ] {
             buf.resize(n, Vec3::zeros());
         }
         // Pins move in a straight line to their targets over the step; that is their velocity.

@@ -5,8 +5,8 @@ use std::path::Path;
 
 fn generate() -> String {
     let root = env!("CARGO_MANIFEST_DIR");
-    let mut config = cbindgen::Config::from_file(Path::new(root).join("cbindgen.toml"))
-        .expect("cbindgen.toml parses");
+    let mut config =
+        cbindgen::Config::from_file(Path::new(root).join("cbindgen.toml")).expect("cbindgen.toml parses");
     let (major, minor, patch) = (
         env!("CARGO_PKG_VERSION_MAJOR"),
         env!("CARGO_PKG_VERSION_MINOR"),

@@ -6,7 +6,12 @@ use crate::Vec3;
 
 /// Writes `v x y z` lines then 1-based `f a b c` lines.
 pub fn write_obj<W: Write>(mut out: W, positions: &[Vec3], triangles: &[[u32; 3]]) -> io::Result<()> {
-    writeln!(out, "# fraccloth mesh: {} vertices, {} triangles", positions.len(), triangles.len())?;
+    writeln!(
+        out,
+        "# fraccloth mesh: {} vertices, {} triangles",
+        positions.len(),
+        triangles.len()
+    )?;
     for p in positions {
         writeln!(out, "v {} {} {}", p.x as f32, p.y as f32, p.z as f32)?;
     }

@@ -72,7 +72,8 @@ mod tests {
     #[test]
     fn layout_round_trips() {
         let mut w = Pc2Writer::new(Cursor::new(Vec::new()), 2, 1.0, 1.0).unwrap();
-        w.write_frame(&[Vec3::new(1.0, 2.0, 3.0), Vec3::new(-1.0, 0.5, 0.25)]).unwrap();
+        w.write_frame(&[Vec3::new(1.0, 2.0, 3.0), Vec3::new(-1.0, 0.5, 0.25)])
+            .unwrap();
         w.write_frame(&[Vec3::zeros(), Vec3::new(4.0, 5.0, 6.0)]).unwrap();
         let bytes = w.finish().unwrap().into_inner();
         assert_eq!(&bytes[..12], b"POINTCACHE2\0");

@@ -30,14 +30,18 @@ pub(crate) unsafe fn slice_in<'a, T>(ptr: *const T, len: usize, what: &str) -> R
 /// Non-NULL `cloth` must be a live handle.
 pub(crate) unsafe fn handle<'a>(cloth: *const FcCloth) -> Result<&'a Cloth, FfiError> {
     // SAFETY: the caller promises a live handle or NULL.
-    unsafe { cloth.as_ref() }.map(|c| &c.cloth).ok_or_else(|| FfiError::null("cloth"))
+    unsafe { cloth.as_ref() }
+        .map(|c| &c.cloth)
+        .ok_or_else(|| FfiError::null("cloth"))
 }
 
 /// # Safety
 /// Non-NULL `cloth` must be a live handle not used elsewhere during the call.
 pub(crate) unsafe fn handle_mut<'a>(cloth: *mut FcCloth) -> Result<&'a mut Cloth, FfiError> {
     // SAFETY: the caller promises a live, unaliased handle or NULL.
-    unsafe { cloth.as_mut() }.map(|c| &mut c.cloth).ok_or_else(|| FfiError::null("cloth"))
+    unsafe { cloth.as_mut() }
+        .map(|c| &mut c.cloth)
+        .ok_or_else(|| FfiError::null("cloth"))
 }
 
 /// Converts float xyz triples to vectors, rejecting NaN and infinities.
@@ -74,7 +78,10 @@ fn check_float_count(cloth: &Cloth, float_count: usize) -> Result<(), FfiError> 
 /// # Safety
 /// `desc` must be NULL or point to an initialised `FcClothDesc`; `out_cloth` NULL or writable.
 #[no_mangle]
-pub unsafe extern "C" fn fc_cloth_create_grid(desc: *const FcClothDesc, out_cloth: *mut *mut FcCloth) -> FcStatus {
+pub unsafe extern "C" fn fc_cloth_create_grid(
+    desc: *const FcClothDesc,
+    out_cloth: *mut *mut FcCloth,
+) -> FcStatus {
     guard(|| {
         if out_cloth.is_null() {
             return Err(FfiError::null("out_cloth"));
@@ -131,7 +138,11 @@ pub unsafe extern "C" fn fc_cloth_time(cloth: *const FcCloth) -> f64 {
 /// # Safety
 /// `cloth` NULL or live; `indices` NULL or `count` readable values.
 #[no_mangle]
-pub unsafe extern "C" fn fc_cloth_set_pinned(cloth: *mut FcCloth, indices: *const u32, count: usize) -> FcStatus {
+pub unsafe extern "C" fn fc_cloth_set_pinned(
+    cloth: *mut FcCloth,
+    indices: *const u32,
+    count: usize,
+) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { handle_mut(cloth) }?;
@@ -157,7 +168,9 @@ pub unsafe extern "C" fn fc_cloth_set_pin_targets(
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { handle_mut(cloth) }?;
         let indices = unsafe { slice_in(indices, count, "indices") }?;
-        let floats = count.checked_mul(3).ok_or_else(|| FfiError::invalid("count too large"))?;
+        let floats = count
+            .checked_mul(3)
+            .ok_or_else(|| FfiError::invalid("count too large"))?;
         let xyz = unsafe { slice_in(xyz, floats, "xyz") }?;
         let targets = triples(xyz, "target")?;
         Ok(cloth.set_pin_targets(indices, &targets)?)
@@ -170,7 +183,11 @@ pub unsafe extern "C" fn fc_cloth_set_pin_targets(
 /// # Safety
 /// `cloth` NULL or live; `xyz` NULL or `float_count` readable floats.
 #[no_mangle]
-pub unsafe extern "C" fn fc_cloth_set_positions(cloth: *mut FcCloth, xyz: *const f32, float_count: usize) -> FcStatus {
+pub unsafe extern "C" fn fc_cloth_set_positions(
+    cloth: *mut FcCloth,
+    xyz: *const f32,
+    float_count: usize,
+) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { handle_mut(cloth) }?;
@@ -193,7 +210,11 @@ fn write_triples(values: &[Vec3], out: &mut [f32]) {
 /// # Safety
 /// `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
 #[no_mangle]
-pub unsafe extern "C" fn fc_cloth_get_positions(cloth: *const FcCloth, xyz: *mut f32, float_count: usize) -> FcStatus {
+pub unsafe extern "C" fn fc_cloth_get_positions(
+    cloth: *const FcCloth,
+    xyz: *mut f32,
+    float_count: usize,
+) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { handle(cloth) }?;
@@ -213,7 +234,11 @@ pub unsafe extern "C" fn fc_cloth_get_positions(cloth: *const FcCloth, xyz: *mut
 /// # Safety
 /// `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
 #[no_mangle]
-pub unsafe extern "C" fn fc_cloth_get_velocities(cloth: *const FcCloth, xyz: *mut f32, float_count: usize) -> FcStatus {
+pub unsafe extern "C" fn fc_cloth_get_velocities(
+    cloth: *const FcCloth,
+    xyz: *mut f32,
+    float_count: usize,
+) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { handle(cloth) }?;

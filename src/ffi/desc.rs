@@ -188,17 +188,29 @@ impl FcClothDesc {
             0 => SpringDamping::None,
             1 => SpringDamping::Velocity,
             2 => SpringDamping::Fractional,
-            x => return Err(FfiError::invalid(format!("spring_damping_mode {x} is not an FcSpringDamping value"))),
+            x => {
+                return Err(FfiError::invalid(format!(
+                    "spring_damping_mode {x} is not an FcSpringDamping value"
+                )))
+            }
         };
         let scheme = match self.history_scheme {
             0 => Scheme::Off,
             1 if self.history_u >= 1 => Scheme::Truncated { u: self.history_u },
             1 => return Err(FfiError::invalid("history_u must be >= 1")),
-            x => return Err(FfiError::invalid(format!("history_scheme {x} is not an FcHistoryScheme value"))),
+            x => {
+                return Err(FfiError::invalid(format!(
+                    "history_scheme {x} is not an FcHistoryScheme value"
+                )))
+            }
         };
         let integrator = match self.integrator {
             0 => Integrator::ExplicitEuler,
-            x => return Err(FfiError::invalid(format!("integrator {x} is not an FcIntegrator value"))),
+            x => {
+                return Err(FfiError::invalid(format!(
+                    "integrator {x} is not an FcIntegrator value"
+                )))
+            }
         };
         Ok(ClothConfig {
             model: Model {

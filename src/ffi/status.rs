@@ -86,7 +86,9 @@ pub(crate) fn guard(f: impl FnOnce() -> Result<(), FfiError>) -> FcStatus {
                 .map(|s| s.to_string())
                 .or_else(|| payload.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "unknown panic".into());
-            set_last_error(&format!("internal error (panic caught at the C boundary): {what}"));
+            set_last_error(&format!(
+                "internal error (panic caught at the C boundary): {what}"
+            ));
             FcStatus::FC_ERROR_PANIC
         }
     }

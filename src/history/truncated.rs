@@ -159,8 +159,7 @@ mod tests {
                     + 2.0 * (v[n - 1] + v[n]) / (0.55 * h).sqrt()
                     + v[n] / (0.1 * h).sqrt())
             + 0.05 * h / sp
-                * (8.0 * 2f64.sqrt() / 3.0 * v[n] / (0.05 * h).sqrt()
-                    - 4.0 / 3.0 * v[n] / (0.1 * h).sqrt())
+                * (8.0 * 2f64.sqrt() / 3.0 * v[n] / (0.05 * h).sqrt() - 4.0 / 3.0 * v[n] / (0.1 * h).sqrt())
     }
 
     fn run(vel: impl Fn(usize) -> f64, steps: usize, h: f64, u: usize) {
@@ -197,8 +196,7 @@ mod tests {
         // For v = 1 the third bracket equals integral_0^{0.1h} s^{-1/2} ds / sqrt(pi).
         let h = 0.01f64;
         let sp = std::f64::consts::PI.sqrt();
-        let b = 0.05 * h / sp
-            * (8.0 * 2f64.sqrt() / 3.0 / (0.05 * h).sqrt() - 4.0 / 3.0 / (0.1 * h).sqrt());
+        let b = 0.05 * h / sp * (8.0 * 2f64.sqrt() / 3.0 / (0.05 * h).sqrt() - 4.0 / 3.0 / (0.1 * h).sqrt());
         let exact = 2.0 * (0.1 * h).sqrt() / sp;
         assert!((b - exact).abs() < 1e-15);
     }

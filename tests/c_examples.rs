@@ -1,0 +1,128 @@
+//! Compiles every C example against the header and the shared library, runs it and
+//! checks the numbers it prints against the Rust side.
+
+mod common;
+
+use common::{compile_c, run, scratch_dir};
+use fraccloth::ffi::*;
+use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
+
+fn field<'a>(out: &'a str, key: &str) -> Vec<&'a str> {
+    out.lines()
+        .find_map(|l| l.strip_prefix(key).map(|r| r.split_whitespace().collect()))
+        .unwrap_or_else(|| panic!("no line {key:?} in output:\n{out}"))
+}
+
+#[test]
+fn hello_prints_the_same_corner_as_the_library() {
+    let dir = scratch_dir("hello");
+    let out = run(&compile_c("hello.c", &dir), &[]);
+    // Same calls from Rust, through the same ABI functions.
+    let desc = fc_cloth_desc_default();
+    let mut cloth = std::ptr::null_mut();
+    unsafe {
+        assert_eq!(fc_cloth_create_grid(&desc, &mut cloth), FcStatus::FC_OK);
+        let top: Vec<u32> = (0..desc.width).collect();
+        assert_eq!(
+            fc_cloth_set_pinned(cloth, top.as_ptr(), top.len()),
+            FcStatus::FC_OK
+        );
+        for _ in 0..2000 {
+            assert_eq!(fc_cloth_step(cloth, 5e-4), FcStatus::FC_OK);
+        }
+        let n = fc_cloth_vertex_count(cloth);
+        let mut xyz = vec![0f32; 3 * n];
+        assert_eq!(
+            fc_cloth_get_positions(cloth, xyz.as_mut_ptr(), xyz.len()),
+            FcStatus::FC_OK
+        );
+        fc_cloth_destroy(cloth);
+        assert_eq!(field(&out, "vertices"), vec![n.to_string()]);
+        let corner = field(&out, "corner");
+        let k: usize = corner[0].parse().unwrap();
+        assert_eq!(k, n - desc.width as usize);
+        for c in 0..3 {
+            let printed: f32 = corner[1 + c].parse().unwrap();
+            assert_eq!(printed, xyz[3 * k + c], "component {c}");
+        }
+        // The corner hangs below its rest height and has not flown away.
+        let y: f32 = corner[2].parse().unwrap();
+        assert!(y < -0.4 + 0.05 && y > -0.6, "corner y = {y}");
+    }
+}
+
+fn read_pc2(path: &std::path::Path) -> (usize, Vec<Vec<[f32; 3]>>) {
+    let b = std::fs::read(path).expect("pc2 written");
+    assert_eq!(&b[..12], b"POINTCACHE2\0");
+    let i32_at = |o: usize| i32::from_le_bytes(b[o..o + 4].try_into().unwrap());
+    let f32_at = |o: usize| f32::from_le_bytes(b[o..o + 4].try_into().unwrap());
+    assert_eq!(i32_at(12), 1, "version");
+    let n = i32_at(16) as usize;
+    let frames = i32_at(28) as usize;
+    assert_eq!(b.len(), 32 + frames * n * 12, "file length matches header");
+    let data = (0..frames)
+        .map(|f| {
+            (0..n)
+                .map(|v| {
+                    let o = 32 + (f * n + v) * 12;
+                    [f32_at(o), f32_at(o + 4), f32_at(o + 8)]
+                })
+                .collect()
+        })
+        .collect();
+    (n, data)
+}
+
+#[test]
+fn swing_writes_a_pc2_that_matches_the_built_in_scene() {
+    let dir = scratch_dir("swing");
+    let exe = compile_c("swing.c", &dir);
+    let pc2 = dir.join("swing.pc2");
+    let out = run(&exe, &[pc2.to_str().unwrap(), "1.0"]);
+    assert_eq!(
+        field(&out, "frames"),
+        vec!["31", "vertices", "2501", "steps", "2000"]
+    );
+    let (n, frames) = read_pc2(&pc2);
+    assert_eq!((n, frames.len()), (2501, 31));
+    // Pins follow the prescribed swing exactly in every frame.
+    for (f, frame) in frames.iter().enumerate() {
+        // Frame f is written at step round(f / (30 dt)).
+        let t = (f as f64 / (30.0 * 5e-4)).round() * 5e-4;
+        let z = 0.08 * (std::f64::consts::TAU * 0.5 * t).sin();
+        for p in &frame[..61] {
+            assert!(
+                (f64::from(p[2]) - z).abs() < 1e-6,
+                "frame {f}: pin z {} != {z}",
+                p[2]
+            );
+        }
+    }
+    // The same scene run by the library itself ends in (nearly) the same place: the
+    // only difference is that C passes pin targets as float.
+    let mut scene = SceneSpec::paper(SceneKind::Swing, Variant::Fractional)
+        .build()
+        .unwrap();
+    scene.run_until(1.0).unwrap();
+    let last = frames.last().unwrap();
+    let mut worst = 0f64;
+    for (p, q) in last.iter().zip(scene.cloth.positions()) {
+        for c in 0..3 {
+            worst = worst.max((f64::from(p[c]) - q[c]).abs());
+        }
+    }
+    assert!(worst < 1e-4, "C and Rust swing differ by {worst} m");
+    // The swing has travelled down: the lower half of the cloth is moving.
+    let lower_z = last[n / 2..].iter().map(|p| p[2].abs()).fold(0f32, f32::max);
+    assert!(lower_z > 1e-3, "lower half did not move: {lower_z}");
+}
+
+#[test]
+fn bad_input_program_passes_every_check() {
+    let dir = scratch_dir("bad_input");
+    let out = run(&compile_c("bad_input.c", &dir), &[]);
+    let last = out.lines().last().unwrap_or("");
+    assert!(last.ends_with(" checks, 0 failures"), "{out}");
+    let checks: u32 = last.split_whitespace().next().unwrap().parse().unwrap();
+    assert!(checks >= 20, "{out}");
+}

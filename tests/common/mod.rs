@@ -1,0 +1,88 @@
+//! Shared helpers for tests that build C programs against the library.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The directory holding `libfraccloth.so` built for this test run.
+pub fn lib_dir() -> PathBuf {
+    build_lib();
+    let exe = std::env::current_exe().expect("current exe");
+    // target/<profile>/deps/<test-binary>
+    let dir = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("target dir")
+        .to_path_buf();
+    assert!(
+        dir.join("libfraccloth.so").exists() || dir.join("libfraccloth.dylib").exists(),
+        "no shared library in {}; cargo builds it with the tests",
+        dir.display()
+    );
+    dir
+}
+
+/// A fresh scratch directory under the target dir.
+pub fn scratch_dir(name: &str) -> PathBuf {
+    let d = lib_dir().join("c-tests").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("scratch dir");
+    d
+}
+
+/// Compiles one C file from `examples_c/` with `cc -std=c99 -Wall -Wextra -Werror`.
+pub fn compile_c(source: &str, out_dir: &Path) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let lib = lib_dir();
+    let stem = Path::new(source)
+        .file_stem()
+        .expect("stem")
+        .to_string_lossy()
+        .to_string();
+    let exe = out_dir.join(stem);
+    let status = Command::new("cc")
+        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-O1"])
+        .arg("-I")
+        .arg(root.join("include"))
+        .arg(root.join("examples_c").join(source))
+        .arg("-o")
+        .arg(&exe)
+        .arg("-L")
+        .arg(&lib)
+        .arg(format!("-Wl,-rpath,{}", lib.display()))
+        .args(["-lfraccloth", "-lm"])
+        .status()
+        .expect("cc runs");
+    assert!(status.success(), "cc failed on {source}");
+    exe
+}
+
+/// Runs a compiled program; returns stdout, asserting a zero exit.
+pub fn run(exe: &Path, args: &[&str]) -> String {
+    let out = Command::new(exe).args(args).output().expect("program runs");
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "{} failed: {}\n{}",
+        exe.display(),
+        stdout,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// Builds the shared library for this test run (cargo test does not build the cdylib).
+pub fn build_lib() {
+    static BUILT: std::sync::Once = std::sync::Once::new();
+    BUILT.call_once(build_lib_now);
+}
+
+fn build_lib_now() {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .args(["build", "--lib", "--quiet"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .status()
+        .expect("cargo runs");
+    assert!(status.success());
+}
