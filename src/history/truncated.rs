@@ -173,11 +173,7 @@ mod tests {
             t.past(&mut out);
             let ours = t.current_weight() * vn + out[0].x;
             let direct = printed_eq6(&hist, h, u);
-            let tol = 1e-12 * (1.0 + direct.abs());
-            assert!(
-                (ours - direct).abs() <= tol,
-                "n={n} u={u}: ours {ours} printed {direct}"
-            );
+            approx::assert_relative_eq!(ours, direct, epsilon = 1e-14, max_relative = 1e-12);
             t.push(&[Vec3::new(vn, 0.0, 0.0)]);
         }
     }
