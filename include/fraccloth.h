@@ -60,9 +60,17 @@ typedef enum {
    */
   FC_HISTORY_OFF = 0,
   /**
-   * The paper's Eq. 6 truncated to the last `history_u` states.
+   * The paper's Eq. 6 truncated to the last `history_u` states (order 1/2; a damper, not a memory).
    */
   FC_HISTORY_TRUNCATED = 1,
+  /**
+   * Exact convolution over the whole history, second order; cost and memory grow with the step count. The reference.
+   */
+  FC_HISTORY_FULL = 2,
+  /**
+   * Sum of exponentials: full memory to `history_tolerance` on [`history_min_dt`, `history_horizon`] at constant cost. The default.
+   */
+  FC_HISTORY_SOE = 3,
 } FcHistoryScheme;
 
 /**
@@ -98,7 +106,7 @@ typedef enum {
  */
 typedef enum {
   /**
-   * The paper's fractional cloth (Eq. 2-7, u = 3, explicit Euler). Same as the defaults.
+   * The paper's fractional cloth exactly (Eq. 2-7, u = 3, explicit Euler).
    */
   FC_PRESET_FRACTIONAL_PAPER = 0,
   /**
@@ -197,13 +205,25 @@ typedef struct {
    */
   double normal_drag;
   /**
-   * An `FcHistoryScheme` value. Default `FC_HISTORY_TRUNCATED`.
+   * An `FcHistoryScheme` value. Default `FC_HISTORY_SOE`.
    */
   uint32_t history_scheme;
   /**
    * Past states kept by `FC_HISTORY_TRUNCATED` (>= 1). Default 3, as in the paper.
    */
   uint32_t history_u;
+  /**
+   * Relative error of the SOE kernel, in [1e-12, 0.1]. Default 1e-3.
+   */
+  double history_tolerance;
+  /**
+   * Longest simulated time (s) over which the SOE memory is accurate. Default 3600.
+   */
+  double history_horizon;
+  /**
+   * Smallest step (s) the SOE kernel is built for. Default 1e-4.
+   */
+  double history_min_dt;
   /**
    * An `FcIntegrator` value. Default `FC_INTEGRATOR_EXPLICIT_EULER`.
    */
@@ -345,6 +365,23 @@ FcStatus fc_cloth_set_current(FcCloth *cloth, const float *xyz);
 FcStatus fc_cloth_step(FcCloth *cloth, double dt);
 
 /**
+ * Exponential modes the SOE history uses per particle (0 for other schemes, for a cloth
+ * without fractional terms, or for NULL).
+ *
+ * # Safety
+ * `cloth` must be NULL or a live handle.
+ */
+uint32_t fc_cloth_history_mode_count(const FcCloth *cloth);
+
+/**
+ * Bytes of half-derivative history held per particle now (0 when no history is kept, or for NULL).
+ *
+ * # Safety
+ * `cloth` must be NULL or a live handle.
+ */
+size_t fc_cloth_history_bytes_per_particle(const FcCloth *cloth);
+
+/**
  * Adds a sphere collider (centre in m, radius in m > 0; velocity in m/s, NULL for
  * resting) and writes its id to `*out_id` (only on success).
  *
@@ -387,7 +424,9 @@ FcStatus fc_cloth_get_sphere(const FcCloth *cloth, uint32_t id, float *center, f
 
 /**
  * The default description: a 61 x 41 grid of 1 cm spacing (0.6 m x 0.4 m, 0.24 kg)
- * with the paper's fractional model (Eq. 2-7, u = 3, explicit Euler).
+ * with the paper's fractional forces (Eq. 2-5), the accurate SOE history (tolerance
+ * 1e-3) and explicit Euler. `fc_cloth_desc_preset(FC_PRESET_FRACTIONAL_PAPER, ...)`
+ * gives the paper's exact configuration (u = 3).
  */
 FcClothDesc fc_cloth_desc_default(void);
 

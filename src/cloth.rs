@@ -29,7 +29,7 @@ impl Default for ClothConfig {
     fn default() -> Self {
         Self {
             model: Model::default(),
-            scheme: Scheme::PAPER,
+            scheme: Scheme::DEFAULT,
             integrator: Integrator::default(),
             max_speed: 100.0,
         }
@@ -70,11 +70,7 @@ impl Cloth {
     pub fn new(topology: Topology, config: ClothConfig) -> Result<Self, Error> {
         config.model.validate()?;
         check_positive("max_speed", config.max_speed)?;
-        if let Scheme::Truncated { u } = config.scheme {
-            if u == 0 {
-                return Err(Error::invalid("truncated history needs u >= 1"));
-            }
-        }
+        config.scheme.validate()?;
         let n = topology.vertex_count();
         let scheme = if config.model.uses_half_derivative() {
             config.scheme
@@ -90,7 +86,7 @@ impl Cloth {
             x,
             collider_slots: Vec::new(),
             colliders: Vec::new(),
-            history: History::new(scheme, n),
+            history: History::new(scheme, n)?,
             time: 0.0,
             steps: 0,
             scratch: Scratch::default(),
@@ -308,7 +304,7 @@ impl Cloth {
         }
         // D^{1/2}x_n = w0 v_n + H_n.
         if !self.history.is_off() {
-            self.history.prepare(dt);
+            self.history.prepare();
             self.history.past(&mut s.half);
             let w0 = self.history.current_weight();
             for (d, r) in s.half.iter_mut().zip(&s.v_rel) {
@@ -344,7 +340,7 @@ impl Cloth {
         let s = &mut self.scratch;
         std::mem::swap(&mut self.x, &mut s.x_new);
         std::mem::swap(&mut self.v, &mut s.v_new);
-        self.history.push(&s.v_rel);
+        self.history.push(&s.v_rel, dt);
         self.time += dt;
         self.steps += 1;
         Ok(())

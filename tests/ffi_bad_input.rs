@@ -177,7 +177,18 @@ fn bad_descriptions_are_rejected_without_output() {
         ("drag infinite", Box::new(|d| d.viscous_drag = f64::INFINITY)),
         ("gravity NaN", Box::new(|d| d.gravity[1] = f64::NAN)),
         ("scheme unknown", Box::new(|d| d.history_scheme = 42)),
-        ("u zero", Box::new(|d| d.history_u = 0)),
+        (
+            "u zero",
+            Box::new(|d| {
+                d.history_scheme = FcHistoryScheme::FC_HISTORY_TRUNCATED as u32;
+                d.history_u = 0
+            }),
+        ),
+        ("soe tolerance 0", Box::new(|d| d.history_tolerance = 0.0)),
+        ("soe tolerance NaN", Box::new(|d| d.history_tolerance = f64::NAN)),
+        ("soe tolerance 0.5", Box::new(|d| d.history_tolerance = 0.5)),
+        ("soe horizon below min_dt", Box::new(|d| d.history_horizon = 1e-5)),
+        ("soe min_dt negative", Box::new(|d| d.history_min_dt = -1.0)),
         ("integrator unknown", Box::new(|d| d.integrator = 9)),
         ("damping mode unknown", Box::new(|d| d.spring_damping_mode = 3)),
         ("max speed 0", Box::new(|d| d.max_speed = 0.0)),

@@ -282,3 +282,29 @@ pub unsafe extern "C" fn fc_cloth_step(cloth: *mut FcCloth, dt: f64) -> FcStatus
         Ok(cloth.step(dt)?)
     })
 }
+
+/// Exponential modes the SOE history uses per particle (0 for other schemes, for a cloth
+/// without fractional terms, or for NULL).
+///
+/// # Safety
+/// `cloth` must be NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_history_mode_count(cloth: *const FcCloth) -> u32 {
+    // SAFETY: forwarded caller promise.
+    guard_value(0, || {
+        unsafe { handle(cloth) }.map_or(0, |c| c.history().mode_count() as u32)
+    })
+}
+
+/// Bytes of half-derivative history held per particle now (0 when no history is kept, or for NULL).
+///
+/// # Safety
+/// `cloth` must be NULL or a live handle.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_history_bytes_per_particle(cloth: *const FcCloth) -> usize {
+    use crate::HalfDerivative;
+    // SAFETY: forwarded caller promise.
+    guard_value(0, || {
+        unsafe { handle(cloth) }.map_or(0, |c| c.history().bytes_per_particle())
+    })
+}

@@ -21,8 +21,12 @@ use super::status::{guard, FcStatus, FfiError};
 pub enum FcHistoryScheme {
     /// No fractional terms (they evaluate to zero); no history is kept.
     FC_HISTORY_OFF = 0,
-    /// The paper's Eq. 6 truncated to the last `history_u` states.
+    /// The paper's Eq. 6 truncated to the last `history_u` states (order 1/2; a damper, not a memory).
     FC_HISTORY_TRUNCATED = 1,
+    /// Exact convolution over the whole history, second order; cost and memory grow with the step count. The reference.
+    FC_HISTORY_FULL = 2,
+    /// Sum of exponentials: full memory to `history_tolerance` on [`history_min_dt`, `history_horizon`] at constant cost. The default.
+    FC_HISTORY_SOE = 3,
 }
 
 /// Values of `FcClothDesc::integrator`.
@@ -49,7 +53,7 @@ pub enum FcSpringDamping {
 #[allow(non_camel_case_types)]
 #[repr(C)]
 pub enum FcPreset {
-    /// The paper's fractional cloth (Eq. 2-7, u = 3, explicit Euler). Same as the defaults.
+    /// The paper's fractional cloth exactly (Eq. 2-7, u = 3, explicit Euler).
     FC_PRESET_FRACTIONAL_PAPER = 0,
     /// Regular cloth of Fig. 7, first column: damped springs, viscous and normal drag.
     FC_PRESET_REGULAR_VISCOUS_NORMAL = 1,
@@ -100,10 +104,16 @@ pub struct FcClothDesc {
     pub history_drag: f64,
     /// Linear normal drag k_nd, N s/m per particle. Default 0.
     pub normal_drag: f64,
-    /// An `FcHistoryScheme` value. Default `FC_HISTORY_TRUNCATED`.
+    /// An `FcHistoryScheme` value. Default `FC_HISTORY_SOE`.
     pub history_scheme: u32,
     /// Past states kept by `FC_HISTORY_TRUNCATED` (>= 1). Default 3, as in the paper.
     pub history_u: u32,
+    /// Relative error of the SOE kernel, in [1e-12, 0.1]. Default 1e-3.
+    pub history_tolerance: f64,
+    /// Longest simulated time (s) over which the SOE memory is accurate. Default 3600.
+    pub history_horizon: f64,
+    /// Smallest step (s) the SOE kernel is built for. Default 1e-4.
+    pub history_min_dt: f64,
     /// An `FcIntegrator` value. Default `FC_INTEGRATOR_EXPLICIT_EULER`.
     pub integrator: u32,
     /// Collision penalty stiffness, N/m. Default 50.
@@ -122,9 +132,21 @@ fn v3(a: [f64; 3]) -> Vec3 {
 
 impl FcClothDesc {
     fn from_model(model: &Model, config: &ClothConfig) -> Self {
+        use crate::history::{DEFAULT_SOE_HORIZON, DEFAULT_SOE_MIN_DT, DEFAULT_SOE_TOLERANCE};
+        let (mut tol, mut horizon, mut min_dt) =
+            (DEFAULT_SOE_TOLERANCE, DEFAULT_SOE_HORIZON, DEFAULT_SOE_MIN_DT);
         let (scheme, u) = match config.scheme {
             Scheme::Off => (FcHistoryScheme::FC_HISTORY_OFF as u32, 3),
             Scheme::Truncated { u } => (FcHistoryScheme::FC_HISTORY_TRUNCATED as u32, u),
+            Scheme::Full => (FcHistoryScheme::FC_HISTORY_FULL as u32, 3),
+            Scheme::SumOfExponentials {
+                tolerance,
+                horizon: hz,
+                min_dt: md,
+            } => {
+                (tol, horizon, min_dt) = (tolerance, hz, md);
+                (FcHistoryScheme::FC_HISTORY_SOE as u32, 3)
+            }
         };
         Self {
             width: 61,
@@ -150,6 +172,9 @@ impl FcClothDesc {
             normal_drag: model.normal_drag,
             history_scheme: scheme,
             history_u: u,
+            history_tolerance: tol,
+            history_horizon: horizon,
+            history_min_dt: min_dt,
             integrator: FcIntegrator::FC_INTEGRATOR_EXPLICIT_EULER as u32,
             collision_stiffness: model.collision_stiffness,
             collision_damping: model.collision_damping,
@@ -198,6 +223,12 @@ impl FcClothDesc {
             0 => Scheme::Off,
             1 if self.history_u >= 1 => Scheme::Truncated { u: self.history_u },
             1 => return Err(FfiError::invalid("history_u must be >= 1")),
+            2 => Scheme::Full,
+            3 => Scheme::SumOfExponentials {
+                tolerance: self.history_tolerance,
+                horizon: self.history_horizon,
+                min_dt: self.history_min_dt,
+            },
             x => {
                 return Err(FfiError::invalid(format!(
                     "history_scheme {x} is not an FcHistoryScheme value"
@@ -238,7 +269,9 @@ impl FcClothDesc {
 }
 
 /// The default description: a 61 x 41 grid of 1 cm spacing (0.6 m x 0.4 m, 0.24 kg)
-/// with the paper's fractional model (Eq. 2-7, u = 3, explicit Euler).
+/// with the paper's fractional forces (Eq. 2-5), the accurate SOE history (tolerance
+/// 1e-3) and explicit Euler. `fc_cloth_desc_preset(FC_PRESET_FRACTIONAL_PAPER, ...)`
+/// gives the paper's exact configuration (u = 3).
 #[no_mangle]
 pub extern "C" fn fc_cloth_desc_default() -> FcClothDesc {
     let config = ClothConfig::default();
@@ -256,6 +289,11 @@ pub unsafe extern "C" fn fc_cloth_desc_preset(preset: u32, out_desc: *mut FcClot
         if out_desc.is_null() {
             return Err(FfiError::null("out_desc"));
         }
+        let scheme = if preset == 0 {
+            Scheme::PAPER
+        } else {
+            Scheme::DEFAULT
+        };
         let model = match preset {
             0 => Model::fractional(),
             1 => Model::regular(RegularDrag::ViscousAndNormal),
@@ -263,7 +301,10 @@ pub unsafe extern "C" fn fc_cloth_desc_preset(preset: u32, out_desc: *mut FcClot
             3 => Model::regular(RegularDrag::Normal),
             x => return Err(FfiError::invalid(format!("preset {x} is not an FcPreset value"))),
         };
-        let config = ClothConfig::default();
+        let config = ClothConfig {
+            scheme,
+            ..ClothConfig::default()
+        };
         // SAFETY: checked non-NULL; the caller promises it is writable.
         unsafe { *out_desc = FcClothDesc::from_model(&model, &config) };
         Ok(())

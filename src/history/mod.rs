@@ -2,19 +2,32 @@
 //!
 //! Caputo form: `D^{1/2}x(t) = 1/sqrt(pi) * integral_0^t (t - s)^{-1/2} v(s) ds`.
 //! Every scheme computes, at step n, `D^{1/2}x_n = w0 * v_n + H_n`: `w0` weighs the
-//! current velocity and `H_n` depends only on velocities already pushed. The
-//! split is what lets an implicit integrator treat `w0` as damping and `H_n` as a
-//! known force.
+//! current velocity and `H_n` depends only on velocities already pushed. The split is
+//! what lets an implicit integrator treat `w0` as damping and `H_n` as a known force.
 //!
-//! Protocol, once per step of size h:
-//! 1. [`HalfDerivative::prepare`] with h;
+//! Protocol, once per step:
+//! 1. [`HalfDerivative::prepare`] (the scheme knows its own clock from the steps pushed);
 //! 2. [`HalfDerivative::current_weight`] and [`HalfDerivative::past`] as often as needed;
-//! 3. after the step is accepted, [`HalfDerivative::push`] the velocities v_n the step used.
+//! 3. after the step of size h is accepted, [`HalfDerivative::push`] the velocities v_n the
+//!    step started from, with h.
+//!
+//! Schemes, one file each: [`Truncated`] (the paper's Eq. 6), [`Full`] (exact product
+//! integration over all history, the reference), [`SumOfExponentials`] (full memory at
+//! O(K) cost). See `docs/accuracy.md` for their measured orders and errors.
 
+mod full;
+mod kernel;
+mod soe;
+mod soe_kernel;
 mod truncated;
 
-pub use truncated::Truncated;
+pub use full::Full;
+pub use kernel::panel_weights;
+pub use soe::SumOfExponentials;
+pub use soe_kernel::SoeKernel;
+pub use truncated::{eq6_weights, Truncated};
 
+use crate::error::Error;
 use crate::Vec3;
 
 /// Which scheme evaluates D^{1/2}x (configuration; see [`History`] for the state).
@@ -24,24 +37,70 @@ pub enum Scheme {
     Off,
     /// The paper's Eq. 6 with the history truncated to the last `u` velocities (`u >= 1`).
     Truncated { u: u32 },
+    /// Exact convolution over the whole history, second order; O(n) per step. The reference.
+    Full,
+    /// Kernel approximated by a sum of exponentials with relative error `tolerance` on
+    /// `[min_dt, horizon]` seconds; O(K) per step, K ~ log(horizon / min_dt).
+    SumOfExponentials {
+        tolerance: f64,
+        horizon: f64,
+        min_dt: f64,
+    },
 }
 
 impl Scheme {
     /// The paper's configuration (u = 3).
     pub const PAPER: Scheme = Scheme::Truncated { u: 3 };
+    /// The default: SOE with 1e-3 relative kernel error (well below what the eye sees in
+    /// cloth motion, see `docs/accuracy.md`) for steps down to 0.1 ms and shots up to 1 h (20 modes).
+    pub const DEFAULT: Scheme = Scheme::SumOfExponentials {
+        tolerance: DEFAULT_SOE_TOLERANCE,
+        horizon: DEFAULT_SOE_HORIZON,
+        min_dt: DEFAULT_SOE_MIN_DT,
+    };
+
+    /// Checks the parameters without building anything heavy.
+    pub fn validate(&self) -> Result<(), Error> {
+        match *self {
+            Scheme::Truncated { u: 0 } => Err(Error::invalid("truncated history needs u >= 1")),
+            Scheme::SumOfExponentials {
+                tolerance,
+                horizon,
+                min_dt,
+            } => soe_kernel::check_parameters(tolerance, min_dt, horizon),
+            _ => Ok(()),
+        }
+    }
+
+    /// Short human name.
+    pub fn name(&self) -> String {
+        match *self {
+            Scheme::Off => "off".into(),
+            Scheme::Truncated { u } => format!("truncated u={u}"),
+            Scheme::Full => "full".into(),
+            Scheme::SumOfExponentials { tolerance, .. } => format!("soe tol={tolerance:e}"),
+        }
+    }
 }
+
+/// Default SOE relative kernel tolerance.
+pub const DEFAULT_SOE_TOLERANCE: f64 = 1e-3;
+/// Default SOE horizon, s (one hour).
+pub const DEFAULT_SOE_HORIZON: f64 = 3600.0;
+/// Default SOE smallest step, s.
+pub const DEFAULT_SOE_MIN_DT: f64 = 1e-4;
 
 /// One way of evaluating the half-derivative for every particle of a cloth.
 pub trait HalfDerivative {
-    /// Readies the weights for a step of size `h` seconds.
-    fn prepare(&mut self, h: f64);
+    /// Readies the weights for the current step.
+    fn prepare(&mut self);
     /// Weight w0 of the current velocity v_n.
     fn current_weight(&self) -> f64;
     /// Writes H_n (the part from the past) for every particle into `out`.
     fn past(&self, out: &mut [Vec3]);
-    /// Records the velocities v_n used by the step just accepted.
-    fn push(&mut self, v: &[Vec3]);
-    /// Bytes of history held per particle.
+    /// Records the velocities v_n the accepted step of size `h` (s) started from.
+    fn push(&mut self, v: &[Vec3], h: f64);
+    /// Bytes of history held per particle now.
     fn bytes_per_particle(&self) -> usize;
     /// Forgets the past (as at t = 0).
     fn reset(&mut self);
@@ -52,28 +111,44 @@ pub trait HalfDerivative {
 pub enum History {
     Off,
     Truncated(Truncated),
+    Full(Full),
+    SumOfExponentials(SumOfExponentials),
 }
 
 impl History {
     /// Builds the state for `n` particles. `Off` allocates nothing.
-    pub fn new(scheme: Scheme, n: usize) -> Self {
-        match scheme {
+    pub fn new(scheme: Scheme, n: usize) -> Result<Self, Error> {
+        scheme.validate()?;
+        Ok(match scheme {
             Scheme::Off => History::Off,
-            Scheme::Truncated { u } => History::Truncated(Truncated::new(u.max(1) as usize, n)),
-        }
+            Scheme::Truncated { u } => History::Truncated(Truncated::new(u as usize, n)),
+            Scheme::Full => History::Full(Full::new(n)),
+            Scheme::SumOfExponentials {
+                tolerance,
+                horizon,
+                min_dt,
+            } => History::SumOfExponentials(SumOfExponentials::new(
+                SoeKernel::build(tolerance, min_dt, horizon)?,
+                n,
+            )),
+        })
     }
 
     fn inner(&self) -> Option<&dyn HalfDerivative> {
         match self {
             History::Off => None,
-            History::Truncated(t) => Some(t),
+            History::Truncated(s) => Some(s),
+            History::Full(s) => Some(s),
+            History::SumOfExponentials(s) => Some(s),
         }
     }
 
     fn inner_mut(&mut self) -> Option<&mut dyn HalfDerivative> {
         match self {
             History::Off => None,
-            History::Truncated(t) => Some(t),
+            History::Truncated(s) => Some(s),
+            History::Full(s) => Some(s),
+            History::SumOfExponentials(s) => Some(s),
         }
     }
 
@@ -81,12 +156,20 @@ impl History {
     pub fn is_off(&self) -> bool {
         matches!(self, History::Off)
     }
+
+    /// Exponential modes in use (SOE only; 0 otherwise).
+    pub fn mode_count(&self) -> usize {
+        match self {
+            History::SumOfExponentials(s) => s.mode_count(),
+            _ => 0,
+        }
+    }
 }
 
 impl HalfDerivative for History {
-    fn prepare(&mut self, h: f64) {
+    fn prepare(&mut self) {
         if let Some(s) = self.inner_mut() {
-            s.prepare(h)
+            s.prepare()
         }
     }
     fn current_weight(&self) -> f64 {
@@ -98,9 +181,9 @@ impl HalfDerivative for History {
             None => out.fill(Vec3::zeros()),
         }
     }
-    fn push(&mut self, v: &[Vec3]) {
+    fn push(&mut self, v: &[Vec3], h: f64) {
         if let Some(s) = self.inner_mut() {
-            s.push(v)
+            s.push(v, h)
         }
     }
     fn bytes_per_particle(&self) -> usize {

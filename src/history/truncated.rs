@@ -24,8 +24,9 @@
 //! u = 1 keeps only the local brackets. Before u steps have been taken the sum starts
 //! at i = 1 as printed, and at n = 0 the integral is empty, so D^{1/2}x_0 = 0.
 //!
-//! The scheme assumes a constant step; if h changes, the stored velocities are
-//! weighted as if they had been sampled at the new h.
+//! The scheme assumes a constant step h (the size of the last step taken); if the
+//! step changes, the stored velocities are weighted as if they had been sampled at
+//! the newest step size.
 
 use super::HalfDerivative;
 use crate::Vec3;
@@ -42,6 +43,8 @@ pub struct Truncated {
     pushed: u64,
     /// weights[k] multiplies v_{n-k}; weights[0] = w0.
     weights: Vec<f64>,
+    /// The step h of Eq. 6: the size of the last step pushed.
+    h: f64,
 }
 
 /// Eq. 6 weights for step h with `panels` past panels (`panels = min(u-1, n-1)`, n >= 1):
@@ -75,6 +78,7 @@ impl Truncated {
             head: 0,
             pushed: 0,
             weights: Vec::with_capacity(u + 1),
+            h: 0.0,
         }
     }
 
@@ -90,7 +94,8 @@ impl Truncated {
 }
 
 impl HalfDerivative for Truncated {
-    fn prepare(&mut self, h: f64) {
+    fn prepare(&mut self) {
+        let h = self.h;
         if self.pushed == 0 {
             self.weights.clear();
             self.weights.push(0.0);
@@ -113,7 +118,8 @@ impl HalfDerivative for Truncated {
         }
     }
 
-    fn push(&mut self, v: &[Vec3]) {
+    fn push(&mut self, v: &[Vec3], h: f64) {
+        self.h = h;
         let h = self.head;
         self.slots[h * self.n..(h + 1) * self.n].copy_from_slice(&v[..self.n]);
         self.head = (self.head + 1) % self.u;
@@ -129,6 +135,7 @@ impl HalfDerivative for Truncated {
         self.head = 0;
         self.pushed = 0;
         self.weights.clear();
+        self.h = 0.0;
     }
 }
 
@@ -169,12 +176,12 @@ mod tests {
         for n in 0..steps {
             let vn = vel(n);
             hist.push(vn);
-            t.prepare(h);
+            t.prepare();
             t.past(&mut out);
             let ours = t.current_weight() * vn + out[0].x;
             let direct = printed_eq6(&hist, h, u);
             approx::assert_relative_eq!(ours, direct, epsilon = 1e-14, max_relative = 1e-12);
-            t.push(&[Vec3::new(vn, 0.0, 0.0)]);
+            t.push(&[Vec3::new(vn, 0.0, 0.0)], h);
         }
     }
 
@@ -200,7 +207,7 @@ mod tests {
     #[test]
     fn off_before_first_push_and_memory() {
         let mut t = Truncated::new(3, 2);
-        t.prepare(0.01);
+        t.prepare();
         assert_eq!(t.current_weight(), 0.0);
         assert_eq!(t.bytes_per_particle(), 3 * 24);
     }

@@ -1,0 +1,104 @@
+//! `Full`: the exact convolution over the whole history, second order (the reference).
+//!
+//! The velocity is taken piecewise linear between samples and integrated exactly
+//! against the kernel ([`super::kernel::panel_weights`]), so the rule is exact when x is
+//! linear or quadratic in t and second order otherwise. Sample times are stored, so
+//! steps of different sizes are handled exactly. Cost and memory are O(n) per
+//! particle after n steps: use it as the reference, not for long bakes.
+
+use super::kernel::panel_weights;
+use super::HalfDerivative;
+use crate::Vec3;
+
+/// Every past velocity of every particle, with its time.
+#[derive(Clone, Debug)]
+pub struct Full {
+    n: usize,
+    /// Step-major: velocities of step k are `samples[k*n .. (k+1)*n]`.
+    samples: Vec<Vec3>,
+    times: Vec<f64>,
+    /// weights[k] multiplies the velocity of step k; w0 is separate.
+    weights: Vec<f64>,
+    w0: f64,
+    /// Current time: the last sample's time plus the step taken since.
+    now: f64,
+}
+
+impl Full {
+    pub fn new(n: usize) -> Self {
+        Self {
+            n,
+            samples: Vec::new(),
+            times: Vec::new(),
+            weights: Vec::new(),
+            w0: 0.0,
+            now: 0.0,
+        }
+    }
+
+    /// Steps stored so far.
+    pub fn len(&self) -> usize {
+        self.times.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.times.is_empty()
+    }
+}
+
+impl HalfDerivative for Full {
+    fn prepare(&mut self) {
+        let m = self.times.len();
+        self.weights.clear();
+        self.weights.resize(m, 0.0);
+        self.w0 = 0.0;
+        if m == 0 {
+            return; // t = 0: the integral is empty
+        }
+        let t_now = self.now;
+        // Panel between sample k (far) and k+1 (near); the last panel ends at "now".
+        for k in 0..m {
+            let far = t_now - self.times[k];
+            let near = if k + 1 < m { t_now - self.times[k + 1] } else { 0.0 };
+            let (w_near, w_far) = panel_weights(near, far);
+            self.weights[k] += w_far;
+            if k + 1 < m {
+                self.weights[k + 1] += w_near;
+            } else {
+                self.w0 = w_near;
+            }
+        }
+    }
+
+    fn current_weight(&self) -> f64 {
+        self.w0
+    }
+
+    fn past(&self, out: &mut [Vec3]) {
+        out.fill(Vec3::zeros());
+        for (k, &w) in self.weights.iter().enumerate() {
+            let step = &self.samples[k * self.n..(k + 1) * self.n];
+            for (o, v) in out.iter_mut().zip(step) {
+                *o += w * v;
+            }
+        }
+    }
+
+    fn push(&mut self, v: &[Vec3], h: f64) {
+        self.samples.extend_from_slice(&v[..self.n]);
+        self.times.push(self.now);
+        self.now += h;
+    }
+
+    fn bytes_per_particle(&self) -> usize {
+        self.times.len() * std::mem::size_of::<Vec3>()
+    }
+
+    fn reset(&mut self) {
+        self.samples.clear();
+        self.times.clear();
+        self.weights.clear();
+        self.w0 = 0.0;
+        self.now = 0.0;
+    }
+}
