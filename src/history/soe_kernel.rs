@@ -105,7 +105,7 @@ fn gauss_rule(s: &[f64], w: &[f64], l: usize) -> Option<(Vec<f64>, Vec<f64>)> {
             }
         }
         let b = r.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if !(b > 1e-300) {
+        if b.is_nan() || b <= 1e-300 {
             return None;
         }
         beta.push(b);
