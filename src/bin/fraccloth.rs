@@ -39,9 +39,16 @@ struct Args {
     /// Time step, seconds.
     #[arg(long, default_value_t = DEFAULT_DT)]
     dt: f64,
-    /// History length u of the paper's Eq. 6 (0 switches the fractional terms off).
+    /// How D^{1/2} is evaluated: soe (accurate, constant cost; the default), paper (Eq. 6 with
+    /// the last --u states), full (exact convolution, cost grows with time), off.
+    #[arg(long, default_value = "soe")]
+    history: String,
+    /// History length u for --history paper.
     #[arg(long, default_value_t = 3)]
     u: u32,
+    /// Relative kernel tolerance for --history soe.
+    #[arg(long, default_value_t = fraccloth::history::DEFAULT_SOE_TOLERANCE)]
+    tolerance: f64,
     /// Output directory.
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -71,15 +78,22 @@ fn run(args: Args) -> Result<(), String> {
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.fps.is_finite() && args.fps > 0.0) {
         return Err("--seconds and --fps must be positive".into());
     }
+    let scheme = match args.history.as_str() {
+        "soe" => Scheme::SumOfExponentials {
+            tolerance: args.tolerance,
+            horizon: fraccloth::history::DEFAULT_SOE_HORIZON.max(2.0 * args.seconds),
+            min_dt: fraccloth::history::DEFAULT_SOE_MIN_DT.min(args.dt),
+        },
+        "paper" => Scheme::Truncated { u: args.u },
+        "full" => Scheme::Full,
+        "off" => Scheme::Off,
+        other => return Err(format!("unknown history {other:?} (soe, paper, full, off)")),
+    };
     let spec = SceneSpec {
         width,
         height,
         dt: args.dt,
-        scheme: if args.u == 0 {
-            Scheme::Off
-        } else {
-            Scheme::Truncated { u: args.u }
-        },
+        scheme,
         ..SceneSpec::paper(kind, variant)
     };
     let mut scene = spec.build().map_err(|e| e.to_string())?;
@@ -125,14 +139,15 @@ fn run(args: Args) -> Result<(), String> {
     let steps = scene.cloth.step_count();
     let n = topo.vertex_count();
     let summary = format!(
-        "scene        {}\nvariant      {}\ngrid         {} x {} ({} vertices, {} springs)\nhistory      {:?} ({} bytes/particle)\nintegrator   {}\ndt           {} s\nsimulated    {:.3} s in {} steps\nframes       {} at {} fps (+ frame 0)\nwall time    {:.3} s ({:.2} M particle-steps/s)\npoint cache  {}\nrest mesh    {}\n",
+        "scene        {}\nvariant      {}\ngrid         {} x {} ({} vertices, {} springs)\nhistory      {} ({} modes, {} bytes/particle)\nintegrator   {}\ndt           {} s\nsimulated    {:.3} s in {} steps\nframes       {} at {} fps (+ frame 0)\nwall time    {:.3} s ({:.2} M particle-steps/s)\npoint cache  {}\nrest mesh    {}\n",
         kind.name(),
         variant.name(),
         width,
         height,
         n,
         topo.springs.len(),
-        if scene.cloth.history().is_off() { Scheme::Off } else { spec.scheme },
+        if scene.cloth.history().is_off() { Scheme::Off.name() } else { spec.scheme.name() },
+        scene.cloth.history().mode_count(),
         scene.cloth.history().bytes_per_particle(),
         spec.integrator.name(),
         spec.dt,

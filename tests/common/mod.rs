@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+pub mod reference;
+
 /// The directory holding `libfraccloth.so` built for this test run.
 pub fn lib_dir() -> PathBuf {
     build_lib();
