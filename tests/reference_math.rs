@@ -7,11 +7,11 @@ use nalgebra::Complex;
 
 #[test]
 fn talbot_inverts_known_transforms() {
-    for &t in &[0.1, 1.0, 3.0] {
+    for     for &t in &[0.1, 1.0, 3.0] {t in &[0.1f64, 1.0, 3.0] {
         let e = talbot(|s| Complex::new(1.0, 0.0) / (s + 1.0), t, 32);
-        assert!((e - (-t as f64).exp()).abs() < 1e-10, "t={t}: {e}");
+        assert!((e - (-t).exp()).abs() < 1e-10, "t={t}: {e}");
         let sin = talbot(|s| Complex::new(1.0, 0.0) / (s * s + 1.0), t, 32);
-        assert!((sin - (t as f64).sin()).abs() < 1e-9, "t={t}: {sin}");
+        assert!((sin - t.sin()).abs() < 1e-9, "t={t}: {sin}");
         // 1/sqrt(s) -> 1/sqrt(pi t): a branch cut like the fractional oscillator's.
         let k = talbot(|s| Complex::new(1.0, 0.0) / s.sqrt(), t, 32);
         assert!(
