@@ -7,7 +7,7 @@ use nalgebra::Complex;
 
 #[test]
 fn talbot_inverts_known_transforms() {
-    for     for &t in &[0.1, 1.0, 3.0] {t in &[0.1f64, 1.0, 3.0] {
+    for &t in &[0.1f64, 1.0, 3.0] {
         let e = talbot(|s| Complex::new(1.0, 0.0) / (s + 1.0), t, 32);
         assert!((e - (-t).exp()).abs() < 1e-10, "t={t}: {e}");
         let sin = talbot(|s| Complex::new(1.0, 0.0) / (s * s + 1.0), t, 32);
