@@ -78,9 +78,17 @@ typedef enum {
  */
 typedef enum {
   /**
-   * The paper's Eq. 7.
+   * The paper's Eq. 7: `x += h v; v += h a`. Conditionally stable; see docs/stability.md.
    */
   FC_INTEGRATOR_EXPLICIT_EULER = 0,
+  /**
+   * `v += h a; x += h v` (semi-implicit). Same cost, stable to about 2/omega without damping.
+   */
+  FC_INTEGRATOR_SYMPLECTIC_EULER = 1,
+  /**
+   * Backward Euler (Baraff & Witkin), CG solve. Stable at frame-rate steps with stiff cloth.
+   */
+  FC_INTEGRATOR_IMPLICIT_EULER = 2,
 } FcIntegrator;
 
 /**
@@ -228,6 +236,19 @@ typedef struct {
    * An `FcIntegrator` value. Default `FC_INTEGRATOR_EXPLICIT_EULER`.
    */
   uint32_t integrator;
+  /**
+   * Longest substep (s) `fc_cloth_step` takes: a call with a larger dt is split into
+   * `ceil(dt / max_substep)` equal substeps. 0 = never split. Default 0.
+   */
+  double max_substep;
+  /**
+   * Relative residual at which the implicit solver's CG stops (> 0). Default 1e-6.
+   */
+  double solver_tolerance;
+  /**
+   * Iteration cap of the implicit solver's CG (>= 1). Default 500.
+   */
+  uint32_t solver_max_iterations;
   /**
    * Collision penalty stiffness, N/m. Default 50.
    */
@@ -380,6 +401,34 @@ uint32_t fc_cloth_history_mode_count(const FcCloth *cloth);
  * `cloth` must be NULL or a live handle.
  */
 size_t fc_cloth_history_bytes_per_particle(const FcCloth *cloth);
+
+/**
+ * Advances by `dt` seconds in `substeps` equal substeps (1 ..= 1000000); pins travel in a
+ * straight line to their targets over the whole call. Atomic over the whole call.
+ *
+ * # Safety
+ * `cloth` NULL or live.
+ */
+FcStatus fc_cloth_step_substeps(FcCloth *cloth, double dt, uint32_t substeps);
+
+/**
+ * Sets the implicit solver's relative residual tolerance (> 0) and iteration cap (>= 1).
+ *
+ * # Safety
+ * `cloth` NULL or live.
+ */
+FcStatus fc_cloth_set_solver(FcCloth *cloth, double tolerance, uint32_t max_iterations);
+
+/**
+ * Reads what the last implicit solve did: CG iterations and final relative residual.
+ * Both are 0 before the first implicit step and for explicit integrators. Either output may be NULL.
+ *
+ * # Safety
+ * `cloth` NULL or live; outputs NULL or writable.
+ */
+FcStatus fc_cloth_get_solver_stats(const FcCloth *cloth,
+                                   uint32_t *iterations,
+                                   double *residual);
 
 /**
  * Adds a sphere collider (centre in m, radius in m > 0; velocity in m/s, NULL for

@@ -9,7 +9,10 @@
 use crate::error::{check_finite_vec, check_positive, Error};
 use crate::forces::{self, Collider, ForceInput, ForceScratch, Sphere};
 use crate::history::{HalfDerivative, History, Scheme};
-use crate::integrate::{explicit_euler, Integrator};
+use crate::integrate::{
+    explicit_euler, implicit_euler, symplectic_euler, ImplicitInput, ImplicitScratch, Integrator,
+    SolverSettings, SolverStats,
+};
 use crate::model::Model;
 use crate::topology::Topology;
 use crate::Vec3;
@@ -23,6 +26,33 @@ pub struct ClothConfig {
     pub integrator: Integrator,
     /// Speed (m/s) above which a step is declared unstable. Default 100.
     pub max_speed: f64,
+    /// Longest substep (s) `Cloth::step` takes; 0 = one step per call. Default 0.
+    pub max_substep: f64,
+    /// Implicit solver settings.
+    pub solver: SolverSettings,
+}
+
+/// Most substeps one call may take.
+pub const MAX_SUBSTEPS: u32 = 1_000_000;
+
+fn check_dt(dt: f64) -> Result<(), Error> {
+    if dt.is_finite() && dt > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(format!(
+            "dt must be finite and > 0 seconds, got {dt}"
+        )))
+    }
+}
+
+fn check_solver(s: &SolverSettings) -> Result<(), Error> {
+    if !(s.tolerance.is_finite() && s.tolerance > 0.0) || s.max_iterations == 0 {
+        return Err(Error::invalid(format!(
+            "solver tolerance must be finite and > 0 and max_iterations >= 1, got {} and {}",
+            s.tolerance, s.max_iterations
+        )));
+    }
+    Ok(())
 }
 
 impl Default for ClothConfig {
@@ -32,6 +62,8 @@ impl Default for ClothConfig {
             scheme: Scheme::DEFAULT,
             integrator: Integrator::default(),
             max_speed: 100.0,
+            max_substep: 0.0,
+            solver: SolverSettings::default(),
         }
     }
 }
@@ -44,7 +76,43 @@ struct Scratch {
     force: Vec<Vec3>,
     x_new: Vec<Vec3>,
     v_new: Vec<Vec3>,
+    goal: Vec<Vec3>,
+    pin_start: Vec<Vec3>,
     forces: ForceScratch,
+    implicit: ImplicitScratch,
+}
+
+/// State saved before a multi-substep call, restored if a substep fails.
+#[derive(Clone, Debug, Default)]
+struct Snapshot {
+    x: Vec<Vec3>,
+    v: Vec<Vec3>,
+    history: Option<History>,
+    time: f64,
+    steps: u64,
+}
+
+impl Snapshot {
+    fn save(&mut self, c: &Cloth) {
+        self.x.clone_from(&c.x);
+        self.v.clone_from(&c.v);
+        match &mut self.history {
+            Some(h) => h.clone_from(&c.history),
+            None => self.history = Some(c.history.clone()),
+        }
+        self.time = c.time;
+        self.steps = c.steps;
+    }
+
+    fn restore(&mut self, c: &mut Cloth) {
+        std::mem::swap(&mut c.x, &mut self.x);
+        std::mem::swap(&mut c.v, &mut self.v);
+        if let Some(h) = &mut self.history {
+            std::mem::swap(&mut c.history, h);
+        }
+        c.time = self.time;
+        c.steps = self.steps;
+    }
 }
 
 /// One cloth: topology, configuration and state.
@@ -63,6 +131,8 @@ pub struct Cloth {
     time: f64,
     steps: u64,
     scratch: Scratch,
+    snapshot: Snapshot,
+    solver_stats: SolverStats,
 }
 
 impl Cloth {
@@ -71,6 +141,13 @@ impl Cloth {
         config.model.validate()?;
         check_positive("max_speed", config.max_speed)?;
         config.scheme.validate()?;
+        check_solver(&config.solver)?;
+        if !(config.max_substep.is_finite() && config.max_substep >= 0.0) {
+            return Err(Error::invalid(format!(
+                "max_substep must be finite and >= 0, got {}",
+                config.max_substep
+            )));
+        }
         let n = topology.vertex_count();
         let scheme = if config.model.uses_half_derivative() {
             config.scheme
@@ -90,6 +167,8 @@ impl Cloth {
             time: 0.0,
             steps: 0,
             scratch: Scratch::default(),
+            snapshot: Snapshot::default(),
+            solver_stats: SolverStats::default(),
             topology,
             config,
         })
@@ -273,13 +352,72 @@ impl Cloth {
         self.colliders = self.collider_slots.iter().flatten().copied().collect();
     }
 
-    /// Advances by `dt` seconds with the configured integrator. Atomic.
+    /// Advances by `dt` seconds with the configured integrator, split into
+    /// `ceil(dt / max_substep)` equal substeps when `max_substep` is set. Atomic.
     pub fn step(&mut self, dt: f64) -> Result<(), Error> {
-        if !(dt.is_finite() && dt > 0.0) {
+        check_dt(dt)?;
+        let max = self.config.max_substep;
+        let n = if max > 0.0 {
+            (dt / max).ceil().max(1.0)
+        } else {
+            1.0
+        };
+        if n > MAX_SUBSTEPS as f64 {
             return Err(Error::invalid(format!(
-                "dt must be finite and > 0 seconds, got {dt}"
+                "dt / max_substep = {n} substeps exceeds the limit of {MAX_SUBSTEPS}"
             )));
         }
+        self.step_substeps(dt, n as u32)
+    }
+
+    /// Advances by `dt` seconds in `substeps` equal substeps. Pins travel in a straight
+    /// line to their targets over the whole call. Atomic over the whole call: if any
+    /// substep fails, the cloth is restored to its state before the call.
+    pub fn step_substeps(&mut self, dt: f64, substeps: u32) -> Result<(), Error> {
+        check_dt(dt)?;
+        if substeps == 0 || substeps > MAX_SUBSTEPS {
+            return Err(Error::invalid(format!(
+                "substeps must be in 1..={MAX_SUBSTEPS}, got {substeps}"
+            )));
+        }
+        if substeps == 1 {
+            return self.advance(dt, None);
+        }
+        let h = dt / f64::from(substeps);
+        let mut snap = std::mem::take(&mut self.snapshot);
+        snap.save(self);
+        self.scratch.pin_start.clear();
+        self.scratch
+            .pin_start
+            .extend(self.pin_list.iter().map(|&i| self.x[i as usize]));
+        for k in 1..=substeps {
+            let goal = (k < substeps).then_some(f64::from(k) / f64::from(substeps));
+            if let Err(mut e) = self.advance(h, goal) {
+                snap.restore(self);
+                self.snapshot = snap;
+                e.message = format!("substep {k} of {substeps}: {}", e.message);
+                return Err(e);
+            }
+        }
+        self.snapshot = snap;
+        Ok(())
+    }
+
+    /// Statistics of the last implicit solve (zeros for explicit integrators).
+    pub fn solver_stats(&self) -> SolverStats {
+        self.solver_stats
+    }
+
+    /// Sets the implicit solver's tolerance and iteration cap.
+    pub fn set_solver(&mut self, settings: SolverSettings) -> Result<(), Error> {
+        check_solver(&settings)?;
+        self.config.solver = settings;
+        Ok(())
+    }
+
+    /// One step of size `h`. Pins go to `pin_start + fraction (target - pin_start)`, or to
+    /// their targets when `fraction` is None.
+    fn advance(&mut self, h: f64, fraction: Option<f64>) -> Result<(), Error> {
         let n = self.vertex_count();
         let s = &mut self.scratch;
         for buf in [
@@ -289,24 +427,30 @@ impl Cloth {
             &mut s.force,
             &mut s.x_new,
             &mut s.v_new,
+            &mut s.goal,
         ] {
             buf.resize(n, Vec3::zeros());
         }
-        // Pins move in a straight line to their targets over the step; that is their velocity.
+        // Pins move in a straight line to their goals over the step; that is their velocity.
         s.v_step.copy_from_slice(&self.v);
-        for &i in &self.pin_list {
+        for (k, &i) in self.pin_list.iter().enumerate() {
             let i = i as usize;
-            s.v_step[i] = (self.pin_target[i] - self.x[i]) / dt;
+            s.goal[i] = match fraction {
+                Some(f) => s.pin_start[k] + f * (self.pin_target[i] - s.pin_start[k]),
+                None => self.pin_target[i],
+            };
+            s.v_step[i] = (s.goal[i] - self.x[i]) / h;
         }
         let current = self.config.model.current;
         for (r, v) in s.v_rel.iter_mut().zip(&s.v_step) {
             *r = v - current;
         }
         // D^{1/2}x_n = w0 v_n + H_n.
+        let mut w0 = 0.0;
         if !self.history.is_off() {
             self.history.prepare();
             self.history.past(&mut s.half);
-            let w0 = self.history.current_weight();
+            w0 = self.history.current_weight();
             for (d, r) in s.half.iter_mut().zip(&s.v_rel) {
                 *d += w0 * r;
             }
@@ -320,28 +464,55 @@ impl Cloth {
             colliders: &self.colliders,
         };
         forces::accumulate(&input, &mut s.forces, &mut s.force);
+        let masses = &self.topology.masses;
         match self.config.integrator {
             Integrator::ExplicitEuler => explicit_euler(
-                dt,
+                h,
                 &self.x,
                 &s.v_step,
                 &s.force,
-                &self.topology.masses,
+                masses,
                 &mut s.x_new,
                 &mut s.v_new,
             ),
+            Integrator::SymplecticEuler => symplectic_euler(
+                h,
+                &self.x,
+                &s.v_step,
+                &s.force,
+                masses,
+                &mut s.x_new,
+                &mut s.v_new,
+            ),
+            Integrator::ImplicitEuler => {
+                forces::linearise(&input, w0, s.forces.normals(), &mut s.implicit.lin);
+                let inp = ImplicitInput {
+                    h,
+                    x: &self.x,
+                    v: &s.v_step,
+                    force: &s.force,
+                    masses,
+                    springs: &self.topology.springs,
+                    pinned: &self.pinned,
+                    settings: self.config.solver,
+                };
+                self.solver_stats = implicit_euler(&inp, &mut s.implicit, &mut s.v_new);
+                for i in 0..n {
+                    s.x_new[i] = self.x[i] + h * s.v_new[i];
+                }
+            }
         }
         for &i in &self.pin_list {
             let i = i as usize;
-            s.x_new[i] = self.pin_target[i];
+            s.x_new[i] = s.goal[i];
             s.v_new[i] = s.v_step[i];
         }
-        self.check_sound(dt)?;
+        self.check_sound(h)?;
         let s = &mut self.scratch;
         std::mem::swap(&mut self.x, &mut s.x_new);
         std::mem::swap(&mut self.v, &mut s.v_new);
-        self.history.push(&s.v_rel, dt);
-        self.time += dt;
+        self.history.push(&s.v_rel, h);
+        self.time += h;
         self.steps += 1;
         Ok(())
     }

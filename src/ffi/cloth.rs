@@ -308,3 +308,64 @@ pub unsafe extern "C" fn fc_cloth_history_bytes_per_particle(cloth: *const FcClo
         unsafe { handle(cloth) }.map_or(0, |c| c.history().bytes_per_particle())
     })
 }
+
+/// Advances by `dt` seconds in `substeps` equal substeps (1 ..= 1000000); pins travel in a
+/// straight line to their targets over the whole call. Atomic over the whole call.
+///
+/// # Safety
+/// `cloth` NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_step_substeps(cloth: *mut FcCloth, dt: f64, substeps: u32) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        Ok(cloth.step_substeps(dt, substeps)?)
+    })
+}
+
+/// Sets the implicit solver's relative residual tolerance (> 0) and iteration cap (>= 1).
+///
+/// # Safety
+/// `cloth` NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_solver(
+    cloth: *mut FcCloth,
+    tolerance: f64,
+    max_iterations: u32,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        Ok(cloth.set_solver(crate::integrate::SolverSettings {
+            tolerance,
+            max_iterations,
+        })?)
+    })
+}
+
+/// Reads what the last implicit solve did: CG iterations and final relative residual.
+/// Both are 0 before the first implicit step and for explicit integrators. Either output may be NULL.
+///
+/// # Safety
+/// `cloth` NULL or live; outputs NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_solver_stats(
+    cloth: *const FcCloth,
+    iterations: *mut u32,
+    residual: *mut f64,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let stats = unsafe { handle(cloth) }?.solver_stats();
+        // SAFETY: each output is NULL or writable, as the caller promises.
+        unsafe {
+            if let Some(i) = iterations.as_mut() {
+                *i = stats.iterations;
+            }
+            if let Some(r) = residual.as_mut() {
+                *r = stats.residual;
+            }
+        }
+        Ok(())
+    })
+}

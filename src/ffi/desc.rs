@@ -8,7 +8,7 @@
 
 use crate::cloth::ClothConfig;
 use crate::history::Scheme;
-use crate::integrate::Integrator;
+use crate::integrate::{Integrator, SolverSettings};
 use crate::model::{Model, RegularDrag, SpringDamping};
 use crate::topology::GridSpec;
 use crate::Vec3;
@@ -33,8 +33,12 @@ pub enum FcHistoryScheme {
 #[allow(non_camel_case_types)]
 #[repr(C)]
 pub enum FcIntegrator {
-    /// The paper's Eq. 7.
+    /// The paper's Eq. 7: `x += h v; v += h a`. Conditionally stable; see docs/stability.md.
     FC_INTEGRATOR_EXPLICIT_EULER = 0,
+    /// `v += h a; x += h v` (semi-implicit). Same cost, stable to about 2/omega without damping.
+    FC_INTEGRATOR_SYMPLECTIC_EULER = 1,
+    /// Backward Euler (Baraff & Witkin), CG solve. Stable at frame-rate steps with stiff cloth.
+    FC_INTEGRATOR_IMPLICIT_EULER = 2,
 }
 
 /// Values of `FcClothDesc::spring_damping_mode`.
@@ -116,6 +120,13 @@ pub struct FcClothDesc {
     pub history_min_dt: f64,
     /// An `FcIntegrator` value. Default `FC_INTEGRATOR_EXPLICIT_EULER`.
     pub integrator: u32,
+    /// Longest substep (s) `fc_cloth_step` takes: a call with a larger dt is split into
+    /// `ceil(dt / max_substep)` equal substeps. 0 = never split. Default 0.
+    pub max_substep: f64,
+    /// Relative residual at which the implicit solver's CG stops (> 0). Default 1e-6.
+    pub solver_tolerance: f64,
+    /// Iteration cap of the implicit solver's CG (>= 1). Default 500.
+    pub solver_max_iterations: u32,
     /// Collision penalty stiffness, N/m. Default 50.
     pub collision_stiffness: f64,
     /// Collision approach damping, N s/m. Default 0.05.
@@ -175,7 +186,14 @@ impl FcClothDesc {
             history_tolerance: tol,
             history_horizon: horizon,
             history_min_dt: min_dt,
-            integrator: FcIntegrator::FC_INTEGRATOR_EXPLICIT_EULER as u32,
+            integrator: match config.integrator {
+                Integrator::ExplicitEuler => FcIntegrator::FC_INTEGRATOR_EXPLICIT_EULER,
+                Integrator::SymplecticEuler => FcIntegrator::FC_INTEGRATOR_SYMPLECTIC_EULER,
+                Integrator::ImplicitEuler => FcIntegrator::FC_INTEGRATOR_IMPLICIT_EULER,
+            } as u32,
+            max_substep: config.max_substep,
+            solver_tolerance: config.solver.tolerance,
+            solver_max_iterations: config.solver.max_iterations,
             collision_stiffness: model.collision_stiffness,
             collision_damping: model.collision_damping,
             collision_margin: model.collision_margin,
@@ -237,6 +255,8 @@ impl FcClothDesc {
         };
         let integrator = match self.integrator {
             0 => Integrator::ExplicitEuler,
+            1 => Integrator::SymplecticEuler,
+            2 => Integrator::ImplicitEuler,
             x => {
                 return Err(FfiError::invalid(format!(
                     "integrator {x} is not an FcIntegrator value"
@@ -264,6 +284,11 @@ impl FcClothDesc {
             scheme,
             integrator,
             max_speed: self.max_speed,
+            max_substep: self.max_substep,
+            solver: SolverSettings {
+                tolerance: self.solver_tolerance,
+                max_iterations: self.solver_max_iterations,
+            },
         })
     }
 }

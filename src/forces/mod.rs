@@ -6,11 +6,13 @@
 mod body;
 mod contact;
 mod drag;
+mod jacobian;
 mod normals;
 mod springs;
 
 pub use body::body_force;
 pub use contact::{Collider, Sphere};
+pub use jacobian::{linearise, Linearisation};
 pub use normals::vertex_normals;
 
 use crate::model::Model;
@@ -36,6 +38,13 @@ pub struct ForceInput<'a> {
 #[derive(Clone, Debug, Default)]
 pub struct ForceScratch {
     normals: Vec<Vec3>,
+}
+
+impl ForceScratch {
+    /// Vertex normals of the last evaluation (empty when no term needed them).
+    pub fn normals(&self) -> &[Vec3] {
+        &self.normals
+    }
 }
 
 /// Writes the total force on every particle into `f` (N).

@@ -2,11 +2,17 @@
 //!
 //! An integrator reads the state at t_n and writes the state at t_n + h into
 //! `x_new`/`v_new`; the cloth checks the result and commits it only if it is sound,
-//! so every step is atomic.
+//! so every step is atomic. See `docs/stability.md` for where each one fails.
 
+mod cg;
 mod explicit_euler;
+mod implicit_euler;
+mod symplectic_euler;
 
+pub use cg::{SolverSettings, SolverStats};
 pub use explicit_euler::explicit_euler;
+pub use implicit_euler::{implicit_euler, ImplicitInput, ImplicitScratch};
+pub use symplectic_euler::symplectic_euler;
 
 /// Which integrator advances the cloth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -14,13 +20,34 @@ pub enum Integrator {
     /// The paper's Eq. 7: `x += h v; v += h a`, both from the state at t_n.
     #[default]
     ExplicitEuler,
+    /// `v += h a(t_n)`, then `x += h v_{n+1}`.
+    SymplecticEuler,
+    /// Backward Euler, linearised (Baraff & Witkin), solved by preconditioned CG.
+    ImplicitEuler,
 }
 
 impl Integrator {
+    pub const ALL: [Integrator; 3] = [
+        Integrator::ExplicitEuler,
+        Integrator::SymplecticEuler,
+        Integrator::ImplicitEuler,
+    ];
+
     /// Human name, used in messages.
     pub fn name(&self) -> &'static str {
         match self {
             Integrator::ExplicitEuler => "explicit Euler",
+            Integrator::SymplecticEuler => "symplectic Euler",
+            Integrator::ImplicitEuler => "implicit Euler",
+        }
+    }
+
+    /// Short name for files and command lines.
+    pub fn key(&self) -> &'static str {
+        match self {
+            Integrator::ExplicitEuler => "explicit",
+            Integrator::SymplecticEuler => "symplectic",
+            Integrator::ImplicitEuler => "implicit",
         }
     }
 }
