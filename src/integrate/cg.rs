@@ -83,7 +83,7 @@ pub fn solve(
             }
         }
         let pq = dot(p, q);
-        if !(pq > 0.0) {
+        if pq.is_nan() || pq <= 0.0 {
             break; // not positive definite along p (only on broken input): stop with what we have
         }
         let alpha = rz / pq;
