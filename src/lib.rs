@@ -19,6 +19,7 @@ pub mod forces;
 pub mod history;
 pub mod integrate;
 pub mod model;
+pub mod oscillator;
 pub mod scenes;
 pub mod topology;
 

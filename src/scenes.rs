@@ -129,6 +129,8 @@ pub struct SceneSpec {
     pub integrator: Integrator,
     /// Step, s.
     pub dt: f64,
+    /// Multiplies every spring constant (1 = the model's own); for stiffness sweeps.
+    pub stiffness_scale: f64,
 }
 
 impl SceneSpec {
@@ -142,6 +144,7 @@ impl SceneSpec {
             scheme: Scheme::PAPER,
             integrator: Integrator::ExplicitEuler,
             dt: DEFAULT_DT,
+            stiffness_scale: 1.0,
         }
     }
 
@@ -159,8 +162,12 @@ impl SceneSpec {
             total_mass: CLOTH_MASS,
         }
         .build()?;
+        let mut model = self.variant.model(spacing);
+        model.stretch_stiffness *= self.stiffness_scale;
+        model.shear_stiffness *= self.stiffness_scale;
+        model.bend_stiffness *= self.stiffness_scale;
         let config = ClothConfig {
-            model: self.variant.model(spacing),
+            model,
             scheme: self.scheme,
             integrator: self.integrator,
             ..ClothConfig::default()
