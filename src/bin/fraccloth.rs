@@ -12,7 +12,7 @@ use clap::Parser;
 use fraccloth::export::{write_obj, Pc2Writer};
 use fraccloth::history::Scheme;
 use fraccloth::scenes::{SceneKind, SceneSpec, Variant, DEFAULT_DT};
-use fraccloth::HalfDerivative;
+use fraccloth::{HalfDerivative, Integrator};
 use indicatif::{ProgressBar, ProgressStyle};
 
 #[derive(Parser, Debug)]
@@ -39,6 +39,9 @@ struct Args {
     /// Time step, seconds.
     #[arg(long, default_value_t = DEFAULT_DT)]
     dt: f64,
+    /// Integrator: explicit (the paper's Eq. 7), symplectic, implicit (stable at frame rate).
+    #[arg(long, default_value = "explicit")]
+    integrator: String,
     /// How D^{1/2} is evaluated: soe (accurate, constant cost; the default), paper (Eq. 6 with
     /// the last --u states), full (exact convolution, cost grows with time), off.
     #[arg(long, default_value = "soe")]
@@ -89,11 +92,16 @@ fn run(args: Args) -> Result<(), String> {
         "off" => Scheme::Off,
         other => return Err(format!("unknown history {other:?} (soe, paper, full, off)")),
     };
+    let integrator = Integrator::ALL
+        .into_iter()
+        .find(|i| i.key() == args.integrator)
+        .ok_or_else(|| format!("unknown integrator {:?} (explicit, symplectic, implicit)", args.integrator))?;
     let spec = SceneSpec {
         width,
         height,
         dt: args.dt,
         scheme,
+        integrator,
         ..SceneSpec::paper(kind, variant)
     };
     let mut scene = spec.build().map_err(|e| e.to_string())?;
