@@ -22,10 +22,16 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 const SOE_DEFAULT: Scheme = Scheme::DEFAULT;
-const SOE_FINE: Scheme = Scheme::SumOfExponentials { tolerance: 1e-6, horizon: 3600.0, min_dt: 1e-5 };
+const SOE_FINE: Scheme = Scheme::SumOfExponentials {
+    tolerance: 1e-6,
+    horizon: 3600.0,
+    min_dt: 1e-5,
+};
 
 fn oscillator_stable(o: &Oscillator, scheme: Scheme, integrator: Integrator, dt: f64) -> bool {
-    let Ok(mut cloth) = o.cloth(scheme, integrator) else { return false };
+    let Ok(mut cloth) = o.cloth(scheme, integrator) else {
+        return false;
+    };
     // At least 20 periods of the undamped oscillator (or 400 steps).
     let period = std::f64::consts::TAU / (o.k / o.m).sqrt();
     let cap = if scheme == Scheme::Full { 8_000.0 } else { 40_000.0 };
@@ -113,7 +119,11 @@ fn colour(i: Integrator) -> RGBColor {
     }
 }
 
-fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, rows: &[Row], schemes: &[Scheme]) -> Result<(), Box<dyn Error>>
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    rows: &[Row],
+    schemes: &[Scheme],
+) -> Result<(), Box<dyn Error>>
 where
     DB::ErrorType: 'static,
 {
@@ -123,13 +133,17 @@ where
         ("oscillator", "spring constant k (N/m), m = 1 kg, c = 0.8"),
         ("swing", "stiffness scale of the swing cloth (1 = 10 N/m stretch)"),
     ]) {
-        let mine: Vec<&Row> = rows.iter().filter(|r| r.problem == problem && r.dt.is_finite()).collect();
+        let mine: Vec<&Row> = rows
+            .iter()
+            .filter(|r| r.problem == problem && r.dt.is_finite())
+            .collect();
         let xs = mine.iter().map(|r| r.stiffness);
         let (xmin, xmax) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
         let mut chart = ChartBuilder::on(panel)
             .caption(
                 if problem == "oscillator" {
-                    "largest stable dt: fractional oscillator (top = stable at every dt tried, 1 s)".to_string()
+                    "largest stable dt: fractional oscillator (top = stable at every dt tried, 1 s)"
+                        .to_string()
                 } else {
                     "largest stable dt: swing scene 31 x 21 (top = stable at frame rate, 1/24 s)".to_string()
                 },
@@ -156,7 +170,11 @@ where
                     continue;
                 }
                 let c = colour(integrator);
-                let style = ShapeStyle { color: c.to_rgba(), filled: si % 2 == 0, stroke_width: 2 };
+                let style = ShapeStyle {
+                    color: c.to_rgba(),
+                    filled: si % 2 == 0,
+                    stroke_width: 2,
+                };
                 chart.draw_series(LineSeries::new(pts.clone(), c.stroke_width(1)))?;
                 let label = format!("{} / {}", integrator.key(), scheme_label(scheme));
                 let marker = move |(x, y): (f64, f64)| -> DynElement<DB, (f64, f64)> {
@@ -180,16 +198,31 @@ where
         }
         if problem == "oscillator" {
             let ks: Vec<f64> = mine.iter().map(|r| r.stiffness).collect();
-            let bound = |k: f64, f: fn(&Oscillator) -> f64| f(&Oscillator { k, ..Oscillator::default() });
-            let explicit: Vec<(f64, f64)> =
-                ks.iter().map(|&k| (k, bound(k, Oscillator::explicit_euler_bound))).collect();
-            let symplectic: Vec<(f64, f64)> = ks.iter().map(|&k| (k, bound(k, Oscillator::symplectic_bound))).collect();
+            let bound = |k: f64, f: fn(&Oscillator) -> f64| {
+                f(&Oscillator {
+                    k,
+                    ..Oscillator::default()
+                })
+            };
+            let explicit: Vec<(f64, f64)> = ks
+                .iter()
+                .map(|&k| (k, bound(k, Oscillator::explicit_euler_bound)))
+                .collect();
+            let symplectic: Vec<(f64, f64)> = ks
+                .iter()
+                .map(|&k| (k, bound(k, Oscillator::symplectic_bound)))
+                .collect();
             chart
                 .draw_series(DashedLineSeries::new(explicit, 6, 4, BLACK.stroke_width(1)))?
                 .label("analytic: 2|Re p|/|p|^2 (explicit, full memory)")
                 .legend(|(x, y)| PathElement::new(vec![(x - 8, y), (x + 8, y)], BLACK));
             chart
-                .draw_series(DashedLineSeries::new(symplectic, 2, 4, RGBColor(120, 120, 120).stroke_width(1)))?
+                .draw_series(DashedLineSeries::new(
+                    symplectic,
+                    2,
+                    4,
+                    RGBColor(120, 120, 120).stroke_width(1),
+                ))?
                 .label("analytic: 2/omega (symplectic, undamped)")
                 .legend(|(x, y)| PathElement::new(vec![(x - 8, y), (x + 8, y)], RGBColor(120, 120, 120)));
         }
@@ -209,38 +242,81 @@ fn main() -> Result<(), Box<dyn Error>> {
     let quick = std::env::args().any(|a| a == "--quick");
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     // The quick sweep is a smoke run: it writes under target/, the full one into docs/.
-    let out = if quick { root.join("target") } else { root.join("docs") };
-    let stiffness: &[f64] = if quick { &[25.0, 400.0] } else { &[6.25, 25.0, 100.0, 400.0, 1600.0] };
+    let out = if quick {
+        root.join("target")
+    } else {
+        root.join("docs")
+    };
+    let stiffness: &[f64] = if quick {
+        &[25.0, 400.0]
+    } else {
+        &[6.25, 25.0, 100.0, 400.0, 1600.0]
+    };
     let scales: &[f64] = if quick { &[1.0, 100.0] } else { &[1.0, 10.0, 100.0] };
     let osc_schemes = [Scheme::PAPER, Scheme::Full, SOE_DEFAULT, SOE_FINE];
     let swing_schemes = [Scheme::PAPER, SOE_DEFAULT];
     let iters = if quick { 8 } else { 14 };
     let mut rows = vec![];
     for &k in stiffness {
-        let o = Oscillator { k, ..Oscillator::default() };
+        let o = Oscillator {
+            k,
+            ..Oscillator::default()
+        };
         let period = std::f64::consts::TAU / (o.k / o.m).sqrt();
         for integrator in Integrator::ALL {
             for scheme in osc_schemes {
-                let dt = largest_stable(period / 2000.0, 1.0, iters, |dt| oscillator_stable(&o, scheme, integrator, dt));
-                println!("oscillator k={k:7} {:10} {:16} largest stable dt {dt:.4e}", integrator.key(), scheme_label(scheme));
-                rows.push(Row { lowest: period / 2000.0, problem: "oscillator", integrator, scheme, stiffness: k, dt });
+                let dt = largest_stable(period / 2000.0, 1.0, iters, |dt| {
+                    oscillator_stable(&o, scheme, integrator, dt)
+                });
+                println!(
+                    "oscillator k={k:7} {:10} {:16} largest stable dt {dt:.4e}",
+                    integrator.key(),
+                    scheme_label(scheme)
+                );
+                rows.push(Row {
+                    lowest: period / 2000.0,
+                    problem: "oscillator",
+                    integrator,
+                    scheme,
+                    stiffness: k,
+                    dt,
+                });
             }
         }
     }
     for &scale in scales {
         for integrator in Integrator::ALL {
             for scheme in swing_schemes {
-                let dt = largest_stable(1e-5, 1.0 / 24.0, iters.min(10), |dt| swing_stable(scale, scheme, integrator, dt));
-                println!("swing scale={scale:5} {:10} {:16} largest stable dt {dt:.4e}", integrator.key(), scheme_label(scheme));
-                rows.push(Row { lowest: 1e-5, problem: "swing", integrator, scheme, stiffness: scale, dt });
+                let dt = largest_stable(1e-5, 1.0 / 24.0, iters.min(10), |dt| {
+                    swing_stable(scale, scheme, integrator, dt)
+                });
+                println!(
+                    "swing scale={scale:5} {:10} {:16} largest stable dt {dt:.4e}",
+                    integrator.key(),
+                    scheme_label(scheme)
+                );
+                rows.push(Row {
+                    lowest: 1e-5,
+                    problem: "swing",
+                    integrator,
+                    scheme,
+                    stiffness: scale,
+                    dt,
+                });
             }
         }
     }
     let mut csv = String::from("problem,integrator,scheme,stiffness,largest_stable_dt,smallest_dt_tried,analytic_explicit_bound,analytic_symplectic_bound\n");
     for r in &rows {
         let (e, s) = if r.problem == "oscillator" {
-            let o = Oscillator { k: r.stiffness, ..Oscillator::default() };
-            (format!("{:.6e}", o.explicit_euler_bound()), format!("{:.6e}", o.symplectic_bound()))
+            let o = Oscillator {
+                k: r.stiffness,
+                ..Oscillator::default()
+            };
+            (
+                format!("{:.6e}", o.explicit_euler_bound()),
+                format!("{:.6e}", o.symplectic_bound()),
+            )
         } else {
             (String::new(), String::new())
         };
@@ -258,8 +334,16 @@ fn main() -> Result<(), Box<dyn Error>> {
     let suffix = if quick { "-quick" } else { "" };
     std::fs::write(out.join(format!("stability{suffix}.csv")), csv)?;
     let all: Vec<Scheme> = osc_schemes.to_vec();
-    draw(BitMapBackend::new(&out.join(format!("stability{suffix}.png")), (1500, 620)).into_drawing_area(), &rows, &all)?;
-    draw(SVGBackend::new(&out.join(format!("stability{suffix}.svg")), (1500, 620)).into_drawing_area(), &rows, &all)?;
+    draw(
+        BitMapBackend::new(&out.join(format!("stability{suffix}.png")), (1500, 620)).into_drawing_area(),
+        &rows,
+        &all,
+    )?;
+    draw(
+        SVGBackend::new(&out.join(format!("stability{suffix}.svg")), (1500, 620)).into_drawing_area(),
+        &rows,
+        &all,
+    )?;
     println!("wrote {}/stability{suffix}.csv, .png, .svg", out.display());
     Ok(())
 }

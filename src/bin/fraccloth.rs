@@ -95,7 +95,12 @@ fn run(args: Args) -> Result<(), String> {
     let integrator = Integrator::ALL
         .into_iter()
         .find(|i| i.key() == args.integrator)
-        .ok_or_else(|| format!("unknown integrator {:?} (explicit, symplectic, implicit)", args.integrator))?;
+        .ok_or_else(|| {
+            format!(
+                "unknown integrator {:?} (explicit, symplectic, implicit)",
+                args.integrator
+            )
+        })?;
     let spec = SceneSpec {
         width,
         height,
