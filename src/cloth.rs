@@ -264,10 +264,7 @@ impl Cloth {
 
     /// Teleports every vertex (velocities and history are kept); pins move with it.
     pub fn set_positions(&mut self, x: &[Vec3]) -> Result<(), Error> {
-        self.check_len(x.len())?;
-        for p in x {
-            check_finite_vec("position", p)?;
-        }
+        self.check_all(x, "position")?;
         self.x.copy_from_slice(x);
         for &i in &self.pin_list {
             self.pin_target[i as usize] = x[i as usize];
@@ -277,23 +274,21 @@ impl Cloth {
 
     /// Sets every velocity (m/s).
     pub fn set_velocities(&mut self, v: &[Vec3]) -> Result<(), Error> {
-        self.check_len(v.len())?;
-        for p in v {
-            check_finite_vec("velocity", p)?;
-        }
+        self.check_all(v, "velocity")?;
         self.v.copy_from_slice(v);
         Ok(())
     }
 
-    fn check_len(&self, len: usize) -> Result<(), Error> {
-        if len == self.vertex_count() {
-            Ok(())
-        } else {
-            Err(Error::invalid(format!(
-                "expected {} vertices, got {len}",
-                self.vertex_count()
-            )))
+    /// One finite vector per vertex.
+    fn check_all(&self, values: &[Vec3], what: &str) -> Result<(), Error> {
+        if values.len() != self.vertex_count() {
+            return Err(Error::invalid(format!(
+                "expected {} vertices, got {}",
+                self.vertex_count(),
+                values.len()
+            )));
         }
+        values.iter().try_for_each(|p| check_finite_vec(what, p))
     }
 
     /// Sets the uniform water current (m/s).

@@ -205,15 +205,15 @@ fn write_triples(values: &[Vec3], out: &mut [f32]) {
     }
 }
 
-/// Copies every vertex position (m) into `xyz` as float triples; `float_count` must be 3 * vertex_count.
+/// Copies `values(cloth)` into the caller's float buffer after the usual checks.
 ///
 /// # Safety
 /// `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
-#[no_mangle]
-pub unsafe extern "C" fn fc_cloth_get_positions(
+unsafe fn copy_out(
     cloth: *const FcCloth,
     xyz: *mut f32,
     float_count: usize,
+    values: fn(&Cloth) -> &[Vec3],
 ) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
@@ -224,9 +224,23 @@ pub unsafe extern "C" fn fc_cloth_get_positions(
         }
         // SAFETY: non-NULL and the caller promises `float_count` writable floats.
         let out = unsafe { std::slice::from_raw_parts_mut(xyz, float_count) };
-        write_triples(cloth.positions(), out);
+        write_triples(values(cloth), out);
         Ok(())
     })
+}
+
+/// Copies every vertex position (m) into `xyz` as float triples; `float_count` must be 3 * vertex_count.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_positions(
+    cloth: *const FcCloth,
+    xyz: *mut f32,
+    float_count: usize,
+) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { copy_out(cloth, xyz, float_count, Cloth::positions) }
 }
 
 /// Copies every vertex velocity (m/s) into `xyz` as float triples; `float_count` must be 3 * vertex_count.
@@ -239,18 +253,8 @@ pub unsafe extern "C" fn fc_cloth_get_velocities(
     xyz: *mut f32,
     float_count: usize,
 ) -> FcStatus {
-    guard(|| {
-        // SAFETY: forwarded caller promises.
-        let cloth = unsafe { handle(cloth) }?;
-        check_float_count(cloth, float_count)?;
-        if xyz.is_null() {
-            return Err(FfiError::null("xyz"));
-        }
-        // SAFETY: non-NULL and the caller promises `float_count` writable floats.
-        let out = unsafe { std::slice::from_raw_parts_mut(xyz, float_count) };
-        write_triples(cloth.velocities(), out);
-        Ok(())
-    })
+    // SAFETY: forwarded caller promises.
+    unsafe { copy_out(cloth, xyz, float_count, Cloth::velocities) }
 }
 
 /// Sets the uniform water current (m/s), effective from the next step.
