@@ -15,7 +15,6 @@
 //! Cost: wall-clock time of the stepping loop only (cloth creation excluded), one thread.
 
 #[path = "../tests/common/reference.rs"]
-#[allow(dead_code)]
 mod reference;
 
 use std::error::Error;
