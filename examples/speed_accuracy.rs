@@ -71,6 +71,22 @@ struct Record {
 }
 
 impl Record {
+    /// A record of a run that has not (yet) completed.
+    fn new(problem: &'static str, scheme: Scheme, integrator: Integrator, dt: f64, particles: usize) -> Self {
+        Self {
+            problem,
+            scheme,
+            integrator,
+            dt,
+            completed: false,
+            error: f64::NAN,
+            wall_per_sim_s: f64::NAN,
+            particle_steps_per_s: f64::NAN,
+            history_bytes: 0,
+            particles,
+        }
+    }
+
     fn is_paper(&self) -> bool {
         self.scheme == Scheme::PAPER && self.integrator == Integrator::ExplicitEuler
     }
@@ -96,18 +112,7 @@ fn osc_reference(o: &Oscillator, t: f64) -> f64 {
 fn run_oscillator(set: &Settings, scheme: Scheme, integrator: Integrator, dt: f64) -> Record {
     let o = Oscillator::default();
     let times = [0.5, 1.0, 1.5, 2.0];
-    let mut rec = Record {
-        problem: "oscillator",
-        scheme,
-        integrator,
-        dt,
-        completed: false,
-        error: f64::NAN,
-        wall_per_sim_s: f64::NAN,
-        particle_steps_per_s: f64::NAN,
-        history_bytes: 0,
-        particles: 4,
-    };
+    let mut rec = Record::new("oscillator", scheme, integrator, dt, 4);
     if scheme == Scheme::Full && 2.0 / dt > 40_000.0 {
         return rec; // O(n^2) overall: skipped, recorded as not run
     }
@@ -529,18 +534,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             for integrator in Integrator::ALL {
                 for &dt in &set.dts {
                     let steps = set.t_end / dt;
-                    let mut rec = Record {
-                        problem: kind.name(),
-                        scheme,
-                        integrator,
-                        dt,
-                        completed: false,
-                        error: f64::NAN,
-                        wall_per_sim_s: f64::NAN,
-                        particle_steps_per_s: f64::NAN,
-                        history_bytes: 0,
-                        particles: n,
-                    };
+                    let mut rec = Record::new(kind.name(), scheme, integrator, dt, n);
                     let skip = scheme == Scheme::Full && steps > 2_000.0;
                     if !skip {
                         if let Some((pos, wall, count, bytes)) =

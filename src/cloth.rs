@@ -344,7 +344,9 @@ impl Cloth {
     }
 
     fn rebuild_colliders(&mut self) {
-        self.colliders = self.collider_slots.iter().flatten().copied().collect();
+        self.colliders.clear();
+        self.colliders
+            .extend(self.collider_slots.iter().flatten().copied());
     }
 
     /// Advances by `dt` seconds with the configured integrator, split into
@@ -538,11 +540,7 @@ impl Cloth {
             e += 0.5 * mass * v.norm_squared() - forces::body_force(m, mass).dot(x);
         }
         for s in &self.topology.springs {
-            let k = match s.kind {
-                crate::topology::SpringKind::Stretch => m.stretch_stiffness,
-                crate::topology::SpringKind::Shear => m.shear_stiffness,
-                crate::topology::SpringKind::Bend => m.bend_stiffness,
-            };
+            let k = m.stiffness(s.kind);
             let d = (self.x[s.i as usize] - self.x[s.j as usize]).norm() - s.rest;
             e += 0.5 * k * d * d;
         }

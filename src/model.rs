@@ -5,6 +5,7 @@
 //! m s^{-1/2}, so `history_drag` and a fractional `spring_damping` are in N s^{1/2} / m.
 
 use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
+use crate::topology::SpringKind;
 use crate::Vec3;
 
 /// How a spring resists the rate of change of its length.
@@ -58,6 +59,15 @@ impl Model {
     pub fn uses_half_derivative(&self) -> bool {
         self.history_drag != 0.0
             || (self.spring_damping_mode == SpringDamping::Fractional && self.spring_damping != 0.0)
+    }
+
+    /// Spring constant of a spring family, N/m.
+    pub fn stiffness(&self, kind: SpringKind) -> f64 {
+        match kind {
+            SpringKind::Stretch => self.stretch_stiffness,
+            SpringKind::Shear => self.shear_stiffness,
+            SpringKind::Bend => self.bend_stiffness,
+        }
     }
 
     /// Checks every coefficient; the cloth is never built from a model that fails this.

@@ -15,7 +15,6 @@ use nalgebra::Matrix3;
 
 use super::{Collider, ForceInput};
 use crate::model::SpringDamping;
-use crate::topology::SpringKind;
 use crate::Vec3;
 
 /// Per-spring and per-particle blocks of `-df/dx` and `-df/dv`.
@@ -54,11 +53,7 @@ pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Li
         SpringDamping::Fractional => m.spring_damping * w0,
     };
     for (k, s) in input.topology.springs.iter().enumerate() {
-        let ks = match s.kind {
-            SpringKind::Stretch => m.stretch_stiffness,
-            SpringKind::Shear => m.shear_stiffness,
-            SpringKind::Bend => m.bend_stiffness,
-        };
+        let ks = m.stiffness(s.kind);
         let l = input.x[s.i as usize] - input.x[s.j as usize];
         let len = l.norm();
         if len == 0.0 {

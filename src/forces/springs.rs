@@ -7,7 +7,6 @@
 
 use super::ForceInput;
 use crate::model::SpringDamping;
-use crate::topology::SpringKind;
 use crate::Vec3;
 
 pub(super) fn add(input: &ForceInput<'_>, f: &mut [Vec3]) {
@@ -20,11 +19,7 @@ pub(super) fn add(input: &ForceInput<'_>, f: &mut [Vec3]) {
         SpringDamping::Fractional => Some(input.half_derivative),
     };
     for s in &input.topology.springs {
-        let ks = match s.kind {
-            SpringKind::Stretch => m.stretch_stiffness,
-            SpringKind::Shear => m.shear_stiffness,
-            SpringKind::Bend => m.bend_stiffness,
-        };
+        let ks = m.stiffness(s.kind);
         let (i, j) = (s.i as usize, s.j as usize);
         let l = input.x[i] - input.x[j];
         let len = l.norm();
