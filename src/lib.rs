@@ -36,8 +36,10 @@ pub mod ffi;
 pub mod forces;
 pub mod history;
 pub mod integrate;
+pub mod look;
 pub mod model;
 pub mod oscillator;
+pub mod render;
 pub mod scenes;
 pub mod topology;
 

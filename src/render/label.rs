@@ -1,0 +1,30 @@
+//! Text labels from the public-domain 8x8 bitmap font of `font8x8`.
+
+use font8x8::{UnicodeFonts, BASIC_FONTS};
+use tiny_skia::{Pixmap, PremultipliedColorU8};
+
+/// Draws `text` with its top-left corner at (x, y), each font pixel `scale` x `scale`, white.
+pub fn draw_label(pix: &mut Pixmap, text: &str, x: u32, y: u32, scale: u32) {
+    let (w, h) = (pix.width(), pix.height());
+    let white = PremultipliedColorU8::from_rgba(255, 255, 255, 255).unwrap_or(PremultipliedColorU8::TRANSPARENT);
+    let pixels = pix.pixels_mut();
+    for (k, ch) in text.chars().enumerate() {
+        let glyph = BASIC_FONTS.get(ch).unwrap_or([0; 8]);
+        for (row, bits) in glyph.iter().enumerate() {
+            for col in 0..8u32 {
+                if bits & (1 << col) == 0 {
+                    continue;
+                }
+                for dy in 0..scale {
+                    for dx in 0..scale {
+                        let px = x + (k as u32 * 8 + col) * scale + dx;
+                        let py = y + row as u32 * scale + dy;
+                        if px < w && py < h {
+                            pixels[(py * w + px) as usize] = white;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
