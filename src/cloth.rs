@@ -331,6 +331,11 @@ impl Cloth {
         Ok(())
     }
 
+    /// Every collider present.
+    pub fn colliders(&self) -> &[Collider] {
+        &self.colliders
+    }
+
     /// The collider with id `id`.
     pub fn collider(&self, id: u32) -> Option<&Collider> {
         self.collider_slots.get(id as usize).and_then(Option::as_ref)

@@ -42,7 +42,14 @@ pub fn half_amplitude_distance(envelope: &[f64], spacing: f64) -> Option<f64> {
 
 /// Speed (m/s) of the pattern between rows `j1 < j2`: the lag (1 ..= max_lag frames) that
 /// maximises the correlation of d[t][j1] with d[t + lag][j2]. None if nothing correlates.
-pub fn travel_speed(field: &[Vec<f64>], j1: usize, j2: usize, frame_dt: f64, spacing: f64, max_lag: usize) -> Option<f64> {
+pub fn travel_speed(
+    field: &[Vec<f64>],
+    j1: usize,
+    j2: usize,
+    frame_dt: f64,
+    spacing: f64,
+    max_lag: usize,
+) -> Option<f64> {
     let n = field.len();
     let mut best: Option<(usize, f64)> = None;
     for lag in 1..=max_lag.min(n.saturating_sub(2)) {
@@ -84,13 +91,19 @@ pub fn describe(field: &[Vec<f64>], spacing: f64, frame_dt: f64, threshold: f64)
     } else {
         field.iter().map(|p| bump_count(p, threshold) as f64).sum::<f64>() / field.len() as f64
     };
-    let envelope: Vec<f64> = (0..rows).map(|j| field.iter().map(|p| p[j].abs()).fold(0.0, f64::max)).collect();
+    let envelope: Vec<f64> = (0..rows)
+        .map(|j| field.iter().map(|p| p[j].abs()).fold(0.0, f64::max))
+        .collect();
     let max_displacement = envelope.iter().copied().fold(0.0, f64::max);
     let max_lag = ((2.0 / frame_dt) as usize).max(1); // up to 2 s
     Look {
         mean_bumps,
         half_amplitude_distance: half_amplitude_distance(&envelope, spacing),
-        travel_speed: if rows >= 4 { travel_speed(field, rows / 4, 3 * rows / 4, frame_dt, spacing, max_lag) } else { None },
+        travel_speed: if rows >= 4 {
+            travel_speed(field, rows / 4, 3 * rows / 4, frame_dt, spacing, max_lag)
+        } else {
+            None
+        },
         max_displacement,
     }
 }

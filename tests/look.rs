@@ -10,7 +10,9 @@ fn bumps_are_runs_of_one_sign_above_the_threshold() {
     assert_eq!(bump_count(&[0.01, 0.001, -0.002, 0.02, 0.01], 0.005), 1);
     assert_eq!(bump_count(&[0.001, -0.001], 0.005), 0);
     // A sampled sine with 2.5 periods over the column has 5 half-waves.
-    let p: Vec<f64> = (0..200).map(|j| (std::f64::consts::TAU * 2.5 * j as f64 / 200.0 + 0.1).sin()).collect();
+    let p: Vec<f64> = (0..200)
+        .map(|j| (std::f64::consts::TAU * 2.5 * j as f64 / 200.0 + 0.1).sin())
+        .collect();
     assert_eq!(bump_count(&p, 0.05), 5);
 }
 
@@ -29,8 +31,13 @@ fn half_amplitude_distance_of_an_exponential_envelope() {
 fn travel_speed_of_a_travelling_wave() {
     // d = A sin(k y - w t) with y = j s: speed w / k.
     let (s, dt, k, w) = (0.01, 1.0 / 30.0, 20.0, 3.0);
-    let field: Vec<Vec<f64>> =
-        (0..300).map(|t| (0..41).map(|j| (k * j as f64 * s - w * t as f64 * dt).sin()).collect()).collect();
+    let field: Vec<Vec<f64>> = (0..300)
+        .map(|t| {
+            (0..41)
+                .map(|j| (k * j as f64 * s - w * t as f64 * dt).sin())
+                .collect()
+        })
+        .collect();
     let v = travel_speed(&field, 10, 30, dt, s, 60).unwrap();
     // Resolution is one frame of lag: 0.2 m over about 1.33 s = 40 frames.
     assert!((v - w / k).abs() < 0.01, "{v} vs {}", w / k);

@@ -26,7 +26,15 @@ impl Camera {
         let right = right.normalize();
         let up = right.cross(&forward);
         let focal = 0.5 * f64::from(height) / (0.5 * fov_y).tan();
-        Self { eye, right, up, forward, focal, width, height }
+        Self {
+            eye,
+            right,
+            up,
+            forward,
+            focal,
+            width,
+            height,
+        }
     }
 
     /// A fixed 3/4 view that keeps the box `[lo, hi]` (world, m) in frame.
@@ -34,7 +42,7 @@ impl Camera {
         let center = 0.5 * (lo + hi);
         let radius = 0.5 * (hi - lo).norm().max(1e-3);
         let fov = 40f64.to_radians();
-        let distance = 1.15 * radius / (0.5 * fov).sin();
+        let distance = 0.95 * radius / (0.5 * fov).sin();
         let dir = Vec3::new(0.62, 0.28, 0.73).normalize();
         Self::look_at(center + distance * dir, center, fov, width, height)
     }

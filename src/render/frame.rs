@@ -1,6 +1,9 @@
 //! One picture of the cloth and its colliders.
 
-use tiny_skia::{Color, FillRule, GradientStop, LinearGradient, Paint, PathBuilder, Pixmap, Point, RadialGradient, Shader, SpreadMode, Transform};
+use tiny_skia::{
+    Color, FillRule, GradientStop, LinearGradient, Paint, PathBuilder, Pixmap, Point, RadialGradient, Shader,
+    SpreadMode, Transform,
+};
 
 use super::Camera;
 use crate::forces::{Collider, Sphere};
@@ -74,12 +77,16 @@ pub fn render_frame(scene: &Scene3d<'_>, camera: &Camera, pix: &mut Pixmap) {
         let lambert = n.dot(&light).max(0.0) as f32;
         let shade = 0.30 + 0.70 * lambert;
         let base = if facing { FRONT } else { BACK };
-        let color = Color::from_rgba(base[0] * shade, base[1] * shade, base[2] * shade, 1.0).unwrap_or(Color::WHITE);
+        let color =
+            Color::from_rgba(base[0] * shade, base[1] * shade, base[2] * shade, 1.0).unwrap_or(Color::WHITE);
         let pa = camera.project(&a);
         let pb = camera.project(&b);
         let pc = camera.project(&c);
         let depth = (pa.2 + pb.2 + pc.2) / 3.0;
-        items.push((depth, Item::Triangle([(pa.0, pa.1), (pb.0, pb.1), (pc.0, pc.1)], color)));
+        items.push((
+            depth,
+            Item::Triangle([(pa.0, pa.1), (pb.0, pb.1), (pc.0, pc.1)], color),
+        ));
     }
     for s in scene.spheres {
         let (x, y, z) = camera.project(&s.center);
@@ -87,7 +94,10 @@ pub fn render_frame(scene: &Scene3d<'_>, camera: &Camera, pix: &mut Pixmap) {
     }
     // Painter's algorithm: far to near.
     items.sort_by(|a, b| b.0.total_cmp(&a.0));
-    let mut paint = Paint { anti_alias: true, ..Paint::default() };
+    let mut paint = Paint {
+        anti_alias: true,
+        ..Paint::default()
+    };
     for (_, item) in items {
         match item {
             Item::Triangle(p, color) => {
@@ -100,7 +110,10 @@ pub fn render_frame(scene: &Scene3d<'_>, camera: &Camera, pix: &mut Pixmap) {
                     paint.shader = Shader::SolidColor(color);
                     pix.fill_path(&path, &paint, FillRule::Winding, Transform::identity(), None);
                     // A hairline of the same colour closes the anti-aliasing seams between triangles.
-                    let stroke = tiny_skia::Stroke { width: 0.6, ..Default::default() };
+                    let stroke = tiny_skia::Stroke {
+                        width: 0.6,
+                        ..Default::default()
+                    };
                     pix.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
                 }
             }
@@ -118,7 +131,8 @@ pub fn render_frame(scene: &Scene3d<'_>, camera: &Camera, pix: &mut Pixmap) {
                         SpreadMode::Pad,
                         Transform::identity(),
                     );
-                    paint.shader = shader.unwrap_or(Shader::SolidColor(Color::from_rgba8(150, 150, 160, 255)));
+                    paint.shader =
+                        shader.unwrap_or(Shader::SolidColor(Color::from_rgba8(150, 150, 160, 255)));
                     pix.fill_path(&circle, &paint, FillRule::Winding, Transform::identity(), None);
                 }
             }

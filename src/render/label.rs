@@ -6,7 +6,8 @@ use tiny_skia::{Pixmap, PremultipliedColorU8};
 /// Draws `text` with its top-left corner at (x, y), each font pixel `scale` x `scale`, white.
 pub fn draw_label(pix: &mut Pixmap, text: &str, x: u32, y: u32, scale: u32) {
     let (w, h) = (pix.width(), pix.height());
-    let white = PremultipliedColorU8::from_rgba(255, 255, 255, 255).unwrap_or(PremultipliedColorU8::TRANSPARENT);
+    let white =
+        PremultipliedColorU8::from_rgba(255, 255, 255, 255).unwrap_or(PremultipliedColorU8::TRANSPARENT);
     let pixels = pix.pixels_mut();
     for (k, ch) in text.chars().enumerate() {
         let glyph = BASIC_FONTS.get(ch).unwrap_or([0; 8]);
