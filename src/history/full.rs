@@ -11,7 +11,7 @@ use super::HalfDerivative;
 use crate::Vec3;
 
 /// Every past velocity of every particle, with its time.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Full {
     n: usize,
     /// Step-major: velocities of step k are `samples[k*n .. (k+1)*n]`.
@@ -22,6 +22,29 @@ pub struct Full {
     w0: f64,
     /// Current time: the last sample's time plus the step taken since.
     now: f64,
+}
+
+/// Field-wise, so that `clone_from` reuses the buffers (the substep snapshot must not allocate).
+impl Clone for Full {
+    fn clone(&self) -> Self {
+        Self {
+            n: self.n,
+            samples: self.samples.clone(),
+            times: self.times.clone(),
+            weights: self.weights.clone(),
+            w0: self.w0,
+            now: self.now,
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.n = source.n;
+        self.samples.clone_from(&source.samples);
+        self.times.clone_from(&source.times);
+        self.weights.clone_from(&source.weights);
+        self.w0 = source.w0;
+        self.now = source.now;
+    }
 }
 
 impl Full {

@@ -107,12 +107,33 @@ pub trait HalfDerivative {
 }
 
 /// State of the chosen scheme for one cloth.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub enum History {
     Off,
     Truncated(Truncated),
     Full(Full),
     SumOfExponentials(SumOfExponentials),
+}
+
+/// `clone_from` reuses the buffers when both sides hold the same scheme.
+impl Clone for History {
+    fn clone(&self) -> Self {
+        match self {
+            History::Off => History::Off,
+            History::Truncated(s) => History::Truncated(s.clone()),
+            History::Full(s) => History::Full(s.clone()),
+            History::SumOfExponentials(s) => History::SumOfExponentials(s.clone()),
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        match (self, source) {
+            (History::Truncated(a), History::Truncated(b)) => a.clone_from(b),
+            (History::Full(a), History::Full(b)) => a.clone_from(b),
+            (History::SumOfExponentials(a), History::SumOfExponentials(b)) => a.clone_from(b),
+            (me, other) => *me = other.clone(),
+        }
+    }
 }
 
 impl History {

@@ -18,6 +18,8 @@
 //! horizon the oldest memory fades faster than t^{-1/2}. Modes with `s_l g > 50` cannot
 //! contribute to D (their factor is below e^{-50}) and are left out of its sum.
 
+use std::sync::Arc;
+
 use super::soe_kernel::SoeKernel;
 use super::HalfDerivative;
 use crate::Vec3;
@@ -45,10 +47,11 @@ fn phi(z: f64) -> (f64, f64) {
 }
 
 /// SOE history of `n` particles.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct SumOfExponentials {
     n: usize,
-    kernel: SoeKernel,
+    /// Shared and immutable: cloning the history (substep snapshots) does not copy it.
+    kernel: Arc<SoeKernel>,
     /// Mode-major: mode l of every particle is `modes[l*n .. (l+1)*n]`.
     modes: Vec<Vec3>,
     prev: Vec<Vec3>,
@@ -61,12 +64,41 @@ pub struct SumOfExponentials {
     w_prev: f64,
 }
 
+/// Field-wise, so that `clone_from` reuses the buffers (the substep snapshot must not allocate).
+impl Clone for SumOfExponentials {
+    fn clone(&self) -> Self {
+        Self {
+            n: self.n,
+            kernel: self.kernel.clone(),
+            modes: self.modes.clone(),
+            prev: self.prev.clone(),
+            has_prev: self.has_prev,
+            gap: self.gap,
+            coef: self.coef.clone(),
+            w0: self.w0,
+            w_prev: self.w_prev,
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.n = source.n;
+        self.kernel.clone_from(&source.kernel);
+        self.modes.clone_from(&source.modes);
+        self.prev.clone_from(&source.prev);
+        self.has_prev = source.has_prev;
+        self.gap = source.gap;
+        self.coef.clone_from(&source.coef);
+        self.w0 = source.w0;
+        self.w_prev = source.w_prev;
+    }
+}
+
 impl SumOfExponentials {
     pub fn new(kernel: SoeKernel, n: usize) -> Self {
         let k = kernel.len();
         Self {
             n,
-            kernel,
+            kernel: Arc::new(kernel),
             modes: vec![Vec3::zeros(); k * n],
             prev: vec![Vec3::zeros(); n],
             has_prev: false,

@@ -32,7 +32,7 @@ use super::HalfDerivative;
 use crate::Vec3;
 
 /// Eq. 6 state: the last `u` velocities of every particle.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Truncated {
     u: usize,
     n: usize,
@@ -45,6 +45,31 @@ pub struct Truncated {
     weights: Vec<f64>,
     /// The step h of Eq. 6: the size of the last step pushed.
     h: f64,
+}
+
+/// Field-wise, so that `clone_from` reuses the buffers (the substep snapshot must not allocate).
+impl Clone for Truncated {
+    fn clone(&self) -> Self {
+        Self {
+            u: self.u,
+            n: self.n,
+            slots: self.slots.clone(),
+            head: self.head,
+            pushed: self.pushed,
+            weights: self.weights.clone(),
+            h: self.h,
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.u = source.u;
+        self.n = source.n;
+        self.slots.clone_from(&source.slots);
+        self.head = source.head;
+        self.pushed = source.pushed;
+        self.weights.clone_from(&source.weights);
+        self.h = source.h;
+    }
 }
 
 /// Eq. 6 weights for step h with `panels` past panels (`panels = min(u-1, n-1)`, n >= 1):

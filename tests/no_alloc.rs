@@ -1,0 +1,120 @@
+//! A step allocates nothing once the cloth has taken its first steps (which size the scratch
+//! buffers): counted with a global allocator, for every integrator and every scheme whose
+//! memory is bounded (`Full` keeps every step by design).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use fraccloth::history::Scheme;
+use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
+use fraccloth::{Integrator, RegularDrag};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn steps_do_not_allocate() {
+    // One test function: the counter is global, so nothing else may run at the same time.
+    let schemes = [
+        Scheme::Off,
+        Scheme::PAPER,
+        Scheme::Truncated { u: 10 },
+        Scheme::DEFAULT,
+    ];
+    let mut checked = 0;
+    for kind in [SceneKind::Swing, SceneKind::Sphere] {
+        for variant in [
+            Variant::Fractional,
+            Variant::Regular(RegularDrag::ViscousAndNormal),
+        ] {
+            for scheme in schemes {
+                for integrator in Integrator::ALL {
+                    let spec = SceneSpec {
+                        width: 15,
+                        height: 11,
+                        scheme,
+                        integrator,
+                        dt: if integrator == Integrator::ImplicitEuler {
+                            1.0 / 60.0
+                        } else {
+                            2e-4
+                        },
+                        ..SceneSpec::paper(kind, variant)
+                    };
+                    let mut scene = spec.build().unwrap();
+                    for _ in 0..3 {
+                        scene.step().unwrap(); // sizes every scratch buffer
+                    }
+                    let before = ALLOCATIONS.load(Ordering::Relaxed);
+                    for _ in 0..50 {
+                        scene.step().unwrap();
+                    }
+                    let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+                    assert_eq!(
+                        during,
+                        0,
+                        "{} {} {} {}: {during} allocations in 50 steps",
+                        kind.name(),
+                        variant.name(),
+                        scheme.name(),
+                        integrator.name()
+                    );
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 48);
+    // Substepped calls too (they save the state to restore it on failure).
+    for scheme in schemes {
+        let spec = SceneSpec {
+            width: 15,
+            height: 11,
+            scheme,
+            ..SceneSpec::paper(SceneKind::Swing, Variant::Fractional)
+        };
+        let mut scene = spec.build().unwrap();
+        // Warm-up: the snapshot buffers grow until the history's start-up is over (u = 10 steps).
+        for _ in 0..4 {
+            scene.cloth.step_substeps(1e-3, 4).unwrap();
+        }
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for _ in 0..20 {
+            scene.cloth.step_substeps(1e-3, 4).unwrap();
+        }
+        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert_eq!(
+            during,
+            0,
+            "{}: {during} allocations in 20 substepped calls",
+            scheme.name()
+        );
+    }
+    // The counter does count: building a cloth allocates.
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let _ = SceneSpec::paper(SceneKind::Swing, Variant::Fractional)
+        .build()
+        .unwrap();
+    assert!(ALLOCATIONS.load(Ordering::Relaxed) > before);
+}
