@@ -20,7 +20,7 @@ fn default_is_the_accurate_scheme_and_reports_its_modes() {
     assert!((5..34).contains(&modes), "{modes} modes");
     assert_eq!(
         unsafe { fc_cloth_history_bytes_per_particle(c) },
-        (modes as usize + 1) * 24
+        (modes as usize + 2) * 24
     );
     unsafe { fc_cloth_destroy(c) };
 }

@@ -207,7 +207,7 @@ fn soe_agrees_with_full_over_1e5_steps_at_constant_memory() {
     assert!(checked >= 10);
     // Memory, and with it the work per step (one update per mode), does not grow for SOE...
     assert_eq!(soe.bytes_per_particle(), bytes_after_10);
-    assert_eq!(soe.bytes_per_particle(), (soe.mode_count() + 1) * 24);
+    assert_eq!(soe.bytes_per_particle(), (soe.mode_count() + 2) * 24);
     // ...while the full history holds every step.
     assert_eq!(full.bytes_per_particle(), steps * 24);
 }

@@ -16,7 +16,8 @@
 //! Steps may change size freely (every mode is updated every step, so a later, smaller
 //! step finds every mode correct). The kernel is accurate on `[min_dt, horizon]`; past the
 //! horizon the oldest memory fades faster than t^{-1/2}. Modes with `s_l g > 50` cannot
-//! contribute to D (their factor is below e^{-50}) and are left out of its sum.
+//! contribute to D (their factor is below e^{-50}) and are left out of its sum. One pass over
+//! the modes per step both updates them and sums what the next step needs.
 
 use std::sync::Arc;
 
@@ -47,21 +48,31 @@ fn phi(z: f64) -> (f64, f64) {
 }
 
 /// SOE history of `n` particles.
+///
+/// Layout and work per step: the K modes of a particle are contiguous, and one pass over them
+/// both folds the newest panel into every mode and sums what the next step needs,
+/// `P_p = sum_l w_l e^{-s_l h} G_{l,p}` (h: the step just taken, which is the next step's gap).
+/// `past` then only adds `w_prev v_{n-1}`: one pass over the modes per step, not two.
 #[derive(Debug)]
 pub struct SumOfExponentials {
     n: usize,
     /// Shared and immutable: cloning the history (substep snapshots) does not copy it.
     kernel: Arc<SoeKernel>,
-    /// Mode-major: mode l of every particle is `modes[l*n .. (l+1)*n]`.
+    /// Particle-major: the modes of particle p are `modes[p*K .. (p+1)*K]`.
     modes: Vec<Vec3>,
     prev: Vec<Vec3>,
+    /// `sum_l w_l e^{-s_l gap} G_l` per particle, computed by the last push.
+    pending: Vec<Vec3>,
     has_prev: bool,
     /// Width of the exact window: time from the last sample to now.
     gap: f64,
-    /// Prepared per step: `w_l e^{-s_l g}` for the active modes.
-    coef: Vec<f64>,
     w0: f64,
     w_prev: f64,
+    /// Per-mode coefficients of the fold, reused between steps.
+    decay: Vec<f64>,
+    a: Vec<f64>,
+    b: Vec<f64>,
+    next: Vec<f64>,
 }
 
 /// Field-wise, so that `clone_from` reuses the buffers (the substep snapshot must not allocate).
@@ -72,11 +83,15 @@ impl Clone for SumOfExponentials {
             kernel: self.kernel.clone(),
             modes: self.modes.clone(),
             prev: self.prev.clone(),
+            pending: self.pending.clone(),
             has_prev: self.has_prev,
             gap: self.gap,
-            coef: self.coef.clone(),
             w0: self.w0,
             w_prev: self.w_prev,
+            decay: self.decay.clone(),
+            a: self.a.clone(),
+            b: self.b.clone(),
+            next: self.next.clone(),
         }
     }
 
@@ -85,11 +100,20 @@ impl Clone for SumOfExponentials {
         self.kernel.clone_from(&source.kernel);
         self.modes.clone_from(&source.modes);
         self.prev.clone_from(&source.prev);
+        self.pending.clone_from(&source.pending);
         self.has_prev = source.has_prev;
         self.gap = source.gap;
-        self.coef.clone_from(&source.coef);
         self.w0 = source.w0;
         self.w_prev = source.w_prev;
+        // Scratch: contents need not be copied, only room kept.
+        for (mine, theirs) in [
+            (&mut self.decay, &source.decay),
+            (&mut self.a, &source.a),
+            (&mut self.b, &source.b),
+            (&mut self.next, &source.next),
+        ] {
+            mine.resize(theirs.len(), 0.0);
+        }
     }
 }
 
@@ -101,11 +125,15 @@ impl SumOfExponentials {
             kernel: Arc::new(kernel),
             modes: vec![Vec3::zeros(); k * n],
             prev: vec![Vec3::zeros(); n],
+            pending: vec![Vec3::zeros(); n],
             has_prev: false,
             gap: 0.0,
-            coef: Vec::with_capacity(k),
             w0: 0.0,
             w_prev: 0.0,
+            decay: vec![0.0; k],
+            a: vec![0.0; k],
+            b: vec![0.0; k],
+            next: vec![0.0; k],
         }
     }
 
@@ -118,33 +146,18 @@ impl SumOfExponentials {
     pub fn kernel(&self) -> &SoeKernel {
         &self.kernel
     }
-
-    fn active_modes(&self, g: f64) -> usize {
-        self.kernel
-            .rates
-            .iter()
-            .take_while(|&&s| s * g <= SKIP_EXPONENT)
-            .count()
-    }
 }
 
 impl HalfDerivative for SumOfExponentials {
     fn prepare(&mut self) {
-        self.coef.clear();
         if !self.has_prev {
             self.w0 = 0.0;
             self.w_prev = 0.0;
             return;
         }
-        let g = self.gap;
-        let c = (g / std::f64::consts::PI).sqrt();
+        let c = (self.gap / std::f64::consts::PI).sqrt();
         self.w0 = 4.0 / 3.0 * c;
         self.w_prev = 2.0 / 3.0 * c;
-        let active = self.active_modes(g);
-        for l in 0..active {
-            self.coef
-                .push(self.kernel.weights[l] * (-self.kernel.rates[l] * g).exp());
-        }
     }
 
     fn current_weight(&self) -> f64 {
@@ -152,28 +165,37 @@ impl HalfDerivative for SumOfExponentials {
     }
 
     fn past(&self, out: &mut [Vec3]) {
-        for (o, p) in out.iter_mut().zip(&self.prev) {
-            *o = self.w_prev * p;
-        }
-        for (l, &c) in self.coef.iter().enumerate() {
-            for (o, m) in out.iter_mut().zip(&self.modes[l * self.n..(l + 1) * self.n]) {
-                *o += c * m;
-            }
+        for ((o, p), q) in out.iter_mut().zip(&self.prev).zip(&self.pending) {
+            *o = self.w_prev * p + q;
         }
     }
 
     fn push(&mut self, v: &[Vec3], h: f64) {
+        let k = self.kernel.len();
         if self.has_prev {
             let g = self.gap;
-            for l in 0..self.kernel.len() {
-                let mode = &mut self.modes[l * self.n..(l + 1) * self.n];
-                let z = self.kernel.rates[l] * g;
-                let decay = (-z).exp();
+            for l in 0..k {
+                let s = self.kernel.rates[l];
+                let z = s * g;
                 let (po, pn) = phi(z);
-                let (a, b) = (g * po, g * pn);
-                for ((m, p), vn) in mode.iter_mut().zip(&self.prev).zip(v) {
-                    *m = decay * *m + a * p + b * vn;
+                self.decay[l] = (-z).exp();
+                self.a[l] = g * po;
+                self.b[l] = g * pn;
+                // Modes that decay by more than e^{-50} over the next gap cannot contribute.
+                self.next[l] = if s * h <= SKIP_EXPONENT {
+                    self.kernel.weights[l] * (-s * h).exp()
+                } else {
+                    0.0
+                };
+            }
+            for p in 0..self.n {
+                let (pv, vn) = (self.prev[p], v[p]);
+                let mut acc = Vec3::zeros();
+                for (l, m) in self.modes[p * k..(p + 1) * k].iter_mut().enumerate() {
+                    *m = self.decay[l] * *m + self.a[l] * pv + self.b[l] * vn;
+                    acc += self.next[l] * *m;
                 }
+                self.pending[p] = acc;
             }
         }
         self.prev.copy_from_slice(&v[..self.n]);
@@ -182,15 +204,15 @@ impl HalfDerivative for SumOfExponentials {
     }
 
     fn bytes_per_particle(&self) -> usize {
-        (self.kernel.len() + 1) * std::mem::size_of::<Vec3>()
+        (self.kernel.len() + 2) * std::mem::size_of::<Vec3>()
     }
 
     fn reset(&mut self) {
         self.modes.fill(Vec3::zeros());
         self.prev.fill(Vec3::zeros());
+        self.pending.fill(Vec3::zeros());
         self.has_prev = false;
         self.gap = 0.0;
-        self.coef.clear();
     }
 }
 
