@@ -184,6 +184,20 @@ fn bad_descriptions_are_rejected_without_output() {
                 d.history_u = 0
             }),
         ),
+        (
+            "u huge",
+            Box::new(|d| {
+                d.history_scheme = FcHistoryScheme::FC_HISTORY_TRUNCATED as u32;
+                d.history_u = u32::MAX
+            }),
+        ),
+        (
+            "grid of 2^25 vertices",
+            Box::new(|d| {
+                d.width = 1 << 13;
+                d.height = 1 << 12
+            }),
+        ),
         ("soe tolerance 0", Box::new(|d| d.history_tolerance = 0.0)),
         ("soe tolerance NaN", Box::new(|d| d.history_tolerance = f64::NAN)),
         ("soe tolerance 0.5", Box::new(|d| d.history_tolerance = 0.5)),

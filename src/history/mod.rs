@@ -63,6 +63,9 @@ impl Scheme {
     pub fn validate(&self) -> Result<(), Error> {
         match *self {
             Scheme::Truncated { u: 0 } => Err(Error::invalid("truncated history needs u >= 1")),
+            Scheme::Truncated { u } if u > MAX_TRUNCATED_U => Err(Error::invalid(format!(
+                "truncated history u = {u} exceeds {MAX_TRUNCATED_U}; use Full or SumOfExponentials for long memory"
+            ))),
             Scheme::SumOfExponentials {
                 tolerance,
                 horizon,
@@ -82,6 +85,12 @@ impl Scheme {
         }
     }
 }
+
+/// Largest `u` accepted for [`Scheme::Truncated`].
+pub const MAX_TRUNCATED_U: u32 = 100_000;
+
+/// Largest history (bytes, all particles) a cloth may ask for up front.
+pub const MAX_HISTORY_BYTES: u64 = 1 << 34;
 
 /// Default SOE relative kernel tolerance.
 pub const DEFAULT_SOE_TOLERANCE: f64 = 1e-3;
@@ -140,6 +149,18 @@ impl History {
     /// Builds the state for `n` particles. `Off` allocates nothing.
     pub fn new(scheme: Scheme, n: usize) -> Result<Self, Error> {
         scheme.validate()?;
+        let per_particle = match scheme {
+            Scheme::Truncated { u } => u64::from(u),
+            _ => 0,
+        };
+        let bytes = per_particle
+            .saturating_mul(n as u64)
+            .saturating_mul(std::mem::size_of::<Vec3>() as u64);
+        if bytes > MAX_HISTORY_BYTES {
+            return Err(Error::invalid(format!(
+                "the history would need {bytes} bytes (limit {MAX_HISTORY_BYTES})"
+            )));
+        }
         Ok(match scheme {
             Scheme::Off => History::Off,
             Scheme::Truncated { u } => History::Truncated(Truncated::new(u as usize, n)),

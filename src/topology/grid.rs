@@ -26,7 +26,7 @@ pub struct GridSpec {
 }
 
 /// Largest particle count a grid may have (keeps u32 indices and memory sane).
-pub const MAX_GRID_VERTICES: u64 = 1 << 26;
+pub const MAX_GRID_VERTICES: u64 = 1 << 24;
 
 impl GridSpec {
     /// Checks the spec and builds the topology.
