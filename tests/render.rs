@@ -3,18 +3,10 @@
 
 use fraccloth::render::{render_frame, Camera, Scene3d};
 use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
-use fraccloth::Vec3;
 use tiny_skia::Pixmap;
 
 fn camera(scene: &fraccloth::scenes::Scene, w: u32, h: u32) -> Camera {
-    let rest = &scene.cloth.topology().rest_positions;
-    let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
-    for p in rest {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
-    let m = Vec3::new(0.08, 0.04, 0.12);
-    Camera::framing(lo - m, hi + m, w, h)
+    Camera::for_rest_shape(&scene.cloth.topology().rest_positions, w, h)
 }
 
 fn draw(scene: &fraccloth::scenes::Scene, cam: &Camera) -> Pixmap {

@@ -122,16 +122,9 @@ fn spec_from(args: &Args, variant: Variant, scheme: Scheme) -> Result<SceneSpec,
     })
 }
 
-/// The fixed camera of a scene: its rest box, widened by how far the scenes move.
+/// The fixed camera of a scene.
 fn camera_for(scene: &Scene, width: u32, height: u32) -> Camera {
-    let rest = &scene.cloth.topology().rest_positions;
-    let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
-    for p in rest {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
-    let margin = Vec3::new(0.08, 0.04, 0.12);
-    Camera::framing(lo - margin, hi + margin, width, height)
+    Camera::for_rest_shape(&scene.cloth.topology().rest_positions, width, height)
 }
 
 fn picture(scene: &Scene, camera: &Camera) -> Result<Pixmap, String> {

@@ -47,6 +47,18 @@ impl Camera {
         Self::look_at(center + distance * dir, center, fov, width, height)
     }
 
+    /// The fixed preview camera of a cloth: its rest box, widened by how far the built-in
+    /// scenes move it (8 cm sideways, 4 cm vertically, 12 cm out of plane).
+    pub fn for_rest_shape(rest: &[Vec3], width: u32, height: u32) -> Self {
+        let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
+        for p in rest {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        let margin = Vec3::new(0.08, 0.04, 0.12);
+        Self::framing(lo - margin, hi + margin, width, height)
+    }
+
     /// Pixel coordinates (x right, y down) and the distance along the view direction.
     pub fn project(&self, p: &Vec3) -> (f32, f32, f64) {
         let d = p - self.eye;
