@@ -18,7 +18,7 @@ use fraccloth::history::Scheme;
 use fraccloth::look::{describe, Look};
 use fraccloth::render::{contact_sheet, render_frame, save_png, Camera, GifWriter, Scene3d};
 use fraccloth::scenes::{Scene, SceneKind, SceneSpec, Variant, DEFAULT_DT};
-use fraccloth::{HalfDerivative, Integrator, RegularDrag, Vec3};
+use fraccloth::{HalfDerivative, Integrator, RegularDrag};
 use indicatif::{ProgressBar, ProgressStyle};
 use tiny_skia::Pixmap;
 
