@@ -259,6 +259,11 @@ fn after_an_unstable_step_a_smaller_dt_continues_from_the_intact_state() {
     assert_eq!(a.cloth.velocities(), b.cloth.velocities());
 }
 
+/// Largest distance between corresponding vertices (m).
+fn max_distance(a: &[fraccloth::Vec3], b: &[fraccloth::Vec3]) -> f64 {
+    a.iter().zip(b).map(|(p, q)| (p - q).norm()).fold(0.0, f64::max)
+}
+
 #[test]
 fn substeps_equal_manual_steps_and_restore_everything_on_failure() {
     let spec = SceneSpec {
@@ -294,13 +299,7 @@ fn substeps_equal_manual_steps_and_restore_everything_on_failure() {
         b.cloth.set_pin_targets(&top, &goal).unwrap();
         b.cloth.step(0.0005).unwrap();
     }
-    let max_diff = a
-        .cloth
-        .positions()
-        .iter()
-        .zip(b.cloth.positions())
-        .map(|(p, q)| (p - q).norm())
-        .fold(0.0, f64::max);
+    let max_diff = max_distance(a.cloth.positions(), b.cloth.positions());
     assert!(
         max_diff < 1e-12,
         "substeps differ from manual steps by {max_diff}"
@@ -333,12 +332,6 @@ fn substeps_equal_manual_steps_and_restore_everything_on_failure() {
     a.cloth.set_pin_targets(&top, &targets).unwrap();
     a.cloth.step(0.0005).unwrap();
     b.cloth.step(0.0005).unwrap();
-    let d = a
-        .cloth
-        .positions()
-        .iter()
-        .zip(b.cloth.positions())
-        .map(|(p, q)| (p - q).norm())
-        .fold(0.0, f64::max);
+    let d = max_distance(a.cloth.positions(), b.cloth.positions());
     assert!(d < 1e-12, "{d}");
 }
