@@ -14,6 +14,7 @@ use crate::integrate::{
     SolverSettings, SolverStats,
 };
 use crate::model::Model;
+use crate::parallel;
 use crate::topology::Topology;
 use crate::Vec3;
 
@@ -443,19 +444,27 @@ impl Cloth {
             };
             s.v_step[i] = (s.goal[i] - self.x[i]) / h;
         }
-        let current = self.config.model.current;
-        for (r, v) in s.v_rel.iter_mut().zip(&s.v_step) {
-            *r = v - current;
-        }
-        // D^{1/2}x_n = w0 v_n + H_n.
+        // D^{1/2}x_n = w0 v_n + H_n, of the velocity relative to the water.
+        let par = parallel::worth_it(n);
         let mut w0 = 0.0;
         if !self.history.is_off() {
             self.history.prepare();
-            self.history.past(&mut s.half);
             w0 = self.history.current_weight();
-            for (d, r) in s.half.iter_mut().zip(&s.v_rel) {
-                *d += w0 * r;
-            }
+            let current = self.config.model.current;
+            let (history, v_step) = (&self.history, &s.v_step);
+            parallel::chunks2(
+                par,
+                (&mut s.v_rel, 1),
+                (&mut s.half, 1),
+                parallel::CHUNK,
+                |first, rel, half| {
+                    history.past_range(first, half);
+                    for ((r, d), v) in rel.iter_mut().zip(half.iter_mut()).zip(&v_step[first..]) {
+                        *r = v - current;
+                        *d += w0 * *r;
+                    }
+                },
+            );
         }
         let input = ForceInput {
             model: &self.config.model,
@@ -522,19 +531,21 @@ impl Cloth {
     fn check_sound(&self, dt: f64) -> Result<(), Error> {
         let s = &self.scratch;
         let vmax2 = self.config.max_speed * self.config.max_speed;
-        for (i, (x, v)) in s.x_new.iter().zip(&s.v_new).enumerate() {
-            let finite = x.iter().chain(v.iter()).all(|c| c.is_finite());
-            if !finite || v.norm_squared() > vmax2 {
-                return Err(Error::unstable(format!(
-                    "{} with dt = {dt} s is unstable at step {}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s); state left unchanged, retry with a smaller dt",
-                    self.config.integrator.name(),
-                    self.steps,
-                    v.norm(),
-                    self.config.max_speed
-                )));
-            }
+        let (x, v) = (&s.x_new, &s.v_new);
+        let bad = |i: usize| {
+            let finite = x[i].iter().chain(v[i].iter()).all(|c| c.is_finite());
+            !finite || v[i].norm_squared() > vmax2
+        };
+        match parallel::first_failing(parallel::worth_it(x.len()), x.len(), bad) {
+            None => Ok(()),
+            Some(i) => Err(Error::unstable(format!(
+                "{} with dt = {dt} s is unstable at step {}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s); state left unchanged, retry with a smaller dt",
+                self.config.integrator.name(),
+                self.steps,
+                v[i].norm(),
+                self.config.max_speed
+            ))),
         }
-        Ok(())
     }
 
     /// Total mechanical energy (J): kinetic + spring + potential of the net weight in water.

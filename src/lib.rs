@@ -39,8 +39,10 @@ pub mod integrate;
 pub mod look;
 pub mod model;
 pub mod oscillator;
+pub mod parallel;
 pub mod render;
 pub mod scenes;
+pub mod simd;
 pub mod topology;
 
 /// 3-vector of f64, the core's only vector type.

@@ -1,8 +1,13 @@
 //! A step allocates nothing once the cloth has taken its first steps (which size the scratch
 //! buffers): counted with a global allocator, for every integrator and every scheme whose
 //! memory is bounded (`Full` keeps every step by design).
+//!
+//! Only allocations made on the test's own thread are counted: the test harness's threads
+//! (and, once started, rayon's idle workers) may allocate on their own schedule. The cloths
+//! here are below `parallel::MIN_PARALLEL`, so every step runs on the test's thread.
 
 use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use fraccloth::history::Scheme;
@@ -13,9 +18,20 @@ struct Counting;
 
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
 
+thread_local! {
+    /// Set on the test's thread only.
+    static COUNTED: Cell<bool> = const { Cell::new(false) };
+}
+
+fn count() {
+    if COUNTED.with(Cell::get) {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        count();
         // SAFETY: forwarded unchanged to the system allocator.
         unsafe { System.alloc(layout) }
     }
@@ -24,7 +40,7 @@ unsafe impl GlobalAlloc for Counting {
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        count();
         // SAFETY: forwarded unchanged to the system allocator.
         unsafe { System.realloc(ptr, layout, new_size) }
     }
@@ -35,6 +51,8 @@ static GLOBAL: Counting = Counting;
 
 #[test]
 fn steps_do_not_allocate() {
+    COUNTED.with(|c| c.set(true));
+    const { assert!(15 * 11 < fraccloth::parallel::MIN_PARALLEL) };
     // One test function: the counter is global, so nothing else may run at the same time.
     let schemes = [
         Scheme::Off,

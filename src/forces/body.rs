@@ -1,6 +1,5 @@
 //! Gravity and buoyancy, Eq. 2: `F_g = (rho_c - rho_w) V_c g` with `V_c = m / rho_c`.
 
-use super::ForceInput;
 use crate::model::Model;
 use crate::Vec3;
 
@@ -8,10 +7,4 @@ use crate::Vec3;
 pub fn body_force(model: &Model, m: f64) -> Vec3 {
     let volume = m / model.cloth_density;
     (model.cloth_density - model.water_density) * volume * model.gravity
-}
-
-pub(super) fn add(input: &ForceInput<'_>, f: &mut [Vec3]) {
-    for (fi, &m) in f.iter_mut().zip(&input.topology.masses) {
-        *fi = body_force(input.model, m);
-    }
 }

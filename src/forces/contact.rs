@@ -5,7 +5,7 @@
 //! d < δ receives `k_c (δ - d) n + c_c max(0, -(v - v_c) . n) n`, n the outward normal:
 //! a spring pushing it out plus damping of the approach velocity only.
 
-use super::ForceInput;
+use crate::model::Model;
 use crate::Vec3;
 
 /// A sphere collider, moved by the host between steps.
@@ -39,22 +39,15 @@ impl Collider {
     }
 }
 
-pub(super) fn add(input: &ForceInput<'_>, f: &mut [Vec3]) {
-    if input.colliders.is_empty() {
-        return;
-    }
-    let (k, c, margin) = (
-        input.model.collision_stiffness,
-        input.model.collision_damping,
-        input.model.collision_margin,
-    );
-    for collider in input.colliders {
-        for ((fi, x), v) in f.iter_mut().zip(input.x).zip(input.v) {
-            let (d, n, vc) = collider.probe(x);
-            if d < margin {
-                let approach = (v - vc).dot(&n).min(0.0);
-                *fi += (k * (margin - d) - c * approach) * n;
-            }
+/// Adds the contact forces of every collider on a particle at `x` with velocity `v` to `f`.
+#[inline]
+pub(super) fn add(m: &Model, colliders: &[Collider], x: &Vec3, v: &Vec3, f: &mut Vec3) {
+    let (k, c, margin) = (m.collision_stiffness, m.collision_damping, m.collision_margin);
+    for collider in colliders {
+        let (d, n, vc) = collider.probe(x);
+        if d < margin {
+            let approach = (v - vc).dot(&n).min(0.0);
+            *f += (k * (margin - d) - c * approach) * n;
         }
     }
 }

@@ -1,43 +1,31 @@
-//! External drags on each particle, acting on the velocity relative to the water.
+//! External drags on one particle, acting on its velocity relative to the water.
 //!
 //! - viscous drag, Eq. 3: `-k_vd v`;
 //! - history (Basset) drag, Eq. 4: `-k_hd (D^{1/2}x . v_hat) v_hat`, zero when v = 0;
 //! - normal drag (regular models of Fig. 7): `-k_nd (v . n_hat) n_hat`.
+//!
+//! A term whose coefficient is zero is skipped.
 
-use super::ForceInput;
+use crate::model::Model;
 use crate::Vec3;
 
-pub(super) fn add_viscous(input: &ForceInput<'_>, f: &mut [Vec3]) {
-    let k = input.model.viscous_drag;
-    if k == 0.0 {
-        return;
+/// Adds the drags on a particle with velocity `v`, half-derivative `d` and unit normal `n`
+/// (read only when normal drag is on) to `f`.
+#[inline]
+pub(super) fn add(m: &Model, v: &Vec3, d: &Vec3, n: Option<&Vec3>, f: &mut Vec3) {
+    let c = m.current;
+    if m.viscous_drag != 0.0 {
+        *f -= m.viscous_drag * (v - c);
     }
-    let c = input.model.current;
-    for (fi, v) in f.iter_mut().zip(input.v) {
-        *fi -= k * (v - c);
-    }
-}
-
-pub(super) fn add_history(input: &ForceInput<'_>, f: &mut [Vec3]) {
-    let k = input.model.history_drag;
-    if k == 0.0 {
-        return;
-    }
-    let c = input.model.current;
-    for ((fi, v), d) in f.iter_mut().zip(input.v).zip(input.half_derivative) {
+    if m.history_drag != 0.0 {
         let rel = v - c;
         let speed2 = rel.norm_squared();
         if speed2 > 0.0 {
             // (d . v_hat) v_hat = (d . rel) rel / |rel|^2
-            *fi -= k * (d.dot(&rel) / speed2) * rel;
+            *f -= m.history_drag * (d.dot(&rel) / speed2) * rel;
         }
     }
-}
-
-pub(super) fn add_normal(input: &ForceInput<'_>, normals: &[Vec3], f: &mut [Vec3]) {
-    let k = input.model.normal_drag;
-    let c = input.model.current;
-    for ((fi, v), n) in f.iter_mut().zip(input.v).zip(normals) {
-        *fi -= k * (v - c).dot(n) * n;
+    if let Some(n) = n {
+        *f -= m.normal_drag * (v - c).dot(n) * n;
     }
 }

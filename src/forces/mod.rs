@@ -16,8 +16,12 @@ pub use jacobian::{linearise, Linearisation};
 pub use normals::vertex_normals;
 
 use crate::model::Model;
+use crate::parallel;
 use crate::topology::Topology;
 use crate::Vec3;
+
+/// Stands in for D^{1/2}x when a cloth keeps no history (no term reads it then).
+static ZERO: Vec3 = Vec3::new(0.0, 0.0, 0.0);
 
 /// Everything the forces read at one instant.
 pub struct ForceInput<'a> {
@@ -38,6 +42,8 @@ pub struct ForceInput<'a> {
 #[derive(Clone, Debug, Default)]
 pub struct ForceScratch {
     normals: Vec<Vec3>,
+    faces: Vec<Vec3>,
+    springs: Vec<Vec3>,
 }
 
 impl ForceScratch {
@@ -48,16 +54,41 @@ impl ForceScratch {
 }
 
 /// Writes the total force on every particle into `f` (N).
+///
+/// Per particle, in this order: net weight, drags, its springs in ascending spring order,
+/// contacts. Springs and face normals are evaluated once each into scratch buffers, then
+/// every particle gathers; chunks of particles run on rayon's pool when the cloth is large
+/// ([`parallel::worth_it`]) and the result does not depend on the thread count.
 pub fn accumulate(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [Vec3]) {
     let m = input.model;
-    body::add(input, f);
-    drag::add_viscous(input, f);
-    drag::add_history(input, f);
-    if m.normal_drag != 0.0 {
-        scratch.normals.resize(input.x.len(), Vec3::zeros());
-        vertex_normals(input.x, &input.topology.triangles, &mut scratch.normals);
-        drag::add_normal(input, &scratch.normals, f);
+    let t = input.topology;
+    let n = input.x.len();
+    let par = parallel::worth_it(n);
+    scratch.springs.resize(t.springs.len(), Vec3::zeros());
+    springs::compute(input, par, &mut scratch.springs);
+    let with_normals = m.normal_drag != 0.0;
+    if with_normals {
+        scratch.normals.resize(n, Vec3::zeros());
+        scratch.faces.resize(t.triangles.len(), Vec3::zeros());
+        normals::vertex_normals_with(
+            input.x,
+            &t.triangles,
+            &t.vertex_triangles,
+            par,
+            &mut scratch.faces,
+            &mut scratch.normals,
+        );
     }
-    springs::add(input, f);
-    contact::add(input, f);
+    let (spring_force, normals) = (&scratch.springs, &scratch.normals);
+    parallel::chunks(par, f, parallel::CHUNK, |first, chunk| {
+        for (k, fi) in chunk.iter_mut().enumerate() {
+            let p = first + k;
+            let (x, v) = (&input.x[p], &input.v[p]);
+            *fi = body_force(m, t.masses[p]);
+            let d = input.half_derivative.get(p).unwrap_or(&ZERO);
+            drag::add(m, v, d, with_normals.then(|| &normals[p]), fi);
+            springs::gather_into(t.vertex_springs.row(p), spring_force, fi);
+            contact::add(m, input.colliders, x, v, fi);
+        }
+    });
 }

@@ -1,23 +1,44 @@
 //! Area-weighted vertex normals from the triangle list.
 
+use crate::parallel;
+use crate::topology::Adjacency;
 use crate::Vec3;
 
 /// Unit normal of every vertex (zero for a vertex in no non-degenerate triangle).
 pub fn vertex_normals(x: &[Vec3], triangles: &[[u32; 3]], out: &mut [Vec3]) {
-    out.fill(Vec3::zeros());
-    for t in triangles {
-        let [a, b, c] = t.map(|i| i as usize);
-        let n = (x[b] - x[a]).cross(&(x[c] - x[a]));
-        out[a] += n;
-        out[b] += n;
-        out[c] += n;
-    }
-    for n in out.iter_mut() {
-        let len = n.norm();
-        if len > 0.0 {
-            *n /= len;
+    let adjacency = Adjacency::triangles(x.len(), triangles);
+    let mut faces = vec![Vec3::zeros(); triangles.len()];
+    vertex_normals_with(x, triangles, &adjacency, false, &mut faces, out);
+}
+
+/// [`vertex_normals`] with the vertex-triangle adjacency and the per-triangle buffer supplied
+/// (no allocation): face normals (twice the area) first, then each vertex sums its triangles
+/// in ascending order.
+pub fn vertex_normals_with(
+    x: &[Vec3],
+    triangles: &[[u32; 3]],
+    adjacency: &Adjacency,
+    parallel: bool,
+    faces: &mut [Vec3],
+    out: &mut [Vec3],
+) {
+    parallel::chunks(parallel, faces, parallel::CHUNK, |first, chunk| {
+        for (f, t) in chunk.iter_mut().zip(&triangles[first..]) {
+            let [a, b, c] = t.map(|i| i as usize);
+            *f = (x[b] - x[a]).cross(&(x[c] - x[a]));
         }
-    }
+    });
+    let faces = &*faces;
+    parallel::chunks(parallel, out, parallel::CHUNK, |first, chunk| {
+        for (k, o) in chunk.iter_mut().enumerate() {
+            let mut n = Vec3::zeros();
+            for &t in adjacency.row(first + k) {
+                n += faces[t as usize];
+            }
+            let len = n.norm();
+            *o = if len > 0.0 { n / len } else { n };
+        }
+    });
 }
 
 #[cfg(test)]

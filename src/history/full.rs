@@ -97,10 +97,10 @@ impl HalfDerivative for Full {
         self.w0
     }
 
-    fn past(&self, out: &mut [Vec3]) {
+    fn past_range(&self, first: usize, out: &mut [Vec3]) {
         out.fill(Vec3::zeros());
         for (k, &w) in self.weights.iter().enumerate() {
-            let step = &self.samples[k * self.n..(k + 1) * self.n];
+            let step = &self.samples[k * self.n + first..(k + 1) * self.n];
             for (o, v) in out.iter_mut().zip(step) {
                 *o += w * v;
             }

@@ -105,8 +105,13 @@ pub trait HalfDerivative {
     fn prepare(&mut self);
     /// Weight w0 of the current velocity v_n.
     fn current_weight(&self) -> f64;
-    /// Writes H_n (the part from the past) for every particle into `out`.
-    fn past(&self, out: &mut [Vec3]);
+    /// Writes H_n (the part from the past) for particles `first .. first + out.len()` into
+    /// `out`. Reads only, so disjoint ranges may be filled by different threads.
+    fn past_range(&self, first: usize, out: &mut [Vec3]);
+    /// Writes H_n for every particle into `out`.
+    fn past(&self, out: &mut [Vec3]) {
+        self.past_range(0, out)
+    }
     /// Records the velocities v_n the accepted step of size `h` (s) started from.
     fn push(&mut self, v: &[Vec3], h: f64);
     /// Bytes of history held per particle now.
@@ -217,9 +222,9 @@ impl HalfDerivative for History {
     fn current_weight(&self) -> f64 {
         self.inner().map_or(0.0, |s| s.current_weight())
     }
-    fn past(&self, out: &mut [Vec3]) {
+    fn past_range(&self, first: usize, out: &mut [Vec3]) {
         match self.inner() {
-            Some(s) => s.past(out),
+            Some(s) => s.past_range(first, out),
             None => out.fill(Vec3::zeros()),
         }
     }

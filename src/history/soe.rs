@@ -23,6 +23,7 @@ use std::sync::Arc;
 
 use super::soe_kernel::SoeKernel;
 use super::HalfDerivative;
+use crate::parallel;
 use crate::Vec3;
 
 /// Modes whose decay over one step exceeds this are skipped.
@@ -47,19 +48,27 @@ fn phi(z: f64) -> (f64, f64) {
     }
 }
 
+/// Particles per block of the mode store: one AVX-512 register of f64, two of AVX2.
+const LANES: usize = 8;
+
 /// SOE history of `n` particles.
 ///
-/// Layout and work per step: the K modes of a particle are contiguous, and one pass over them
-/// both folds the newest panel into every mode and sums what the next step needs,
-/// `P_p = sum_l w_l e^{-s_l h} G_{l,p}` (h: the step just taken, which is the next step's gap).
+/// Layout and work per step: particles are stored in blocks of [`LANES`]; within a block the
+/// modes are ordered mode, component, particle (`[K][3][LANES]`), so the update of one mode
+/// is the same arithmetic on `3 * LANES` contiguous numbers and the compiler vectorises it
+/// across particles. One pass over the modes both folds the newest panel into every mode and
+/// sums what the next step needs, `P_p = sum_l w_l e^{-s_l h} G_{l,p}` (h: the step just
+/// taken, which is the next step's gap), each particle's sum in ascending mode order.
 /// `past` then only adds `w_prev v_{n-1}`: one pass over the modes per step, not two.
+/// Blocks are independent, so chunks of them run in parallel with identical results.
 #[derive(Debug)]
 pub struct SumOfExponentials {
     n: usize,
     /// Shared and immutable: cloning the history (substep snapshots) does not copy it.
     kernel: Arc<SoeKernel>,
-    /// Particle-major: the modes of particle p are `modes[p*K .. (p+1)*K]`.
-    modes: Vec<Vec3>,
+    /// Block-major: block b holds `[K][3][LANES]` numbers (see the type's docs); the lanes
+    /// past `n` in the last block stay zero.
+    modes: Vec<f64>,
     prev: Vec<Vec3>,
     /// `sum_l w_l e^{-s_l gap} G_l` per particle, computed by the last push.
     pending: Vec<Vec3>,
@@ -123,7 +132,7 @@ impl SumOfExponentials {
         Self {
             n,
             kernel: Arc::new(kernel),
-            modes: vec![Vec3::zeros(); k * n],
+            modes: vec![0.0; n.div_ceil(LANES) * k * 3 * LANES],
             prev: vec![Vec3::zeros(); n],
             pending: vec![Vec3::zeros(); n],
             has_prev: false,
@@ -164,8 +173,12 @@ impl HalfDerivative for SumOfExponentials {
         self.w0
     }
 
-    fn past(&self, out: &mut [Vec3]) {
-        for ((o, p), q) in out.iter_mut().zip(&self.prev).zip(&self.pending) {
+    fn past_range(&self, first: usize, out: &mut [Vec3]) {
+        for ((o, p), q) in out
+            .iter_mut()
+            .zip(&self.prev[first..])
+            .zip(&self.pending[first..])
+        {
             *o = self.w_prev * p + q;
         }
     }
@@ -188,15 +201,32 @@ impl HalfDerivative for SumOfExponentials {
                     0.0
                 };
             }
-            for p in 0..self.n {
-                let (pv, vn) = (self.prev[p], v[p]);
-                let mut acc = Vec3::zeros();
-                for (l, m) in self.modes[p * k..(p + 1) * k].iter_mut().enumerate() {
-                    *m = self.decay[l] * *m + self.a[l] * pv + self.b[l] * vn;
-                    acc += self.next[l] * *m;
-                }
-                self.pending[p] = acc;
-            }
+            let coefficients = Coefficients {
+                decay: &self.decay,
+                a: &self.a,
+                b: &self.b,
+                next: &self.next,
+            };
+            let (prev, n) = (&self.prev, self.n);
+            let block = k * 3 * LANES;
+            let blocks_per_chunk = parallel::CHUNK / LANES;
+            parallel::chunks2(
+                parallel::worth_it(n),
+                (&mut self.modes, block),
+                (&mut self.pending, LANES),
+                blocks_per_chunk,
+                |first_block, modes, pending| {
+                    for (b, (m, out)) in modes
+                        .chunks_exact_mut(block)
+                        .zip(pending.chunks_mut(LANES))
+                        .enumerate()
+                    {
+                        let p0 = (first_block + b) * LANES;
+                        let lanes = out.len().min(n - p0);
+                        fold_block(&coefficients, &prev[p0..p0 + lanes], &v[p0..p0 + lanes], m, out);
+                    }
+                },
+            );
         }
         self.prev.copy_from_slice(&v[..self.n]);
         self.has_prev = true;
@@ -208,11 +238,48 @@ impl HalfDerivative for SumOfExponentials {
     }
 
     fn reset(&mut self) {
-        self.modes.fill(Vec3::zeros());
+        self.modes.fill(0.0);
         self.prev.fill(Vec3::zeros());
         self.pending.fill(Vec3::zeros());
         self.has_prev = false;
         self.gap = 0.0;
+    }
+}
+
+/// Per-mode coefficients of one fold.
+struct Coefficients<'a> {
+    decay: &'a [f64],
+    a: &'a [f64],
+    b: &'a [f64],
+    next: &'a [f64],
+}
+
+/// Folds the panel (`prev`, `v`) into the modes of one block of up to [`LANES`] particles and
+/// writes each particle's next-step sum into `out`. Same arithmetic, in the same order, for
+/// every particle as a scalar loop over its modes; laid out so it vectorises across lanes.
+#[inline]
+fn fold_block(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64], out: &mut [Vec3]) {
+    let mut pv = [[0.0; LANES]; 3];
+    let mut vn = [[0.0; LANES]; 3];
+    for q in 0..prev.len() {
+        for d in 0..3 {
+            pv[d][q] = prev[q][d];
+            vn[d][q] = v[q][d];
+        }
+    }
+    let mut acc = [[0.0; LANES]; 3];
+    for (l, mode) in modes.chunks_exact_mut(3 * LANES).enumerate() {
+        let (decay, a, b, next) = (c.decay[l], c.a[l], c.b[l], c.next[l]);
+        for d in 0..3 {
+            let m = &mut mode[d * LANES..(d + 1) * LANES];
+            for q in 0..LANES {
+                m[q] = decay * m[q] + a * pv[d][q] + b * vn[d][q];
+                acc[d][q] += next * m[q];
+            }
+        }
+    }
+    for (q, o) in out.iter_mut().enumerate().take(prev.len()) {
+        *o = Vec3::new(acc[0][q], acc[1][q], acc[2][q]);
     }
 }
 

@@ -134,10 +134,10 @@ impl HalfDerivative for Truncated {
         self.weights.first().copied().unwrap_or(0.0)
     }
 
-    fn past(&self, out: &mut [Vec3]) {
+    fn past_range(&self, first: usize, out: &mut [Vec3]) {
         out.fill(Vec3::zeros());
         for (k, &w) in self.weights.iter().enumerate().skip(1) {
-            for (o, v) in out.iter_mut().zip(self.slot(k)) {
+            for (o, v) in out.iter_mut().zip(&self.slot(k)[first..]) {
                 *o += w * v;
             }
         }

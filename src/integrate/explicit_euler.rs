@@ -4,6 +4,7 @@
 //! Chosen as the paper's reference; it is only conditionally stable (the damping
 //! must be large enough for the stiffest mode: h ω² < c), see `docs/`.
 
+use crate::parallel;
 use crate::Vec3;
 
 /// One explicit Euler step for free particles. `force` holds F(t_n); pinned particles
@@ -17,8 +18,17 @@ pub fn explicit_euler(
     x_new: &mut [Vec3],
     v_new: &mut [Vec3],
 ) {
-    for i in 0..x.len() {
-        x_new[i] = x[i] + h * v[i];
-        v_new[i] = v[i] + (h / masses[i]) * force[i];
-    }
+    parallel::chunks2(
+        parallel::worth_it(x.len()),
+        (x_new, 1),
+        (v_new, 1),
+        parallel::CHUNK,
+        |first, x_new, v_new| {
+            for k in 0..x_new.len() {
+                let i = first + k;
+                x_new[k] = x[i] + h * v[i];
+                v_new[k] = v[i] + (h / masses[i]) * force[i];
+            }
+        },
+    );
 }

@@ -4,6 +4,7 @@
 //! makes the undamped part stable up to `h < 2/omega` instead of never; damping is still
 //! explicit.
 
+use crate::parallel;
 use crate::Vec3;
 
 /// One symplectic Euler step for free particles; pinned particles are overwritten by the caller.
@@ -16,8 +17,17 @@ pub fn symplectic_euler(
     x_new: &mut [Vec3],
     v_new: &mut [Vec3],
 ) {
-    for i in 0..x.len() {
-        v_new[i] = v[i] + (h / masses[i]) * force[i];
-        x_new[i] = x[i] + h * v_new[i];
-    }
+    parallel::chunks2(
+        parallel::worth_it(x.len()),
+        (x_new, 1),
+        (v_new, 1),
+        parallel::CHUNK,
+        |first, x_new, v_new| {
+            for k in 0..x_new.len() {
+                let i = first + k;
+                v_new[k] = v[i] + (h / masses[i]) * force[i];
+                x_new[k] = x[i] + h * v_new[k];
+            }
+        },
+    );
 }

@@ -103,13 +103,13 @@ impl GridSpec {
                 triangles.push([b, c, d]);
             }
         }
-        Ok(Topology {
+        Ok(Topology::new(
             rest_positions,
-            masses: vec![self.total_mass / n as f64; n],
+            vec![self.total_mass / n as f64; n],
             springs,
             triangles,
-            grid: Some((w, h)),
-        })
+            Some((w, h)),
+        ))
     }
 }
 

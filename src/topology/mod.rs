@@ -4,10 +4,14 @@
 //! the simulator: rest positions, per-particle masses, the spring list and a
 //! triangle list (used for normals and rendering).
 
+mod adjacency;
 mod grid;
+mod runs;
 mod spring;
 
+pub use adjacency::Adjacency;
 pub use grid::{grid_index, GridSpec};
+pub use runs::SpringRun;
 pub use spring::{Spring, SpringKind};
 
 use crate::Vec3;
@@ -19,15 +23,51 @@ pub struct Topology {
     pub rest_positions: Vec<Vec3>,
     /// Lumped particle masses, kilograms.
     pub masses: Vec<f64>,
-    /// Every spring once (i < j).
+    /// Every spring once (i < j), ordered into [`SpringRun`]s.
     pub springs: Vec<Spring>,
+    /// The springs as runs of consecutive vertices (see [`SpringRun`]).
+    pub spring_runs: Vec<SpringRun>,
+    /// Rest length of each spring (a copy laid out for the spring pass), m.
+    pub spring_rest: Vec<f64>,
+    /// Family of each spring (`SpringKind as u8`).
+    pub spring_kinds: Vec<u8>,
     /// Triangles (counter-clockwise seen from the +normal side), vertex indices.
     pub triangles: Vec<[u32; 3]>,
     /// Grid size (columns, rows) when the cloth was built from a grid.
     pub grid: Option<(u32, u32)>,
+    /// Springs touching each vertex (see [`Adjacency::springs`]).
+    pub vertex_springs: Adjacency,
+    /// Triangles touching each vertex.
+    pub vertex_triangles: Adjacency,
 }
 
 impl Topology {
+    /// Assembles a topology: orders the springs into runs and builds the per-vertex adjacency.
+    /// Every spring must have i < j. Indices must be in range (the
+    /// constructors check their input before calling this).
+    pub fn new(
+        rest_positions: Vec<Vec3>,
+        masses: Vec<f64>,
+        mut springs: Vec<Spring>,
+        triangles: Vec<[u32; 3]>,
+        grid: Option<(u32, u32)>,
+    ) -> Self {
+        let n = rest_positions.len();
+        let spring_runs = runs::order_into_runs(&mut springs);
+        Self {
+            spring_runs,
+            spring_rest: springs.iter().map(|s| s.rest).collect(),
+            spring_kinds: springs.iter().map(|s| s.kind as u8).collect(),
+            vertex_springs: Adjacency::springs(n, &springs),
+            vertex_triangles: Adjacency::triangles(n, &triangles),
+            rest_positions,
+            masses,
+            springs,
+            triangles,
+            grid,
+        }
+    }
+
     /// Number of particles.
     pub fn vertex_count(&self) -> usize {
         self.rest_positions.len()

@@ -1,0 +1,259 @@
+//! Throughput: particle-steps per second of the main configurations, from 2.5k to 1M
+//! particles, on 1 and 2 threads, and the scaling plot.
+//!
+//! `cargo run --release --example throughput` (about 3 minutes on 2 cores) prints a table and
+//! writes docs/throughput.csv, docs/scaling.png and docs/scaling.svg. `-- --quick` (sizes up to
+//! 100k, shorter runs) writes them under target/ instead. `-- --sizes 61x41` limits the sizes.
+//!
+//! The cloth: a grid at 1 cm spacing (so every size is equally stiff and the same dt is stable),
+//! 0.096 g per particle, top row pinned, in a 0.2 m/s cross current so it keeps moving; dt = 1 ms
+//! (the setting). Timed: the stepping loop only (`Cloth::step`), after 20 warm-up steps,
+//! for at least 0.5 s of wall clock (0.15 s with --quick). Threads: a rayon pool of that many
+//! threads around the loop. Every step must succeed; a failed step aborts the run.
+
+use std::error::Error;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use fraccloth::history::Scheme;
+use fraccloth::scenes::Variant;
+use fraccloth::topology::grid_index;
+use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, RegularDrag, Vec3};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+const SPACING: f64 = 0.01;
+const PARTICLE_MASS: f64 = 0.24 / 2501.0;
+const DT: f64 = 5e-4;
+
+#[derive(Clone, Copy)]
+struct Config {
+    name: &'static str,
+    variant: Variant,
+    scheme: Scheme,
+    integrator: Integrator,
+}
+
+fn configs() -> Vec<Config> {
+    vec![
+        Config {
+            name: "fractional SOE, symplectic",
+            variant: Variant::Fractional,
+            scheme: Scheme::DEFAULT,
+            integrator: Integrator::SymplecticEuler,
+        },
+        Config {
+            name: "regular (normal drag), symplectic",
+            variant: Variant::Regular(RegularDrag::Normal),
+            scheme: Scheme::Off,
+            integrator: Integrator::SymplecticEuler,
+        },
+        Config {
+            name: "fractional SOE, explicit",
+            variant: Variant::Fractional,
+            scheme: Scheme::DEFAULT,
+            integrator: Integrator::ExplicitEuler,
+        },
+        Config {
+            name: "paper (u = 3), explicit",
+            variant: Variant::Fractional,
+            scheme: Scheme::PAPER,
+            integrator: Integrator::ExplicitEuler,
+        },
+    ]
+}
+
+fn build(c: &Config, w: u32, h: u32) -> Result<Cloth, Box<dyn Error>> {
+    let n = f64::from(w) * f64::from(h);
+    let topology = GridSpec {
+        width: w,
+        height: h,
+        spacing: SPACING,
+        total_mass: PARTICLE_MASS * n,
+    }
+    .build()?;
+    let mut model = c.variant.model(SPACING);
+    model.current = Vec3::new(0.0, 0.0, 0.2);
+    let config = ClothConfig {
+        model,
+        scheme: c.scheme,
+        integrator: c.integrator,
+        ..ClothConfig::default()
+    };
+    let mut cloth = Cloth::new(topology, config)?;
+    let top: Vec<u32> = (0..w).map(|i| grid_index(w, i, 0)).collect();
+    cloth.set_pinned(&top)?;
+    Ok(cloth)
+}
+
+/// Particle-steps per second of `c` at `w x h` on `threads` threads.
+fn measure(c: &Config, w: u32, h: u32, threads: usize, min_secs: f64) -> Result<f64, Box<dyn Error>> {
+    let mut cloth = build(c, w, h)?;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+    let rate = pool.install(|| -> Result<f64, fraccloth::Error> {
+        for _ in 0..20 {
+            cloth.step(DT)?;
+        }
+        let start = Instant::now();
+        let mut steps = 0u64;
+        while start.elapsed().as_secs_f64() < min_secs || steps < 5 {
+            for _ in 0..5 {
+                cloth.step(DT)?;
+            }
+            steps += 5;
+        }
+        let secs = start.elapsed().as_secs_f64();
+        Ok(steps as f64 * cloth.vertex_count() as f64 / secs)
+    })?;
+    Ok(rate)
+}
+
+struct Row {
+    config: &'static str,
+    particles: usize,
+    threads: usize,
+    rate: f64,
+}
+
+fn main() -> Result<(), Box<dyn Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let mut sizes: Vec<(u32, u32)> = if quick {
+        vec![(61, 41), (101, 101), (317, 317)]
+    } else {
+        vec![(61, 41), (101, 101), (317, 317), (501, 501), (1001, 1001)]
+    };
+    if let Some(k) = args.iter().position(|a| a == "--sizes") {
+        sizes = args
+            .get(k + 1)
+            .ok_or("--sizes needs WxH[,WxH...]")?
+            .split(',')
+            .map(|s| -> Result<(u32, u32), Box<dyn Error>> {
+                let (w, h) = s.split_once('x').ok_or("size must be WxH")?;
+                Ok((w.parse()?, h.parse()?))
+            })
+            .collect::<Result<_, _>>()?;
+    }
+    let min_secs = if quick { 0.15 } else { 0.5 };
+    let out_dir = if quick {
+        Path::new("target")
+    } else {
+        Path::new("docs")
+    };
+    let mut rows = vec![];
+    println!(
+        "{:<36} {:>9} {:>14} {:>14} {:>8}",
+        "configuration", "particles", "1 thread M/s", "2 threads M/s", "speedup"
+    );
+    for c in configs() {
+        for &(w, h) in &sizes {
+            let one = measure(&c, w, h, 1, min_secs)?;
+            let two = measure(&c, w, h, 2, min_secs)?;
+            let n = (w * h) as usize;
+            println!(
+                "{:<36} {:>9} {:>14.2} {:>14.2} {:>8.2}",
+                c.name,
+                n,
+                one / 1e6,
+                two / 1e6,
+                two / one
+            );
+            rows.push(Row {
+                config: c.name,
+                particles: n,
+                threads: 1,
+                rate: one,
+            });
+            rows.push(Row {
+                config: c.name,
+                particles: n,
+                threads: 2,
+                rate: two,
+            });
+        }
+    }
+    let mut csv = String::from("configuration,particles,threads,particle_steps_per_second\n");
+    for r in &rows {
+        writeln!(csv, "{},{},{},{:.0}", r.config, r.particles, r.threads, r.rate)?;
+    }
+    std::fs::write(out_dir.join("throughput.csv"), csv)?;
+    draw(
+        &rows,
+        BitMapBackend::new(&out_dir.join("scaling.png"), (1000, 600)).into_drawing_area(),
+    )?;
+    draw(
+        &rows,
+        SVGBackend::new(&out_dir.join("scaling.svg"), (1000, 600)).into_drawing_area(),
+    )?;
+    println!(
+        "wrote {}",
+        ["throughput.csv", "scaling.png", "scaling.svg"]
+            .map(|f| out_dir.join(f).display().to_string())
+            .join(", ")
+    );
+    Ok(())
+}
+
+/// Nanoseconds per particle-step against particle count (log x), one line per configuration
+/// and thread count.
+fn draw<DB: DrawingBackend>(rows: &[Row], area: DrawingArea<DB, Shift>) -> Result<(), Box<dyn Error>>
+where
+    DB::ErrorType: 'static,
+{
+    area.fill(&WHITE)?;
+    let ns = |r: &Row| 1e9 / r.rate;
+    let nmin = rows.iter().map(|r| r.particles).min().unwrap_or(1) as f64;
+    let nmax = rows.iter().map(|r| r.particles).max().unwrap_or(2) as f64;
+    let ymax = rows.iter().map(ns).fold(0.0, f64::max) * 1.15;
+    let mut chart = ChartBuilder::on(&area)
+        .caption(
+            "Time per particle-step (lower is better; flat = scales linearly)",
+            ("sans-serif", 22),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d((nmin * 0.8..nmax * 1.25).log_scale(), 0.0..ymax)?;
+    chart
+        .configure_mesh()
+        .x_desc("particles")
+        .y_desc("ns per particle-step")
+        .draw()?;
+    let names: Vec<&str> = {
+        let mut v: Vec<&str> = rows.iter().map(|r| r.config).collect();
+        v.dedup();
+        v
+    };
+    for (k, name) in names.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        for threads in [1usize, 2] {
+            let pts: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.config == *name && r.threads == threads)
+                .map(|r| (r.particles as f64, ns(r)))
+                .collect();
+            let style = if threads == 1 {
+                color.stroke_width(2)
+            } else {
+                color.stroke_width(1)
+            };
+            let series = chart.draw_series(LineSeries::new(pts.clone(), style))?;
+            series
+                .label(format!(
+                    "{name}, {threads} thread{}",
+                    if threads == 1 { "" } else { "s" }
+                ))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()?;
+    area.present()?;
+    Ok(())
+}

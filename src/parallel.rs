@@ -1,0 +1,122 @@
+//! How the per-particle passes are split among threads.
+//!
+//! Every pass writes each output element from inputs that no other element of the same pass
+//! writes (gather, never scatter), and the work is cut into chunks of a fixed size that does
+//! not depend on the number of threads. So the result is bitwise identical for any thread
+//! count: threads only change which core computes a chunk, never what is computed.
+//!
+//! Small cloths stay on the calling thread: below [`MIN_PARALLEL`] particles a step takes a
+//! few tens of microseconds and handing chunks to other threads costs more than it saves.
+//! Threads come from rayon's current pool: the global pool (`RAYON_NUM_THREADS`), or a pool
+//! the host installs around the call.
+
+use rayon::prelude::*;
+
+/// Elements per task. Fixed, so the split never depends on the thread count.
+pub const CHUNK: usize = 4096;
+
+/// Fewest particles for which a step uses more than one thread (measured with
+/// `cargo run --release --example throughput`; see docs/benchmarks.md).
+pub const MIN_PARALLEL: usize = 10_000;
+
+/// Whether a cloth of `n` particles should spread its passes over the pool.
+pub fn worth_it(n: usize) -> bool {
+    n >= MIN_PARALLEL && rayon::current_num_threads() > 1
+}
+
+/// Calls `f(first_index, chunk)` on consecutive chunks of `a` of `chunk` elements, in
+/// parallel when `parallel`.
+pub fn chunks<A, F>(parallel: bool, a: &mut [A], chunk: usize, f: F)
+where
+    A: Send,
+    F: Fn(usize, &mut [A]) + Sync + Send,
+{
+    if parallel {
+        a.par_chunks_mut(chunk)
+            .enumerate()
+            .for_each(|(k, c)| f(k * chunk, c));
+    } else {
+        a.chunks_mut(chunk).enumerate().for_each(|(k, c)| f(k * chunk, c));
+    }
+}
+
+/// As [`chunks`], over two slices cut at the same element boundaries: chunk k of `a` has
+/// `chunk * stride_a` elements and chunk k of `b` has `chunk * stride_b`. `f` gets the index
+/// of the first element (in units of `chunk`'s elements).
+pub fn chunks2<A, B, F>(
+    parallel: bool,
+    (a, stride_a): (&mut [A], usize),
+    (b, stride_b): (&mut [B], usize),
+    chunk: usize,
+    f: F,
+) where
+    A: Send,
+    B: Send,
+    F: Fn(usize, &mut [A], &mut [B]) + Sync + Send,
+{
+    if parallel {
+        a.par_chunks_mut(chunk * stride_a)
+            .zip(b.par_chunks_mut(chunk * stride_b))
+            .enumerate()
+            .for_each(|(k, (ca, cb))| f(k * chunk, ca, cb));
+    } else {
+        a.chunks_mut(chunk * stride_a)
+            .zip(b.chunks_mut(chunk * stride_b))
+            .enumerate()
+            .for_each(|(k, (ca, cb))| f(k * chunk, ca, cb));
+    }
+}
+
+/// The smallest index in `0..n` for which `bad` holds, searched in parallel chunks when
+/// `parallel`; the answer does not depend on the split.
+pub fn first_failing<F>(parallel: bool, n: usize, bad: F) -> Option<usize>
+where
+    F: Fn(usize) -> bool + Sync + Send,
+{
+    let scan = |k: usize| (k * CHUNK..((k + 1) * CHUNK).min(n)).find(|&i| bad(i));
+    let chunks = n.div_ceil(CHUNK);
+    if parallel {
+        (0..chunks).into_par_iter().filter_map(scan).min()
+    } else {
+        (0..chunks).find_map(scan)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunks_cover_every_element_once_with_its_index() {
+        for parallel in [false, true] {
+            let mut a = vec![0usize; 3 * CHUNK + 5];
+            chunks(parallel, &mut a, CHUNK, |first, c| {
+                for (k, x) in c.iter_mut().enumerate() {
+                    *x += first + k + 1;
+                }
+            });
+            assert!(a.iter().enumerate().all(|(i, &x)| x == i + 1));
+            let mut b = vec![0usize; 2 * a.len()];
+            chunks2(parallel, (&mut a, 1), (&mut b, 2), 100, |first, ca, cb| {
+                assert_eq!(2 * ca.len(), cb.len());
+                for k in 0..ca.len() {
+                    cb[2 * k] = first + k;
+                }
+            });
+            assert!((0..a.len()).all(|i| b[2 * i] == i));
+        }
+    }
+
+    #[test]
+    fn first_failing_finds_the_smallest_index() {
+        let n = 5 * CHUNK + 17;
+        for parallel in [false, true] {
+            assert_eq!(
+                first_failing(parallel, n, |i| i % 3000 == 2999 && i > 9000),
+                Some(11999)
+            );
+            assert_eq!(first_failing(parallel, n, |_| false), None);
+            assert_eq!(first_failing(parallel, n, |i| i == n - 1), Some(n - 1));
+        }
+    }
+}
