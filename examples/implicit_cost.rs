@@ -1,13 +1,13 @@
 //! Cost per frame of the implicit integrator stepping once per frame (dt = 1/24 s) on the
-//! fractional swing, at 61 x 41 and 201 x 201, with the CG iterations it needed.
-//! `cargo run --release --example implicit_cost`
+//! fractional swing, at 61 x 41 and 201 x 201, on 1 and 2 threads, with the CG iterations
+//! it needed. `cargo run --release --example implicit_cost`
 
 use fraccloth::history::Scheme;
 use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
 use fraccloth::Integrator;
 
 fn main() {
-    for (w, h) in [(61u32, 41u32), (201, 201)] {
+    for ((w, h), threads) in [((61u32, 41u32), 1), ((201, 201), 1), ((201, 201), 2)] {
         let spec = SceneSpec {
             width: w,
             height: h,
@@ -18,17 +18,23 @@ fn main() {
         };
         let mut scene = spec.build().expect("scene");
         let frames = 48;
-        let start = std::time::Instant::now();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("thread pool");
         let mut iterations = vec![];
-        for _ in 0..frames {
-            scene.step().expect("implicit step");
-            iterations.push(scene.cloth.solver_stats().iterations);
-        }
-        let per_frame = start.elapsed().as_secs_f64() / f64::from(frames);
+        let per_frame = pool.install(|| {
+            let start = std::time::Instant::now();
+            for _ in 0..frames {
+                scene.step().expect("implicit step");
+                iterations.push(scene.cloth.solver_stats().iterations);
+            }
+            start.elapsed().as_secs_f64() / f64::from(frames)
+        });
         let max = iterations.iter().max().copied().unwrap_or(0);
         let mean = f64::from(iterations.iter().sum::<u32>()) / f64::from(frames);
         println!(
-            "{w} x {h}: {:.1} ms per frame (one thread), CG iterations per frame: mean {mean:.1}, max {max} (cap {})",
+            "{w} x {h}, {threads} thread(s): {:.1} ms per frame, CG iterations per frame: mean {mean:.1}, max {max} (cap {})",
             per_frame * 1e3,
             spec.build().expect("scene").cloth.config().solver.max_iterations
         );

@@ -503,7 +503,7 @@ impl Cloth {
                     v: &s.v_step,
                     force: &s.force,
                     masses,
-                    springs: &self.topology.springs,
+                    topology: &self.topology,
                     pinned: &self.pinned,
                     settings: self.config.solver,
                 };

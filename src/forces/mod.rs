@@ -3,6 +3,7 @@
 //! [`accumulate`] sums every enabled term into a force buffer. A term whose
 //! coefficient is zero is skipped entirely, so a scene pays only for what it uses.
 
+mod assemble;
 mod body;
 mod contact;
 mod drag;
@@ -10,6 +11,7 @@ mod jacobian;
 mod normals;
 mod springs;
 
+pub use assemble::add_spring_values;
 pub use body::body_force;
 pub use contact::{Collider, Sphere};
 pub use jacobian::{linearise, Linearisation};
@@ -55,8 +57,8 @@ impl ForceScratch {
 
 /// Writes the total force on every particle into `f` (N).
 ///
-/// Per particle, in this order: net weight, drags, its springs in ascending spring order,
-/// contacts. Springs and face normals are evaluated once each into scratch buffers, then
+/// Per particle, in this order: net weight, drags, its springs (in ascending spring order,
+/// see [`add_spring_values`]), contacts. Springs and face normals are evaluated once each into scratch buffers, then
 /// every particle gathers; chunks of particles run on rayon's pool when the cloth is large
 /// ([`parallel::worth_it`]) and the result does not depend on the thread count.
 pub fn accumulate(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [Vec3]) {
@@ -83,12 +85,16 @@ pub fn accumulate(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [V
     parallel::chunks(par, f, parallel::CHUNK, |first, chunk| {
         for (k, fi) in chunk.iter_mut().enumerate() {
             let p = first + k;
-            let (x, v) = (&input.x[p], &input.v[p]);
             *fi = body_force(m, t.masses[p]);
             let d = input.half_derivative.get(p).unwrap_or(&ZERO);
-            drag::add(m, v, d, with_normals.then(|| &normals[p]), fi);
-            springs::gather_into(t.vertex_springs.row(p), spring_force, fi);
-            contact::add(m, input.colliders, x, v, fi);
+            drag::add(m, &input.v[p], d, with_normals.then(|| &normals[p]), fi);
+        }
+        add_spring_values(t, first, spring_force, -1.0, chunk);
+        if !input.colliders.is_empty() {
+            for (k, fi) in chunk.iter_mut().enumerate() {
+                let p = first + k;
+                contact::add(m, input.colliders, &input.x[p], &input.v[p], fi);
+            }
         }
     });
 }

@@ -6,8 +6,8 @@
 //! Particle j receives the opposite force.
 //!
 //! Two passes: [`compute`] evaluates each spring once into a per-spring buffer (springs are
-//! independent, so chunks of them run in parallel), then every particle gathers its springs
-//! in ascending order ([`gather_into`]).
+//! independent, so chunks of them run in parallel), then every chunk of particles adds the
+//! springs that touch it ([`super::assemble`]).
 //!
 //! The per-spring pass walks the topology's [`SpringRun`]s: the end points of a run are two
 //! contiguous slices of the position array, so the loop has no index loads and vectorises.
@@ -106,24 +106,4 @@ fn run_kernel(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: &mut [V
             out[t] = Vec3::new(s * l.x, s * l.y, s * l.z);
         }
     }
-}
-
-/// Adds the forces of the springs of particle `p` (`row`: its adjacency row) to `f`.
-///
-/// Two partial sums (entries 0, 2, 4, ... and 1, 3, 5, ...) so consecutive additions do not
-/// wait on each other; the order is fixed by the row, never by the thread split.
-#[inline]
-pub(super) fn gather_into(row: &[u32], spring_force: &[Vec3], f: &mut Vec3) {
-    // +1 for the i end, -1 for the j end: exact, and no branch to mispredict.
-    let term = |e: u32| (1.0 - 2.0 * f64::from(e & 1)) * spring_force[(e >> 1) as usize];
-    let (mut even, mut odd) = (Vec3::zeros(), Vec3::zeros());
-    let mut pairs = row.chunks_exact(2);
-    for pair in &mut pairs {
-        even += term(pair[0]);
-        odd += term(pair[1]);
-    }
-    if let [last] = pairs.remainder() {
-        even += term(*last);
-    }
-    *f += even + odd;
 }

@@ -3,6 +3,7 @@
 
 use nalgebra::Matrix3;
 
+use crate::parallel;
 use crate::Vec3;
 
 /// Tolerance and iteration cap of the solver.
@@ -38,16 +39,24 @@ pub struct CgScratch {
     z: Vec<Vec3>,
     p: Vec<Vec3>,
     q: Vec<Vec3>,
+    partial: Vec<f64>,
 }
 
-fn dot(a: &[Vec3], b: &[Vec3]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x.dot(y)).sum()
+/// `a . b`, summed chunk by chunk ([`parallel::CHUNK`]) and then over the chunks in order:
+/// the same bits whether the chunks run on one thread or many.
+fn dot(par: bool, partial: &mut [f64], a: &[Vec3], b: &[Vec3]) -> f64 {
+    parallel::chunks(par, partial, 1, |k, s| {
+        let lo = k * parallel::CHUNK;
+        let hi = (lo + parallel::CHUNK).min(a.len());
+        s[0] = a[lo..hi].iter().zip(&b[lo..hi]).map(|(x, y)| x.dot(y)).sum();
+    });
+    partial.iter().sum()
 }
 
 /// Solves `A x = b` for the free components (`fixed[i]` false); fixed components of `x`
 /// are zero. `apply(p, out)` writes `A p`; `precond` holds the inverse diagonal blocks.
 pub fn solve(
-    apply: impl Fn(&[Vec3], &mut [Vec3]),
+    mut apply: impl FnMut(&[Vec3], &mut [Vec3]),
     b: &[Vec3],
     precond: &[Matrix3<f64>],
     fixed: &[bool],
@@ -56,59 +65,73 @@ pub fn solve(
     x: &mut [Vec3],
 ) -> SolverStats {
     let n = b.len();
-    let CgScratch { r, z, p, q } = scratch;
+    let par = parallel::worth_it(n);
+    let CgScratch { r, z, p, q, partial } = scratch;
     for v in [&mut *r, &mut *z, &mut *p, &mut *q] {
         v.resize(n, Vec3::zeros());
     }
+    partial.resize(n.div_ceil(parallel::CHUNK), 0.0);
     x.fill(Vec3::zeros());
     for i in 0..n {
         r[i] = if fixed[i] { Vec3::zeros() } else { b[i] };
         z[i] = precond[i] * r[i];
         p[i] = z[i];
     }
-    let b_norm = dot(r, r).sqrt();
+    let b_norm = dot(par, partial, r, r).sqrt();
     if b_norm == 0.0 {
         return SolverStats::default();
     }
-    let mut rz = dot(r, z);
+    let mut rz = dot(par, partial, r, z);
     let mut stats = SolverStats {
         iterations: 0,
         residual: 1.0,
     };
     while stats.iterations < settings.max_iterations {
         apply(p, q);
-        for i in 0..n {
-            if fixed[i] {
-                q[i] = Vec3::zeros();
+        parallel::chunks(par, q, parallel::CHUNK, |first, q| {
+            for (k, qi) in q.iter_mut().enumerate() {
+                if fixed[first + k] {
+                    *qi = Vec3::zeros();
+                }
             }
-        }
-        let pq = dot(p, q);
+        });
+        let pq = dot(par, partial, p, q);
         if pq.is_nan() || pq <= 0.0 {
             break; // not positive definite along p (only on broken input): stop with what we have
         }
         let alpha = rz / pq;
-        for i in 0..n {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * q[i];
-        }
+        let (pp, qq) = (&*p, &*q);
+        parallel::chunks2(par, (x, 1), (r, 1), parallel::CHUNK, |first, x, r| {
+            for k in 0..x.len() {
+                x[k] += alpha * pp[first + k];
+                r[k] -= alpha * qq[first + k];
+            }
+        });
         stats.iterations += 1;
-        stats.residual = dot(r, r).sqrt() / b_norm;
+        stats.residual = dot(par, partial, r, r).sqrt() / b_norm;
         if stats.residual <= settings.tolerance {
             break;
         }
-        for i in 0..n {
-            z[i] = precond[i] * r[i];
-        }
-        let rz_new = dot(r, z);
+        let rr = &*r;
+        parallel::chunks(par, z, parallel::CHUNK, |first, z| {
+            for (k, zi) in z.iter_mut().enumerate() {
+                *zi = precond[first + k] * rr[first + k];
+            }
+        });
+        let rz_new = dot(par, partial, r, z);
         let beta = rz_new / rz;
         rz = rz_new;
-        for i in 0..n {
-            p[i] = if fixed[i] {
-                Vec3::zeros()
-            } else {
-                z[i] + beta * p[i]
-            };
-        }
+        let zz = &*z;
+        parallel::chunks(par, p, parallel::CHUNK, |first, p| {
+            for (k, pi) in p.iter_mut().enumerate() {
+                let i = first + k;
+                *pi = if fixed[i] {
+                    Vec3::zeros()
+                } else {
+                    zz[i] + beta * *pi
+                };
+            }
+        });
     }
     stats
 }

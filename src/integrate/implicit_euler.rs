@@ -13,8 +13,10 @@
 use nalgebra::Matrix3;
 
 use super::cg::{self, CgScratch, SolverSettings, SolverStats};
+use crate::forces::add_spring_values;
 use crate::forces::Linearisation;
-use crate::topology::Spring;
+use crate::parallel;
+use crate::topology::Topology;
 use crate::Vec3;
 
 /// Work memory of the implicit step.
@@ -24,6 +26,9 @@ pub struct ImplicitScratch {
     rhs: Vec<Vec3>,
     dv: Vec<Vec3>,
     precond: Vec<Matrix3<f64>>,
+    /// Per-spring blocks of the system and per-spring vectors of the product.
+    spring_blocks: Vec<Matrix3<f64>>,
+    spring_values: Vec<Vec3>,
     cg: CgScratch,
 }
 
@@ -34,24 +39,42 @@ pub struct ImplicitInput<'a> {
     pub v: &'a [Vec3],
     pub force: &'a [Vec3],
     pub masses: &'a [f64],
-    pub springs: &'a [Spring],
+    pub topology: &'a Topology,
     pub pinned: &'a [bool],
     pub settings: SolverSettings,
 }
 
-fn apply_system(inp: &ImplicitInput<'_>, lin: &Linearisation, p: &[Vec3], out: &mut [Vec3]) {
+/// Writes `out[k] = blocks[k] (p_i - p_j)` for every spring k.
+fn spring_products(par: bool, t: &Topology, blocks: &[Matrix3<f64>], p: &[Vec3], out: &mut [Vec3]) {
+    parallel::chunks(par, out, parallel::CHUNK, |first, chunk| {
+        for (k, o) in chunk.iter_mut().enumerate() {
+            let s = &t.springs[first + k];
+            *o = blocks[first + k] * (p[s.i as usize] - p[s.j as usize]);
+        }
+    });
+}
+
+/// `out = A p` with `A = M + h C + h^2 K`: per-particle blocks, then the springs' blocks
+/// (`S_k (p_i - p_j)` added at i and subtracted at j).
+fn apply_system(
+    inp: &ImplicitInput<'_>,
+    lin: &Linearisation,
+    blocks: &[Matrix3<f64>],
+    values: &mut [Vec3],
+    p: &[Vec3],
+    out: &mut [Vec3],
+) {
     let h = inp.h;
-    for i in 0..p.len() {
-        out[i] = inp.masses[i] * p[i] + h * (lin.damping[i] * p[i]) + h * h * (lin.stiffness[i] * p[i]);
-    }
-    for (k, s) in inp.springs.iter().enumerate() {
-        let (i, j) = (s.i as usize, s.j as usize);
-        let d = p[i] - p[j];
-        let dir = lin.spring_dir[k];
-        let f = h * lin.spring_damping[k] * dir.dot(&d) * dir + h * h * (lin.spring_stiffness[k] * d);
-        out[i] += f;
-        out[j] -= f;
-    }
+    let par = parallel::worth_it(p.len());
+    spring_products(par, inp.topology, blocks, p, values);
+    let values = &*values;
+    parallel::chunks(par, out, parallel::CHUNK, |first, chunk| {
+        for (k, o) in chunk.iter_mut().enumerate() {
+            let i = first + k;
+            *o = inp.masses[i] * p[i] + h * (lin.damping[i] * p[i]) + h * h * (lin.stiffness[i] * p[i]);
+        }
+        add_spring_values(inp.topology, first, values, -1.0, chunk);
+    });
 }
 
 /// Solves for the new velocities of free particles into `v_new` (pinned entries keep `inp.v`).
@@ -62,44 +85,62 @@ pub fn implicit_euler(
 ) -> SolverStats {
     let n = inp.x.len();
     let h = inp.h;
+    let t = inp.topology;
+    let par = parallel::worth_it(n);
     let ImplicitScratch {
         lin,
         rhs,
         dv,
         precond,
+        spring_blocks,
+        spring_values,
         cg,
     } = scratch;
     rhs.resize(n, Vec3::zeros());
     dv.resize(n, Vec3::zeros());
     precond.resize(n, Matrix3::identity());
-    // rhs = h f_n - h^2 K v_n
-    for i in 0..n {
-        rhs[i] = h * inp.force[i] - h * h * (lin.stiffness[i] * inp.v[i]);
-    }
-    for (k, s) in inp.springs.iter().enumerate() {
-        let (i, j) = (s.i as usize, s.j as usize);
-        let f = h * h * (lin.spring_stiffness[k] * (inp.v[i] - inp.v[j]));
-        rhs[i] -= f;
-        rhs[j] += f;
-    }
+    spring_blocks.resize(t.springs.len(), Matrix3::zeros());
+    spring_values.resize(t.springs.len(), Vec3::zeros());
+    // Each spring's block of the system: h c_s dir dir^T + h^2 K_s.
+    parallel::chunks(par, spring_blocks, parallel::CHUNK, |first, chunk| {
+        for (k, b) in chunk.iter_mut().enumerate() {
+            let dir = lin.spring_dir[first + k];
+            *b = h * lin.spring_damping[first + k] * dir * dir.transpose()
+                + h * h * lin.spring_stiffness[first + k];
+        }
+    });
+    // rhs = h f_n - h^2 K v_n (the springs' K acting on v_i - v_j).
+    parallel::chunks(par, spring_values, parallel::CHUNK, |first, chunk| {
+        for (k, o) in chunk.iter_mut().enumerate() {
+            let s = &t.springs[first + k];
+            *o = -(h * h) * (lin.spring_stiffness[first + k] * (inp.v[s.i as usize] - inp.v[s.j as usize]));
+        }
+    });
+    let values = &*spring_values;
+    parallel::chunks(par, rhs, parallel::CHUNK, |first, chunk| {
+        for (k, r) in chunk.iter_mut().enumerate() {
+            let i = first + k;
+            *r = h * inp.force[i] - h * h * (lin.stiffness[i] * inp.v[i]);
+        }
+        add_spring_values(t, first, values, -1.0, chunk);
+    });
     // Block-Jacobi preconditioner: inverse of each 3x3 diagonal block of the system.
-    for i in 0..n {
-        precond[i] = inp.masses[i] * Matrix3::identity() + h * lin.damping[i] + h * h * lin.stiffness[i];
-    }
-    for (k, s) in inp.springs.iter().enumerate() {
-        let dir = lin.spring_dir[k];
-        let b = h * lin.spring_damping[k] * dir * dir.transpose() + h * h * lin.spring_stiffness[k];
-        precond[s.i as usize] += b;
-        precond[s.j as usize] += b;
-    }
-    for (i, m) in precond.iter_mut().enumerate() {
-        *m = m
-            .try_inverse()
-            .unwrap_or_else(|| Matrix3::identity() / inp.masses[i]);
-    }
+    let blocks = &*spring_blocks;
+    parallel::chunks(par, precond, parallel::CHUNK, |first, chunk| {
+        for (k, m) in chunk.iter_mut().enumerate() {
+            let i = first + k;
+            *m = inp.masses[i] * Matrix3::identity() + h * lin.damping[i] + h * h * lin.stiffness[i];
+        }
+        add_spring_values(t, first, blocks, 1.0, chunk);
+        for (k, m) in chunk.iter_mut().enumerate() {
+            *m = m
+                .try_inverse()
+                .unwrap_or_else(|| Matrix3::identity() / inp.masses[first + k]);
+        }
+    });
     let lin_ref: &Linearisation = lin;
     let stats = cg::solve(
-        |p, out| apply_system(inp, lin_ref, p, out),
+        |p, out| apply_system(inp, lin_ref, blocks, spring_values, p, out),
         rhs,
         precond,
         inp.pinned,

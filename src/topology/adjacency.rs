@@ -16,7 +16,7 @@ pub struct Adjacency {
 impl Adjacency {
     /// Builds rows for `n` vertices from `(vertex, entry)` pairs given in ascending entry
     /// order; each row keeps that order.
-    fn from_pairs(n: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> Self {
+    pub(super) fn from_pairs(n: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> Self {
         let mut offsets = vec![0u32; n + 1];
         for (p, _) in pairs.clone() {
             offsets[p as usize + 1] += 1;
@@ -50,6 +50,30 @@ impl Adjacency {
             .enumerate()
             .flat_map(|(t, tri)| tri.map(|v| (v, t as u32)));
         Self::from_pairs(n, pairs)
+    }
+
+    /// Runs touching each chunk of [`crate::parallel::CHUNK`] vertices (as the `i` end or as
+    /// the `j` end), in ascending run order.
+    pub fn chunk_runs(n: usize, runs: &[super::SpringRun]) -> Self {
+        let chunk = crate::parallel::CHUNK;
+        let pairs = runs.iter().enumerate().flat_map(move |(r, run)| {
+            let i0 = run.first_vertex as usize;
+            let j0 = i0 + run.offset as usize;
+            let len = run.len as usize;
+            let i_chunks = i0 / chunk..=(i0 + len - 1) / chunk;
+            let j_chunks = j0 / chunk..=(j0 + len - 1) / chunk;
+            // Both ranges, each chunk once, ascending.
+            let (lo, hi) = (*i_chunks.start(), *j_chunks.end());
+            (lo..=hi)
+                .filter(move |c| i_chunks.contains(c) || j_chunks.contains(c))
+                .map(move |c| (c as u32, r as u32))
+        });
+        Self::from_pairs(n.div_ceil(chunk), pairs)
+    }
+
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.offsets.len() - 1
     }
 
     /// Entries of vertex `p`.

@@ -39,6 +39,8 @@ pub struct Topology {
     pub vertex_springs: Adjacency,
     /// Triangles touching each vertex.
     pub vertex_triangles: Adjacency,
+    /// Spring runs touching each chunk of vertices (see [`Adjacency::chunk_runs`]).
+    pub chunk_runs: Adjacency,
 }
 
 impl Topology {
@@ -55,10 +57,11 @@ impl Topology {
         let n = rest_positions.len();
         let spring_runs = runs::order_into_runs(&mut springs);
         Self {
-            spring_runs,
             spring_rest: springs.iter().map(|s| s.rest).collect(),
             spring_kinds: springs.iter().map(|s| s.kind as u8).collect(),
             vertex_springs: Adjacency::springs(n, &springs),
+            chunk_runs: Adjacency::chunk_runs(n, &spring_runs),
+            spring_runs,
             vertex_triangles: Adjacency::triangles(n, &triangles),
             rest_positions,
             masses,
@@ -71,5 +74,11 @@ impl Topology {
     /// Number of particles.
     pub fn vertex_count(&self) -> usize {
         self.rest_positions.len()
+    }
+
+    /// Whether the springs form runs long enough (8 springs on average) that the force pass
+    /// adds them run by run rather than gathering them vertex by vertex.
+    pub fn long_runs(&self) -> bool {
+        self.springs.len() >= 8 * self.spring_runs.len()
     }
 }
