@@ -49,6 +49,10 @@ typedef enum {
    * The library hit an internal error (a Rust panic was caught); the handle is unchanged where the failure allowed it.
    */
   FC_ERROR_PANIC = 5,
+  /**
+   * A file could not be created, written or completed (cache writers); the message has the operating system's reason.
+   */
+  FC_ERROR_IO = 6,
 } FcStatus;
 
 /**
@@ -130,6 +134,11 @@ typedef enum {
    */
   FC_PRESET_REGULAR_NORMAL = 3,
 } FcPreset;
+
+/**
+ * An open cache file. Create with `fc_cache_open`, free with `fc_cache_close`.
+ */
+typedef struct FcCache FcCache;
 
 /**
  * Opaque handle to one simulated cloth. Create with `fc_cloth_create_grid`,
@@ -284,6 +293,60 @@ const char *fc_last_error_message(void);
 const char *fc_status_string(int32_t status);
 
 /**
+ * Opens a cache file at `path` (UTF-8) for the vertices of `cloth` and writes its header.
+ * `start_frame`: the host frame of the first sample; `frames_per_second` (> 0): the frame
+ * rate (MDD stores times in seconds); `expected_frames`: how many frames will be written
+ * (MDD only; ignored otherwise). Write frames with `fc_cache_write_frame`; finish with
+ * `fc_cache_close`. Errors: `FC_ERROR_IO` if the file cannot be created,
+ * `FC_ERROR_INVALID_ARGUMENT` for a bad format or rate.
+ *
+ * # Safety
+ * `path` NULL or a NUL-terminated string; `cloth` NULL or live; `out_cache` NULL or writable.
+ */
+FcStatus fc_cache_open(const char *path,
+                       uint32_t format,
+                       const FcCloth *cloth,
+                       double start_frame,
+                       double frames_per_second,
+                       uint32_t expected_frames,
+                       FcCache **out_cache);
+
+/**
+ * Appends the current positions of `cloth` (which must have the vertex count the cache was
+ * opened for) as the next frame.
+ *
+ * # Safety
+ * `cache` NULL or live (not closed); `cloth` NULL or live.
+ */
+FcStatus fc_cache_write_frame(FcCache *cache, const FcCloth *cloth);
+
+/**
+ * Completes the cache file (patches its frame count) and frees the handle, also when
+ * completing fails (the status then says why). NULL is fine.
+ *
+ * # Safety
+ * `cache` NULL or a live handle from `fc_cache_open`; not used afterwards.
+ */
+FcStatus fc_cache_close(FcCache *cache);
+
+/**
+ * Writes the current positions of `cloth` as one OBJ mesh (vertices and triangles) at
+ * `path` (UTF-8). Errors: `FC_ERROR_IO` when the file cannot be written.
+ *
+ * # Safety
+ * `cloth` NULL or live; `path` NULL or a NUL-terminated string.
+ */
+FcStatus fc_cloth_write_obj(const FcCloth *cloth, const char *path);
+
+/**
+ * Number of triangles of `cloth` (quads count as two); 0 for NULL.
+ *
+ * # Safety
+ * `cloth` NULL or live.
+ */
+size_t fc_cloth_triangle_count(const FcCloth *cloth);
+
+/**
  * Creates a grid cloth at rest from `*desc` and writes the handle to `*out_cloth`
  * (only on success). Bad fields give `FC_ERROR_INVALID_ARGUMENT` and a message naming them.
  *
@@ -324,6 +387,26 @@ double fc_cloth_time(const FcCloth *cloth);
  * `cloth` NULL or live; `indices` NULL or `count` readable values.
  */
 FcStatus fc_cloth_set_pinned(FcCloth *cloth, const uint32_t *indices, size_t count);
+
+/**
+ * Sets the pin weight of every vertex: `weights[0..count]`, `count` = vertex_count, each in
+ * [0, 1] (0 = free, 1 = fully pinned). A vertex of weight w in (0, 1) is a soft pin: at the
+ * end of every step it is pulled the fraction w of the way onto its target (and its velocity
+ * onto the target's). Replaces the pinned set; new pins hold their current positions.
+ *
+ * # Safety
+ * `cloth` NULL or live; `weights` NULL or `count` readable floats.
+ */
+FcStatus fc_cloth_set_pin_weights(FcCloth *cloth, const float *weights, size_t count);
+
+/**
+ * Pins a vertex group in one call: sets the pin weight of `indices[0..count]` to `weight`
+ * (in [0, 1]; 0 frees them), leaving every other vertex as it is.
+ *
+ * # Safety
+ * `cloth` NULL or live; `indices` NULL or `count` readable values.
+ */
+FcStatus fc_cloth_pin_group(FcCloth *cloth, const uint32_t *indices, size_t count, float weight);
 
 /**
  * Moves pinned vertices: after the next step, vertex `indices[k]` sits exactly at
@@ -456,6 +539,70 @@ FcStatus fc_cloth_set_sphere(FcCloth *cloth,
                              const float *velocity);
 
 /**
+ * Adds an infinite plane through `point` (3 floats, m) with normal `normal` (3 floats, any
+ * non-zero length; the cloth is kept on the side it points to), moving at `velocity` (m/s,
+ * NULL for resting); writes its id to `*out_id` (only on success).
+ *
+ * # Safety
+ * `cloth` NULL or live; `point`, `normal` 3 readable floats; `velocity` NULL or 3 readable floats; `out_id` NULL or writable.
+ */
+FcStatus fc_cloth_add_plane(FcCloth *cloth,
+                            const float *point,
+                            const float *normal,
+                            const float *velocity,
+                            uint32_t *out_id);
+
+/**
+ * Moves or turns plane `id` (same units as `fc_cloth_add_plane`); any collider id may be
+ * given a new shape this way.
+ *
+ * # Safety
+ * As `fc_cloth_add_plane`.
+ */
+FcStatus fc_cloth_set_plane(FcCloth *cloth,
+                            uint32_t id,
+                            const float *point,
+                            const float *normal,
+                            const float *velocity);
+
+/**
+ * Adds a capsule: the points within `radius` (m, > 0) of the segment from `a` to `b` (3
+ * floats each, m), moving at `velocity` (m/s, NULL for resting); writes its id to `*out_id`.
+ *
+ * # Safety
+ * `cloth` NULL or live; `a`, `b` 3 readable floats; `velocity` NULL or 3 readable floats; `out_id` NULL or writable.
+ */
+FcStatus fc_cloth_add_capsule(FcCloth *cloth,
+                              const float *a,
+                              const float *b,
+                              float radius,
+                              const float *velocity,
+                              uint32_t *out_id);
+
+/**
+ * Moves or resizes capsule `id` (same units as `fc_cloth_add_capsule`).
+ *
+ * # Safety
+ * As `fc_cloth_add_capsule`.
+ */
+FcStatus fc_cloth_set_capsule(FcCloth *cloth,
+                              uint32_t id,
+                              const float *a,
+                              const float *b,
+                              float radius,
+                              const float *velocity);
+
+/**
+ * Sets the Coulomb friction coefficient (>= 0; default 0) of collider `id`. Friction acts
+ * as a velocity correction after each step: a particle in contact loses up to `friction`
+ * times the normal velocity change of its tangential velocity relative to the collider.
+ *
+ * # Safety
+ * `cloth` NULL or live.
+ */
+FcStatus fc_cloth_set_collider_friction(FcCloth *cloth, uint32_t id, float friction);
+
+/**
  * Removes collider `id` (`FC_ERROR_OUT_OF_RANGE` if there is none); the id may be reused.
  *
  * # Safety
@@ -487,6 +634,35 @@ FcClothDesc fc_cloth_desc_default(void);
  * `out_desc` must be NULL or point to writable memory for one `FcClothDesc`.
  */
 FcStatus fc_cloth_desc_preset(uint32_t preset, FcClothDesc *out_desc);
+
+/**
+ * Creates a cloth from a mesh at rest: `vertex_count` positions (xyz floats, m) and
+ * `index_count` corner indices, `face_size` (3: triangles, 4: quads with corners in order
+ * around the face) per face. Writes the handle to `*out_cloth` only on success.
+ *
+ * Springs: stretch on every edge, shear on both diagonals of each quad, bend across every
+ * interior edge. Masses are lumped from face areas: `desc->total_mass` spread over the
+ * area, or `desc->areal_density` (kg/m^2) when `total_mass` <= 0. The grid fields of `desc`
+ * (`width`, `height`, `spacing`) are ignored. Drag coefficients act per particle, as for
+ * grids: scale them by (vertex spacing / 1 cm)^2 for meshes much finer or coarser than 1 cm.
+ *
+ * Errors (the message names the face, edge or vertex): `FC_ERROR_OUT_OF_RANGE` for an index
+ * not below vertex_count; `FC_ERROR_INVALID_ARGUMENT` for an index count that is not a positive
+ * multiple of `face_size`, `face_size` other than 3 or 4, a face repeating a vertex or of
+ * (near) zero area, an edge shared by more than two faces (non-manifold), a vertex used by
+ * no face, a non-finite position, or a bad description field.
+ *
+ * # Safety
+ * `desc` NULL or an initialised description; `positions` NULL or `3 * vertex_count` readable
+ * floats; `indices` NULL or `index_count` readable values; `out_cloth` NULL or writable.
+ */
+FcStatus fc_cloth_create_mesh(const FcClothDesc *desc,
+                              const float *positions,
+                              size_t vertex_count,
+                              const uint32_t *indices,
+                              size_t index_count,
+                              uint32_t face_size,
+                              FcCloth **out_cloth);
 
 /**
  * `major * 1000000 + minor * 1000 + patch`; equals `FC_VERSION` of the header the host compiled against.

@@ -6,8 +6,8 @@
 //! than [`ClothConfig::max_speed`] (an underwater cloth never moves at 100 m/s; a
 //! state that does has exploded).
 
-use crate::error::{check_finite_vec, check_positive, Error};
-use crate::forces::{self, Collider, ForceInput, ForceScratch, Sphere};
+use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
+use crate::forces::{self, Collider, ForceInput, ForceScratch, Plane, Sphere};
 use crate::history::{HalfDerivative, History, Scheme};
 use crate::integrate::{
     explicit_euler, implicit_euler, symplectic_euler, ImplicitInput, ImplicitScratch, Integrator,
@@ -123,11 +123,17 @@ pub struct Cloth {
     config: ClothConfig,
     x: Vec<Vec3>,
     v: Vec<Vec3>,
+    /// Fully pinned (weight 1): the solver treats these as prescribed.
     pinned: Vec<bool>,
+    /// Pin weight of every vertex in [0, 1]; 0 = free.
+    pin_weight: Vec<f64>,
+    /// Vertices with a weight > 0, in the order they were pinned.
     pin_list: Vec<u32>,
     pin_target: Vec<Vec3>,
-    collider_slots: Vec<Option<Collider>>,
+    /// Colliders by id, each with its friction coefficient.
+    collider_slots: Vec<Option<(Collider, f64)>>,
     colliders: Vec<Collider>,
+    friction: Vec<f64>,
     history: History,
     time: f64,
     steps: u64,
@@ -159,11 +165,13 @@ impl Cloth {
         Ok(Self {
             v: vec![Vec3::zeros(); n],
             pinned: vec![false; n],
+            pin_weight: vec![0.0; n],
             pin_list: Vec::new(),
             pin_target: x.clone(),
             x,
             collider_slots: Vec::new(),
             colliders: Vec::new(),
+            friction: Vec::new(),
             history: History::new(scheme, n)?,
             time: 0.0,
             steps: 0,
@@ -223,21 +231,78 @@ impl Cloth {
         }
     }
 
-    /// Replaces the pinned set. Pins hold their current positions until moved.
+    /// Replaces the pinned set: the listed vertices are fully pinned (weight 1), every other
+    /// vertex is free. Pins hold their current positions until moved.
     pub fn set_pinned(&mut self, indices: &[u32]) -> Result<(), Error> {
         for &i in indices {
             self.check_index(i)?;
         }
-        self.pinned.fill(false);
-        self.pin_list.clear();
+        self.clear_pins();
         for &i in indices {
-            if !self.pinned[i as usize] {
-                self.pinned[i as usize] = true;
-                self.pin_list.push(i);
-                self.pin_target[i as usize] = self.x[i as usize];
-            }
+            self.pin(i as usize, 1.0);
         }
         Ok(())
+    }
+
+    /// Replaces every vertex's pin weight (one per vertex, each in [0, 1]; 0 = free,
+    /// 1 = fully pinned). A vertex of weight w in (0, 1) is pulled the fraction w of the way
+    /// onto its target (and its velocity the fraction w onto the target's) at the end of
+    /// every step: a soft pin, as a DCC's pin weight or goal strength.
+    pub fn set_pin_weights(&mut self, weights: &[f64]) -> Result<(), Error> {
+        if weights.len() != self.vertex_count() {
+            return Err(Error::invalid(format!(
+                "expected {} pin weights, got {}",
+                self.vertex_count(),
+                weights.len()
+            )));
+        }
+        for (i, &w) in weights.iter().enumerate() {
+            check_weight(i, w)?;
+        }
+        self.clear_pins();
+        for (i, &w) in weights.iter().enumerate() {
+            self.pin(i, w);
+        }
+        Ok(())
+    }
+
+    /// Sets the pin weight of a group of vertices (e.g. a DCC vertex group) to `weight` in
+    /// [0, 1], leaving every other vertex as it is; 0 frees them.
+    pub fn pin_group(&mut self, indices: &[u32], weight: f64) -> Result<(), Error> {
+        for &i in indices {
+            check_weight(self.check_index(i)?, weight)?;
+        }
+        for &i in indices {
+            let i = i as usize;
+            if self.pin_weight[i] > 0.0 {
+                self.pin_weight[i] = 0.0;
+                self.pinned[i] = false;
+                self.pin_list.retain(|&p| p as usize != i);
+            }
+            self.pin(i, weight);
+        }
+        Ok(())
+    }
+
+    /// Pin weight of every vertex.
+    pub fn pin_weights(&self) -> &[f64] {
+        &self.pin_weight
+    }
+
+    fn clear_pins(&mut self) {
+        self.pinned.fill(false);
+        self.pin_weight.fill(0.0);
+        self.pin_list.clear();
+    }
+
+    /// Pins free vertex `i` with weight `w` (nothing for w = 0) at its current position.
+    fn pin(&mut self, i: usize, w: f64) {
+        if w > 0.0 && self.pin_weight[i] == 0.0 {
+            self.pin_weight[i] = w;
+            self.pinned[i] = w == 1.0;
+            self.pin_list.push(i as u32);
+            self.pin_target[i] = self.x[i];
+        }
     }
 
     /// Moves pinned vertices: at the end of the next step vertex `indices[k]` sits at
@@ -252,7 +317,7 @@ impl Cloth {
         }
         for (&i, t) in indices.iter().zip(targets) {
             let i = self.check_index(i)?;
-            if !self.pinned[i] {
+            if self.pin_weight[i] == 0.0 {
                 return Err(Error::invalid(format!("vertex {i} is not pinned")));
             }
             check_finite_vec("pin target", t)?;
@@ -301,14 +366,24 @@ impl Cloth {
 
     /// Adds a sphere collider and returns its id.
     pub fn add_sphere(&mut self, sphere: Sphere) -> Result<u32, Error> {
-        check_sphere(&sphere)?;
+        self.add_collider(Collider::Sphere(sphere))
+    }
+
+    /// Moves or resizes sphere `id`.
+    pub fn set_sphere(&mut self, id: u32, sphere: Sphere) -> Result<(), Error> {
+        self.set_collider(id, Collider::Sphere(sphere))
+    }
+
+    /// Adds any collider (friction 0) and returns its id, the smallest free one.
+    pub fn add_collider(&mut self, collider: Collider) -> Result<u32, Error> {
+        let collider = checked_collider(collider)?;
         let id = match self.collider_slots.iter().position(Option::is_none) {
             Some(free) => {
-                self.collider_slots[free] = Some(Collider::Sphere(sphere));
+                self.collider_slots[free] = Some((collider, 0.0));
                 free
             }
             None => {
-                self.collider_slots.push(Some(Collider::Sphere(sphere)));
+                self.collider_slots.push(Some((collider, 0.0)));
                 self.collider_slots.len() - 1
             }
         };
@@ -316,11 +391,22 @@ impl Cloth {
         Ok(id as u32)
     }
 
-    /// Moves or resizes sphere `id`.
-    pub fn set_sphere(&mut self, id: u32, sphere: Sphere) -> Result<(), Error> {
-        check_sphere(&sphere)?;
+    /// Replaces collider `id` (its shape may change; its friction is kept).
+    pub fn set_collider(&mut self, id: u32, collider: Collider) -> Result<(), Error> {
+        let collider = checked_collider(collider)?;
         let slot = self.collider_slot(id)?;
-        *slot = Some(Collider::Sphere(sphere));
+        let friction = slot.map_or(0.0, |s| s.1);
+        *slot = Some((collider, friction));
+        self.rebuild_colliders();
+        Ok(())
+    }
+
+    /// Sets the Coulomb friction coefficient (>= 0) of collider `id`.
+    pub fn set_collider_friction(&mut self, id: u32, friction: f64) -> Result<(), Error> {
+        check_non_negative("friction", friction)?;
+        if let Some((_, f)) = self.collider_slot(id)? {
+            *f = friction;
+        }
         self.rebuild_colliders();
         Ok(())
     }
@@ -339,10 +425,21 @@ impl Cloth {
 
     /// The collider with id `id`.
     pub fn collider(&self, id: u32) -> Option<&Collider> {
-        self.collider_slots.get(id as usize).and_then(Option::as_ref)
+        self.collider_slots
+            .get(id as usize)
+            .and_then(Option::as_ref)
+            .map(|s| &s.0)
     }
 
-    fn collider_slot(&mut self, id: u32) -> Result<&mut Option<Collider>, Error> {
+    /// Friction coefficient of collider `id`.
+    pub fn collider_friction(&self, id: u32) -> Option<f64> {
+        self.collider_slots
+            .get(id as usize)
+            .and_then(Option::as_ref)
+            .map(|s| s.1)
+    }
+
+    fn collider_slot(&mut self, id: u32) -> Result<&mut Option<(Collider, f64)>, Error> {
         match self.collider_slots.get_mut(id as usize) {
             Some(slot @ Some(_)) => Ok(slot),
             _ => Err(Error::out_of_range(format!("no collider with id {id}"))),
@@ -351,8 +448,11 @@ impl Cloth {
 
     fn rebuild_colliders(&mut self) {
         self.colliders.clear();
-        self.colliders
-            .extend(self.collider_slots.iter().flatten().copied());
+        self.friction.clear();
+        for (c, f) in self.collider_slots.iter().flatten() {
+            self.colliders.push(*c);
+            self.friction.push(*f);
+        }
     }
 
     /// Advances by `dt` seconds with the configured integrator, split into
@@ -442,7 +542,9 @@ impl Cloth {
                 Some(f) => s.pin_start[k] + f * (self.pin_target[i] - s.pin_start[k]),
                 None => self.pin_target[i],
             };
-            s.v_step[i] = (s.goal[i] - self.x[i]) / h;
+            if self.pinned[i] {
+                s.v_step[i] = (s.goal[i] - self.x[i]) / h;
+            }
         }
         // D^{1/2}x_n = w0 v_n + H_n, of the velocity relative to the water.
         let par = parallel::worth_it(n);
@@ -513,10 +615,29 @@ impl Cloth {
                 }
             }
         }
+        forces::apply_friction(
+            &self.config.model,
+            &self.colliders,
+            &self.friction,
+            h,
+            &self.x,
+            masses,
+            &self.pinned,
+            &mut s.v_new,
+        );
         for &i in &self.pin_list {
             let i = i as usize;
-            s.x_new[i] = s.goal[i];
-            s.v_new[i] = s.v_step[i];
+            let w = self.pin_weight[i];
+            if self.pinned[i] {
+                s.x_new[i] = s.goal[i];
+                s.v_new[i] = s.v_step[i];
+            } else {
+                // Soft pin: the fraction w of the way onto the target and its velocity.
+                let v_goal = (s.goal[i] - self.x[i]) / h;
+                let (x_free, v_free) = (s.x_new[i], s.v_new[i]);
+                s.x_new[i] = x_free + w * (s.goal[i] - x_free);
+                s.v_new[i] = v_free + w * (v_goal - v_free);
+            }
         }
         self.check_sound(h)?;
         let s = &mut self.scratch;
@@ -564,8 +685,44 @@ impl Cloth {
     }
 }
 
-fn check_sphere(s: &Sphere) -> Result<(), Error> {
-    check_finite_vec("sphere center", &s.center)?;
-    check_finite_vec("sphere velocity", &s.velocity)?;
-    check_positive("sphere radius", s.radius)
+fn check_weight(i: usize, w: f64) -> Result<(), Error> {
+    if (0.0..=1.0).contains(&w) {
+        Ok(())
+    } else {
+        Err(Error::invalid(format!(
+            "pin weight of vertex {i} must be in [0, 1], got {w}"
+        )))
+    }
+}
+
+/// Checks a collider's numbers; a plane's normal is normalised.
+fn checked_collider(c: Collider) -> Result<Collider, Error> {
+    Ok(match c {
+        Collider::Sphere(s) => {
+            check_finite_vec("sphere center", &s.center)?;
+            check_finite_vec("sphere velocity", &s.velocity)?;
+            check_positive("sphere radius", s.radius)?;
+            c
+        }
+        Collider::Plane(p) => {
+            check_finite_vec("plane point", &p.point)?;
+            check_finite_vec("plane velocity", &p.velocity)?;
+            check_finite_vec("plane normal", &p.normal)?;
+            let len = p.normal.norm();
+            if !(len > 0.0 && len.is_finite()) {
+                return Err(Error::invalid("plane normal must not be zero"));
+            }
+            Collider::Plane(Plane {
+                normal: p.normal / len,
+                ..p
+            })
+        }
+        Collider::Capsule(k) => {
+            check_finite_vec("capsule end a", &k.a)?;
+            check_finite_vec("capsule end b", &k.b)?;
+            check_finite_vec("capsule velocity", &k.velocity)?;
+            check_positive("capsule radius", k.radius)?;
+            c
+        }
+    })
 }

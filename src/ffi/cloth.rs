@@ -151,6 +151,48 @@ pub unsafe extern "C" fn fc_cloth_set_pinned(
     })
 }
 
+/// Sets the pin weight of every vertex: `weights[0..count]`, `count` = vertex_count, each in
+/// [0, 1] (0 = free, 1 = fully pinned). A vertex of weight w in (0, 1) is a soft pin: at the
+/// end of every step it is pulled the fraction w of the way onto its target (and its velocity
+/// onto the target's). Replaces the pinned set; new pins hold their current positions.
+///
+/// # Safety
+/// `cloth` NULL or live; `weights` NULL or `count` readable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_pin_weights(
+    cloth: *mut FcCloth,
+    weights: *const f32,
+    count: usize,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        let weights = unsafe { slice_in(weights, count, "weights") }?;
+        let w: Vec<f64> = weights.iter().map(|&w| f64::from(w)).collect();
+        Ok(cloth.set_pin_weights(&w)?)
+    })
+}
+
+/// Pins a vertex group in one call: sets the pin weight of `indices[0..count]` to `weight`
+/// (in [0, 1]; 0 frees them), leaving every other vertex as it is.
+///
+/// # Safety
+/// `cloth` NULL or live; `indices` NULL or `count` readable values.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_pin_group(
+    cloth: *mut FcCloth,
+    indices: *const u32,
+    count: usize,
+    weight: f32,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        let indices = unsafe { slice_in(indices, count, "indices") }?;
+        Ok(cloth.pin_group(indices, f64::from(weight))?)
+    })
+}
+
 /// Moves pinned vertices: after the next step, vertex `indices[k]` sits exactly at
 /// `(xyz[3k], xyz[3k+1], xyz[3k+2])` (m). Every index must be pinned; the pin
 /// travels in a straight line over the step, which is its velocity.

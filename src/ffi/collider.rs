@@ -1,23 +1,92 @@
 //! Colliders, addressed by small integer ids.
 
-use crate::forces::{Collider, Sphere};
+use crate::forces::{Capsule, Collider, Plane, Sphere};
 use crate::Vec3;
 
 use super::cloth::{handle, handle_mut, slice_in, triples};
 use super::status::{guard, FcStatus, FfiError};
 
+/// Three floats at `p` as a vector (NULL is an error).
+unsafe fn vec_in(p: *const f32, what: &str) -> Result<Vec3, FfiError> {
+    if p.is_null() {
+        return Err(FfiError::null(what));
+    }
+    // SAFETY: non-NULL; the caller promises 3 readable floats.
+    Ok(triples(unsafe { slice_in(p, 3, what) }?, what)?[0])
+}
+
+/// A velocity: three floats, or zero for NULL.
+unsafe fn velocity_in(p: *const f32) -> Result<Vec3, FfiError> {
+    if p.is_null() {
+        Ok(Vec3::zeros())
+    } else {
+        // SAFETY: forwarded caller promise.
+        unsafe { vec_in(p, "velocity") }
+    }
+}
+
 unsafe fn sphere_from(center: *const f32, radius: f32, velocity: *const f32) -> Result<Sphere, FfiError> {
     // SAFETY: forwarded caller promises.
-    let c = triples(unsafe { slice_in(center, 3, "center") }?, "center")?;
-    let v = if velocity.is_null() {
-        Vec3::zeros()
-    } else {
-        triples(unsafe { slice_in(velocity, 3, "velocity") }?, "velocity")?[0]
-    };
     Ok(Sphere {
-        center: c[0],
+        center: unsafe { vec_in(center, "center") }?,
         radius: f64::from(radius),
-        velocity: v,
+        velocity: unsafe { velocity_in(velocity) }?,
+    })
+}
+
+unsafe fn plane_from(
+    point: *const f32,
+    normal: *const f32,
+    velocity: *const f32,
+) -> Result<Collider, FfiError> {
+    // SAFETY: forwarded caller promises.
+    Ok(Collider::Plane(Plane {
+        point: unsafe { vec_in(point, "point") }?,
+        normal: unsafe { vec_in(normal, "normal") }?,
+        velocity: unsafe { velocity_in(velocity) }?,
+    }))
+}
+
+unsafe fn capsule_from(
+    a: *const f32,
+    b: *const f32,
+    radius: f32,
+    velocity: *const f32,
+) -> Result<Collider, FfiError> {
+    // SAFETY: forwarded caller promises.
+    Ok(Collider::Capsule(Capsule {
+        a: unsafe { vec_in(a, "a") }?,
+        b: unsafe { vec_in(b, "b") }?,
+        radius: f64::from(radius),
+        velocity: unsafe { velocity_in(velocity) }?,
+    }))
+}
+
+/// Adds `collider` and writes its id to `*out_id`.
+unsafe fn add(
+    cloth: *mut FcCloth,
+    out_id: *mut u32,
+    make: impl FnOnce() -> Result<Collider, FfiError>,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        if out_id.is_null() {
+            return Err(FfiError::null("out_id"));
+        }
+        let id = cloth.add_collider(make()?)?;
+        // SAFETY: checked non-NULL; the caller promises it is writable.
+        unsafe { *out_id = id };
+        Ok(())
+    })
+}
+
+/// Replaces collider `id` by `collider`.
+unsafe fn set(cloth: *mut FcCloth, id: u32, make: impl FnOnce() -> Result<Collider, FfiError>) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        Ok(cloth.set_collider(id, make()?)?)
     })
 }
 
@@ -34,18 +103,12 @@ pub unsafe extern "C" fn fc_cloth_add_sphere(
     velocity: *const f32,
     out_id: *mut u32,
 ) -> FcStatus {
-    guard(|| {
-        // SAFETY: forwarded caller promises.
-        let cloth = unsafe { handle_mut(cloth) }?;
-        if out_id.is_null() {
-            return Err(FfiError::null("out_id"));
-        }
-        let sphere = unsafe { sphere_from(center, radius, velocity) }?;
-        let id = cloth.add_sphere(sphere)?;
-        // SAFETY: checked non-NULL; the caller promises it is writable.
-        unsafe { *out_id = id };
-        Ok(())
-    })
+    // SAFETY: forwarded caller promises.
+    unsafe {
+        add(cloth, out_id, || {
+            Ok(Collider::Sphere(sphere_from(center, radius, velocity)?))
+        })
+    }
 }
 
 /// Moves, resizes or re-speeds sphere `id` (same units as `fc_cloth_add_sphere`).
@@ -60,11 +123,100 @@ pub unsafe extern "C" fn fc_cloth_set_sphere(
     radius: f32,
     velocity: *const f32,
 ) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe {
+        set(cloth, id, || {
+            Ok(Collider::Sphere(sphere_from(center, radius, velocity)?))
+        })
+    }
+}
+
+/// Adds an infinite plane through `point` (3 floats, m) with normal `normal` (3 floats, any
+/// non-zero length; the cloth is kept on the side it points to), moving at `velocity` (m/s,
+/// NULL for resting); writes its id to `*out_id` (only on success).
+///
+/// # Safety
+/// `cloth` NULL or live; `point`, `normal` 3 readable floats; `velocity` NULL or 3 readable floats; `out_id` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_add_plane(
+    cloth: *mut FcCloth,
+    point: *const f32,
+    normal: *const f32,
+    velocity: *const f32,
+    out_id: *mut u32,
+) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { add(cloth, out_id, || plane_from(point, normal, velocity)) }
+}
+
+/// Moves or turns plane `id` (same units as `fc_cloth_add_plane`); any collider id may be
+/// given a new shape this way.
+///
+/// # Safety
+/// As `fc_cloth_add_plane`.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_plane(
+    cloth: *mut FcCloth,
+    id: u32,
+    point: *const f32,
+    normal: *const f32,
+    velocity: *const f32,
+) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { set(cloth, id, || plane_from(point, normal, velocity)) }
+}
+
+/// Adds a capsule: the points within `radius` (m, > 0) of the segment from `a` to `b` (3
+/// floats each, m), moving at `velocity` (m/s, NULL for resting); writes its id to `*out_id`.
+///
+/// # Safety
+/// `cloth` NULL or live; `a`, `b` 3 readable floats; `velocity` NULL or 3 readable floats; `out_id` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_add_capsule(
+    cloth: *mut FcCloth,
+    a: *const f32,
+    b: *const f32,
+    radius: f32,
+    velocity: *const f32,
+    out_id: *mut u32,
+) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { add(cloth, out_id, || capsule_from(a, b, radius, velocity)) }
+}
+
+/// Moves or resizes capsule `id` (same units as `fc_cloth_add_capsule`).
+///
+/// # Safety
+/// As `fc_cloth_add_capsule`.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_capsule(
+    cloth: *mut FcCloth,
+    id: u32,
+    a: *const f32,
+    b: *const f32,
+    radius: f32,
+    velocity: *const f32,
+) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { set(cloth, id, || capsule_from(a, b, radius, velocity)) }
+}
+
+/// Sets the Coulomb friction coefficient (>= 0; default 0) of collider `id`. Friction acts
+/// as a velocity correction after each step: a particle in contact loses up to `friction`
+/// times the normal velocity change of its tangential velocity relative to the collider.
+///
+/// # Safety
+/// `cloth` NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_collider_friction(
+    cloth: *mut FcCloth,
+    id: u32,
+    friction: f32,
+) -> FcStatus {
     guard(|| {
-        // SAFETY: forwarded caller promises.
+        // SAFETY: forwarded caller promise.
         let cloth = unsafe { handle_mut(cloth) }?;
-        let sphere = unsafe { sphere_from(center, radius, velocity) }?;
-        Ok(cloth.set_sphere(id, sphere)?)
+        Ok(cloth.set_collider_friction(id, f64::from(friction))?)
     })
 }
 

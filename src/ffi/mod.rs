@@ -2,7 +2,8 @@
 //!
 //! One file per header area: [`status`] (status codes, last error, the panic
 //! boundary), [`desc`] (the description struct and its defaults), [`cloth`]
-//! (lifetime, pins, positions, stepping), [`collider`] (colliders), [`version`].
+//! (lifetime, pins, positions, stepping), [`mesh`] (cloths from meshes), [`collider`]
+//! (colliders), [`cache`] (PC2 / MDD / OBJ writers), [`version`].
 //!
 //! Rules every export follows:
 //! - it runs inside a panic boundary; a panic becomes `FC_ERROR_PANIC`;
@@ -15,13 +16,17 @@
 
 #[macro_use]
 pub mod status;
+pub mod cache;
 pub mod cloth;
 pub mod collider;
 pub mod desc;
+pub mod mesh;
 pub mod version;
 
+pub use cache::*;
 pub use cloth::*;
 pub use collider::*;
 pub use desc::*;
+pub use mesh::*;
 pub use status::*;
 pub use version::*;

@@ -22,6 +22,8 @@ pub enum FcStatus {
     FC_ERROR_UNSTABLE = 4,
     /// The library hit an internal error (a Rust panic was caught); the handle is unchanged where the failure allowed it.
     FC_ERROR_PANIC = 5,
+    /// A file could not be created, written or completed (cache writers); the message has the operating system's reason.
+    FC_ERROR_IO = 6,
 }
 
 thread_local! {
@@ -46,6 +48,17 @@ impl FfiError {
         Self {
             status: FcStatus::FC_ERROR_INVALID_ARGUMENT,
             message: message.into(),
+        }
+    }
+    pub fn io(what: &str, e: &std::io::Error) -> Self {
+        let status = if e.kind() == std::io::ErrorKind::InvalidInput {
+            FcStatus::FC_ERROR_INVALID_ARGUMENT
+        } else {
+            FcStatus::FC_ERROR_IO
+        };
+        Self {
+            status,
+            message: format!("{what}: {e}"),
         }
     }
 }
@@ -119,6 +132,7 @@ pub extern "C" fn fc_status_string(status: i32) -> *const c_char {
         3 => c"out of range",
         4 => c"unstable",
         5 => c"internal error",
+        6 => c"i/o error",
         _ => c"unknown status",
     };
     s.as_ptr()

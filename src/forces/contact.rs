@@ -3,7 +3,13 @@
 //!
 //! With d the signed distance from the collider surface and margin δ, a particle with
 //! d < δ receives `k_c (δ - d) n + c_c max(0, -(v - v_c) . n) n`, n the outward normal:
-//! a spring pushing it out plus damping of the approach velocity only.
+//! a spring pushing it out plus damping of the approach velocity only. v_c is the collider
+//! surface's velocity (colliders move rigidly, without spin).
+//!
+//! Friction is not a force here: [`apply_friction`] corrects velocities after the step
+//! (Coulomb, as an impulse: the tangential velocity relative to the collider shrinks by at
+//! most μ times the normal velocity change the contact gave, and never reverses), which is
+//! stable at any step size.
 
 use crate::model::Model;
 use crate::Vec3;
@@ -19,10 +25,41 @@ pub struct Sphere {
     pub velocity: Vec3,
 }
 
+/// An infinite plane; the cloth is kept on the side the normal points to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plane {
+    /// A point on the plane, m.
+    pub point: Vec3,
+    /// Unit normal (normalised when the plane is set).
+    pub normal: Vec3,
+    /// Velocity of the plane, m/s.
+    pub velocity: Vec3,
+}
+
+/// A capsule: the points within `radius` of the segment from `a` to `b`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Capsule {
+    /// Segment ends, m.
+    pub a: Vec3,
+    pub b: Vec3,
+    /// Radius, m (> 0).
+    pub radius: f64,
+    /// Velocity of the capsule, m/s.
+    pub velocity: Vec3,
+}
+
 /// Any collider.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Collider {
     Sphere(Sphere),
+    Plane(Plane),
+    Capsule(Capsule),
+}
+
+fn radial(r: Vec3) -> (f64, Vec3) {
+    let len = r.norm();
+    let n = if len > 0.0 { r / len } else { Vec3::y() };
+    (len, n)
 }
 
 impl Collider {
@@ -30,10 +67,20 @@ impl Collider {
     pub fn probe(&self, p: &Vec3) -> (f64, Vec3, Vec3) {
         match self {
             Collider::Sphere(s) => {
-                let r = p - s.center;
-                let len = r.norm();
-                let n = if len > 0.0 { r / len } else { Vec3::y() };
+                let (len, n) = radial(p - s.center);
                 (len - s.radius, n, s.velocity)
+            }
+            Collider::Plane(pl) => ((p - pl.point).dot(&pl.normal), pl.normal, pl.velocity),
+            Collider::Capsule(c) => {
+                let ab = c.b - c.a;
+                let len2 = ab.norm_squared();
+                let t = if len2 > 0.0 {
+                    ((p - c.a).dot(&ab) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let (len, n) = radial(p - (c.a + t * ab));
+                (len - c.radius, n, c.velocity)
             }
         }
     }
@@ -50,4 +97,51 @@ pub(super) fn add(m: &Model, colliders: &[Collider], x: &Vec3, v: &Vec3, f: &mut
             *f += (k * (margin - d) - c * approach) * n;
         }
     }
+}
+
+/// Coulomb friction as a velocity correction after a step of size `h`: for every particle in
+/// contact with a collider of friction coefficient μ > 0 (at the start-of-step position `x`),
+/// the tangential part of `v_new - v_c` shrinks by `min(|v_t|, μ h F_n / m)`, F_n the normal
+/// penalty force. Free particles only (`pinned` false).
+#[allow(clippy::too_many_arguments)] // one pass over the step's arrays; a struct would only rename them
+pub fn apply_friction(
+    m: &Model,
+    colliders: &[Collider],
+    friction: &[f64],
+    h: f64,
+    x: &[Vec3],
+    masses: &[f64],
+    pinned: &[bool],
+    v_new: &mut [Vec3],
+) {
+    if friction.iter().all(|&mu| mu == 0.0) {
+        return;
+    }
+    let (k, margin) = (m.collision_stiffness, m.collision_margin);
+    crate::parallel::chunks(
+        crate::parallel::worth_it(x.len()),
+        v_new,
+        crate::parallel::CHUNK,
+        |first, chunk| {
+            for (q, v) in chunk.iter_mut().enumerate() {
+                let p = first + q;
+                if pinned[p] {
+                    continue;
+                }
+                for (collider, &mu) in colliders.iter().zip(friction) {
+                    let (d, n, vc) = collider.probe(&x[p]);
+                    if mu == 0.0 || d >= margin {
+                        continue;
+                    }
+                    let rel = *v - vc;
+                    let vt = rel - rel.dot(&n) * n;
+                    let speed = vt.norm();
+                    if speed > 0.0 {
+                        let dv = (mu * h * k * (margin - d) / masses[p]).min(speed);
+                        *v -= (dv / speed) * vt;
+                    }
+                }
+            }
+        },
+    );
 }

@@ -13,7 +13,7 @@ mod springs;
 
 pub use assemble::add_spring_values;
 pub use body::body_force;
-pub use contact::{Collider, Sphere};
+pub use contact::{apply_friction, Capsule, Collider, Plane, Sphere};
 pub use jacobian::{linearise, Linearisation};
 pub use normals::vertex_normals;
 

@@ -21,8 +21,9 @@ impl Scene3d<'_> {
     pub fn spheres_of(colliders: impl IntoIterator<Item = Collider>) -> Vec<Sphere> {
         colliders
             .into_iter()
-            .map(|c| match c {
-                Collider::Sphere(s) => s,
+            .filter_map(|c| match c {
+                Collider::Sphere(s) => Some(s),
+                _ => None,
             })
             .collect()
     }

@@ -6,11 +6,13 @@
 
 mod adjacency;
 mod grid;
+mod mesh;
 mod runs;
 mod spring;
 
 pub use adjacency::Adjacency;
 pub use grid::{grid_index, GridSpec};
+pub use mesh::{MeshMass, MeshSpec, MAX_MESH_VERTICES};
 pub use runs::SpringRun;
 pub use spring::{Spring, SpringKind};
 
