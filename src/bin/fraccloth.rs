@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Parser;
-use fraccloth::export::{write_obj, Pc2Writer};
+use fraccloth::export::{write_obj, CacheFormat, CacheWriter};
 use fraccloth::history::Scheme;
 use fraccloth::look::{describe, Look};
 use fraccloth::render::{contact_sheet, render_frame, save_png, Camera, GifWriter, Scene3d};
@@ -25,7 +25,7 @@ use tiny_skia::Pixmap;
 #[derive(Parser, Debug)]
 #[command(
     version,
-    about = "Bake an underwater cloth scene to a PC2 point cache, an OBJ rest mesh and preview pictures"
+    about = "Bake an underwater cloth scene to PC2 and MDD point caches, an OBJ rest mesh and preview pictures"
 )]
 struct Args {
     /// Scene: swing, sway or sphere.
@@ -69,6 +69,9 @@ struct Args {
     /// preset, the accurate default) into one comparison sheet, and measure their look.
     #[arg(long)]
     compare: bool,
+    /// Also write every frame as an OBJ (NAME_0001.obj, ...).
+    #[arg(long)]
+    obj_frames: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -178,16 +181,31 @@ fn bake(args: &Args) -> Result<(), String> {
         &topo.triangles,
     )
     .map_err(io(&obj_path))?;
-    let pc2_path = path(".pc2");
-    let mut cache = Pc2Writer::new(
-        BufWriter::new(File::create(&pc2_path).map_err(io(&pc2_path))?),
-        topo.vertex_count(),
-        1.0,
-        1.0,
-    )
-    .map_err(io(&pc2_path))?;
-
     let frames = (args.seconds * args.fps).round() as u64;
+    let (pc2_path, mdd_path, seq_path) = (path(".pc2"), path(".mdd"), path(".obj"));
+    let mut formats = vec![(CacheFormat::Pc2, &pc2_path), (CacheFormat::Mdd, &mdd_path)];
+    if args.obj_frames {
+        formats.push((CacheFormat::ObjSequence, &seq_path));
+    }
+    // Frame 0 is the first sample: host frame 1, as Blender counts.
+    let mut caches = formats
+        .into_iter()
+        .map(|(format, p)| {
+            let expected = u32::try_from(frames + 1).map_err(|_| "too many frames".to_string())?;
+            CacheWriter::create(
+                p,
+                format,
+                topo.vertex_count(),
+                &topo.triangles,
+                1.0,
+                args.fps,
+                expected,
+            )
+            .map(|w| (w, p))
+            .map_err(io(p))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+
     let preview = !args.no_preview;
     let (sheet_cam, gif_cam) = (camera_for(&scene, 320, 240), camera_for(&scene, 400, 300));
     let gif_every = (args.fps / 15.0).round().max(1.0) as u64;
@@ -209,9 +227,9 @@ fn bake(args: &Args) -> Result<(), String> {
                 .map_err(|e| format!("frame {f}: {e}"))?;
             bar.inc(1);
         }
-        cache
-            .write_frame(scene.cloth.positions())
-            .map_err(io(&pc2_path))?;
+        for (cache, p) in caches.iter_mut() {
+            cache.write_frame(scene.cloth.positions()).map_err(io(p))?;
+        }
         let t0 = Instant::now();
         if let Some(g) = gif.as_mut() {
             if f % gif_every == 0 {
@@ -223,7 +241,9 @@ fn bake(args: &Args) -> Result<(), String> {
         }
         render_time += t0.elapsed().as_secs_f64();
     }
-    cache.finish().map_err(io(&pc2_path))?;
+    for (cache, p) in caches {
+        cache.finish().map_err(io(p))?;
+    }
     bar.finish_and_clear();
     let wall = started.elapsed().as_secs_f64() - render_time;
     if preview {
@@ -243,7 +263,7 @@ fn bake(args: &Args) -> Result<(), String> {
     let n = topo.vertex_count();
     let history = &scene.cloth.history();
     let mut summary = format!(
-        "scene        {}\nvariant      {}\ngrid         {} x {} ({} vertices, {} springs)\nhistory      {} ({} modes, {} bytes/particle)\nintegrator   {}\ndt           {} s\nsimulated    {:.3} s in {} steps\nframes       {} at {} fps (+ frame 0)\nwall time    {:.3} s simulating ({:.2} M particle-steps/s), {:.3} s drawing previews\npoint cache  {}\nrest mesh    {}\n",
+        "scene        {}\nvariant      {}\ngrid         {} x {} ({} vertices, {} springs)\nhistory      {} ({} modes, {} bytes/particle)\nintegrator   {}\ndt           {} s\nsimulated    {:.3} s in {} steps\nframes       {} at {} fps (+ frame 0)\nwall time    {:.3} s simulating ({:.2} M particle-steps/s), {:.3} s drawing previews\npoint caches {} (PC2), {} (MDD)\nrest mesh    {}\n",
         spec.kind.name(),
         variant.name(),
         spec.width,
@@ -263,6 +283,7 @@ fn bake(args: &Args) -> Result<(), String> {
         (steps as f64 * n as f64) / wall / 1e6,
         render_time,
         pc2_path.display(),
+        mdd_path.display(),
         obj_path.display(),
     );
     if preview {
