@@ -205,12 +205,12 @@ fn pin_weights_and_groups() {
         );
         let bad = [0u32, 99];
         assert_eq!(fc_cloth_pin_group(c, bad.as_ptr(), 2, 1.0), FC_ERROR_OUT_OF_RANGE);
-        let w = vec![0.5f32; 11];
+        let w = [0.5f32; 11];
         assert_eq!(
             fc_cloth_set_pin_weights(c, w.as_ptr(), 11),
             FC_ERROR_INVALID_ARGUMENT
         );
-        let w = vec![0.5f32; 12];
+        let w = [0.5f32; 12];
         assert_eq!(fc_cloth_set_pin_weights(c, w.as_ptr(), 12), FC_OK);
         // Every vertex is (softly) pinned now, so every vertex can take a target.
         let t = [0.0f32, 0.0, 0.1];
