@@ -136,6 +136,24 @@ typedef enum {
 } FcPreset;
 
 /**
+ * Values of the `format` argument of `fc_cache_open`.
+ */
+typedef enum {
+  /**
+   * PC2 point cache, little-endian (Blender's Mesh Cache modifier, Maya, 3ds Max).
+   */
+  FC_CACHE_PC2 = 0,
+  /**
+   * MDD point cache, big-endian; needs `expected_frames` up front (fewer is fine: the file is compacted on close).
+   */
+  FC_CACHE_MDD = 1,
+  /**
+   * One OBJ per frame: `path` "dir/name.obj" gives "dir/name_0001.obj", ... numbered from `start_frame`.
+   */
+  FC_CACHE_OBJ_SEQUENCE = 2,
+} FcCacheFormat;
+
+/**
  * An open cache file. Create with `fc_cache_open`, free with `fc_cache_close`.
  */
 typedef struct FcCache FcCache;

@@ -34,6 +34,18 @@ pub fn scratch_dir(name: &str) -> PathBuf {
 
 /// Compiles one C file from `examples_c/` with `cc -std=c99 -Wall -Wextra -Werror`.
 pub fn compile_c(source: &str, out_dir: &Path) -> PathBuf {
+    compile("cc", &["-std=c99"], "examples_c", source, out_dir)
+}
+
+/// Compiles one C++ file from `examples_cpp/` against `bindings/cpp/fraccloth.hpp` with
+/// `c++ -std=c++17 -Wall -Wextra -Werror`.
+pub fn compile_cpp(source: &str, out_dir: &Path) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let include = format!("-I{}", root.join("bindings").join("cpp").display());
+    compile("c++", &["-std=c++17", &include], "examples_cpp", source, out_dir)
+}
+
+fn compile(compiler: &str, flags: &[&str], dir: &str, source: &str, out_dir: &Path) -> PathBuf {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let lib = lib_dir();
     let stem = Path::new(source)
@@ -42,11 +54,12 @@ pub fn compile_c(source: &str, out_dir: &Path) -> PathBuf {
         .to_string_lossy()
         .to_string();
     let exe = out_dir.join(stem);
-    let status = Command::new("cc")
-        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-O1"])
+    let status = Command::new(compiler)
+        .args(flags)
+        .args(["-Wall", "-Wextra", "-Werror", "-O1"])
         .arg("-I")
         .arg(root.join("include"))
-        .arg(root.join("examples_c").join(source))
+        .arg(root.join(dir).join(source))
         .arg("-o")
         .arg(&exe)
         .arg("-L")
@@ -54,8 +67,8 @@ pub fn compile_c(source: &str, out_dir: &Path) -> PathBuf {
         .arg(format!("-Wl,-rpath,{}", lib.display()))
         .args(["-lfraccloth", "-lm"])
         .status()
-        .expect("cc runs");
-    assert!(status.success(), "cc failed on {source}");
+        .unwrap_or_else(|e| panic!("{compiler} runs: {e}"));
+    assert!(status.success(), "{compiler} failed on {source}");
     exe
 }
 

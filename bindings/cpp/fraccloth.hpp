@@ -1,0 +1,229 @@
+// fraccloth.hpp: header-only C++17 wrapper over the fraccloth C ABI (include/fraccloth.h).
+//
+// - fraccloth::Cloth and fraccloth::Cache own their handles (move-only, freed in the
+//   destructor);
+// - every failing call throws fraccloth::Error, which carries the FcStatus and the
+//   library's message; a failed call leaves the cloth exactly as it was (the C ABI's rule);
+// - buffers are passed as fraccloth::span (std::span with C++20, a minimal view before),
+//   built implicitly from std::vector and std::array.
+//
+// Link against libfraccloth (pkg-config --libs fraccloth, or find_package(fraccloth) in
+// CMake). Units are SI: m, kg, s.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#if __cplusplus >= 202002L && __has_include(<span>)
+#include <span>
+#endif
+
+extern "C" {
+#include "fraccloth.h"
+}
+
+namespace fraccloth {
+
+#if __cplusplus >= 202002L && defined(__cpp_lib_span)
+template <class T>
+using span = std::span<T>;
+#else
+/// A pointer and a length: the part of std::span this wrapper needs, for C++17.
+template <class T>
+class span {
+public:
+    constexpr span() noexcept = default;
+    constexpr span(T* data, std::size_t size) noexcept : data_(data), size_(size) {}
+    template <class U, class A>
+    span(std::vector<U, A>& v) noexcept : data_(v.data()), size_(v.size()) {}
+    template <class U, class A>
+    span(const std::vector<U, A>& v) noexcept : data_(v.data()), size_(v.size()) {}
+    template <class U, std::size_t N>
+    span(std::array<U, N>& a) noexcept : data_(a.data()), size_(N) {}
+    template <class U, std::size_t N>
+    span(const std::array<U, N>& a) noexcept : data_(a.data()), size_(N) {}
+    constexpr T* data() const noexcept { return data_; }
+    constexpr std::size_t size() const noexcept { return size_; }
+
+private:
+    T* data_ = nullptr;
+    std::size_t size_ = 0;
+};
+#endif
+
+/// A failed call: the status and the library's message.
+class Error : public std::runtime_error {
+public:
+    Error(FcStatus status, const std::string& message)
+        : std::runtime_error(std::string(fc_status_string(static_cast<int32_t>(status))) + ": " + message),
+          status_(status) {}
+    FcStatus status() const noexcept { return status_; }
+
+private:
+    FcStatus status_;
+};
+
+/// Throws Error unless `status` is FC_OK.
+inline void check(FcStatus status) {
+    if (status != FC_OK) {
+        throw Error(status, fc_last_error_message());
+    }
+}
+
+/// A 3-vector of floats (m, or m/s).
+using Vec3f = std::array<float, 3>;
+
+/// Description with the library's defaults (a 61 x 41 grid of 1 cm, fractional model, SOE history).
+inline FcClothDesc default_desc() { return fc_cloth_desc_default(); }
+
+/// Description of a preset (an FcPreset value).
+inline FcClothDesc preset_desc(FcPreset preset) {
+    FcClothDesc d;
+    check(fc_cloth_desc_preset(static_cast<uint32_t>(preset), &d));
+    return d;
+}
+
+/// One simulated cloth. Move-only; the handle is freed by the destructor.
+class Cloth {
+public:
+    /// A grid cloth from `desc` (width x height vertices).
+    static Cloth grid(const FcClothDesc& desc) {
+        FcCloth* c = nullptr;
+        check(fc_cloth_create_grid(&desc, &c));
+        return Cloth(c);
+    }
+
+    /// A cloth from a mesh: xyz positions (3 floats per vertex) and face corner indices,
+    /// `face_size` (3 or 4) per face.
+    static Cloth mesh(const FcClothDesc& desc, span<const float> xyz, span<const uint32_t> indices,
+                      uint32_t face_size) {
+        FcCloth* c = nullptr;
+        check(fc_cloth_create_mesh(&desc, xyz.data(), xyz.size() / 3, indices.data(), indices.size(),
+                                   face_size, &c));
+        return Cloth(c);
+    }
+
+    Cloth(Cloth&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
+    Cloth& operator=(Cloth&& other) noexcept {
+        if (this != &other) {
+            fc_cloth_destroy(handle_);
+            handle_ = std::exchange(other.handle_, nullptr);
+        }
+        return *this;
+    }
+    Cloth(const Cloth&) = delete;
+    Cloth& operator=(const Cloth&) = delete;
+    ~Cloth() { fc_cloth_destroy(handle_); }
+
+    /// The C handle, for calls this wrapper does not cover.
+    FcCloth* get() const noexcept { return handle_; }
+
+    std::size_t vertex_count() const noexcept { return fc_cloth_vertex_count(handle_); }
+    double time() const noexcept { return fc_cloth_time(handle_); }
+
+    void set_pinned(span<const uint32_t> indices) { check(fc_cloth_set_pinned(handle_, indices.data(), indices.size())); }
+    void set_pin_weights(span<const float> weights) {
+        check(fc_cloth_set_pin_weights(handle_, weights.data(), weights.size()));
+    }
+    void pin_group(span<const uint32_t> indices, float weight) {
+        check(fc_cloth_pin_group(handle_, indices.data(), indices.size(), weight));
+    }
+    /// Targets: 3 floats per index.
+    void set_pin_targets(span<const uint32_t> indices, span<const float> xyz) {
+        if (xyz.size() != 3 * indices.size()) {
+            throw Error(FC_ERROR_INVALID_ARGUMENT, "set_pin_targets needs 3 floats per index");
+        }
+        check(fc_cloth_set_pin_targets(handle_, indices.data(), xyz.data(), indices.size()));
+    }
+    void set_current(const Vec3f& current) { check(fc_cloth_set_current(handle_, current.data())); }
+
+    void step(double dt) { check(fc_cloth_step(handle_, dt)); }
+    void step_substeps(double dt, uint32_t substeps) { check(fc_cloth_step_substeps(handle_, dt, substeps)); }
+
+    /// Positions as xyz floats (3 per vertex).
+    std::vector<float> positions() const {
+        std::vector<float> xyz(3 * vertex_count());
+        check(fc_cloth_get_positions(handle_, xyz.data(), xyz.size()));
+        return xyz;
+    }
+    void positions(span<float> out) const { check(fc_cloth_get_positions(handle_, out.data(), out.size())); }
+    std::vector<float> velocities() const {
+        std::vector<float> xyz(3 * vertex_count());
+        check(fc_cloth_get_velocities(handle_, xyz.data(), xyz.size()));
+        return xyz;
+    }
+    void set_positions(span<const float> xyz) { check(fc_cloth_set_positions(handle_, xyz.data(), xyz.size())); }
+
+    /// Colliders; each returns its id. A null velocity means resting.
+    uint32_t add_sphere(const Vec3f& center, float radius, const Vec3f& velocity = {}) {
+        uint32_t id = 0;
+        check(fc_cloth_add_sphere(handle_, center.data(), radius, velocity.data(), &id));
+        return id;
+    }
+    void set_sphere(uint32_t id, const Vec3f& center, float radius, const Vec3f& velocity = {}) {
+        check(fc_cloth_set_sphere(handle_, id, center.data(), radius, velocity.data()));
+    }
+    uint32_t add_plane(const Vec3f& point, const Vec3f& normal, const Vec3f& velocity = {}) {
+        uint32_t id = 0;
+        check(fc_cloth_add_plane(handle_, point.data(), normal.data(), velocity.data(), &id));
+        return id;
+    }
+    void set_plane(uint32_t id, const Vec3f& point, const Vec3f& normal, const Vec3f& velocity = {}) {
+        check(fc_cloth_set_plane(handle_, id, point.data(), normal.data(), velocity.data()));
+    }
+    uint32_t add_capsule(const Vec3f& a, const Vec3f& b, float radius, const Vec3f& velocity = {}) {
+        uint32_t id = 0;
+        check(fc_cloth_add_capsule(handle_, a.data(), b.data(), radius, velocity.data(), &id));
+        return id;
+    }
+    void set_capsule(uint32_t id, const Vec3f& a, const Vec3f& b, float radius, const Vec3f& velocity = {}) {
+        check(fc_cloth_set_capsule(handle_, id, a.data(), b.data(), radius, velocity.data()));
+    }
+    void set_collider_friction(uint32_t id, float friction) {
+        check(fc_cloth_set_collider_friction(handle_, id, friction));
+    }
+    void remove_collider(uint32_t id) { check(fc_cloth_remove_collider(handle_, id)); }
+
+    void write_obj(const std::string& path) const { check(fc_cloth_write_obj(handle_, path.c_str())); }
+
+private:
+    explicit Cloth(FcCloth* handle) noexcept : handle_(handle) {}
+    FcCloth* handle_ = nullptr;
+};
+
+/// A point cache being written (PC2, MDD or an OBJ sequence). Move-only; `close()` completes
+/// the file and reports errors; the destructor closes silently if `close()` was not called.
+class Cache {
+public:
+    Cache(const std::string& path, FcCacheFormat format, const Cloth& cloth, double start_frame = 1.0,
+          double frames_per_second = 24.0, uint32_t expected_frames = 0) {
+        check(fc_cache_open(path.c_str(), static_cast<uint32_t>(format), cloth.get(), start_frame,
+                            frames_per_second, expected_frames, &handle_));
+    }
+    Cache(Cache&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
+    Cache& operator=(Cache&& other) noexcept {
+        if (this != &other) {
+            fc_cache_close(handle_);
+            handle_ = std::exchange(other.handle_, nullptr);
+        }
+        return *this;
+    }
+    Cache(const Cache&) = delete;
+    Cache& operator=(const Cache&) = delete;
+    ~Cache() { fc_cache_close(handle_); }
+
+    /// Appends the cloth's current positions as the next frame.
+    void write_frame(const Cloth& cloth) { check(fc_cache_write_frame(handle_, cloth.get())); }
+    /// Completes the file; throws if that fails. The handle is gone either way.
+    void close() { check(fc_cache_close(std::exchange(handle_, nullptr))); }
+
+private:
+    FcCache* handle_ = nullptr;
+};
+
+}  // namespace fraccloth
