@@ -1,0 +1,266 @@
+"""fraccloth for Blender: simulate the active mesh as cloth underwater.
+
+Physics > fraccloth panel (Properties editor, Physics tab). "Bake underwater cloth":
+- the active mesh object is the cloth (triangles and quads; apply its scale first);
+- vertices of the vertex group named in "Pin group" are pinned with their group weight
+  (1 = held in place, less = a soft pin);
+- every other selected object is a collider: a flat one (one dimension near zero) is an
+  infinite plane through its origin along its local Z axis, any other a sphere of half its
+  largest dimension around its origin; "Collider friction" applies to them all;
+- the scene's frame range is baked at the scene's frame rate, each frame split into steps of
+  "Time step"; the result is written to a PC2 (or MDD) point cache by the fraccloth library and
+  attached with a Mesh Cache modifier.
+
+Simulation happens in the object's local frame (gravity, current and colliders are carried
+into it), so the cache holds local coordinates as the Mesh Cache modifier expects.
+
+Needs the `fraccloth` Python package (bindings/python) importable from Blender's Python:
+`pip install ./bindings/python` into it, or put the package (with its _lib folder) next to
+this add-on.
+"""
+
+bl_info = {
+    "name": "fraccloth: underwater cloth",
+    "author": "fraccloth developers",
+    "version": (0, 1, 0),
+    "blender": (4, 2, 0),
+    "location": "Properties > Physics > fraccloth",
+    "description": "Cloth that moves as if underwater (fractional mass-spring model), baked to a point cache",
+    "category": "Physics",
+}
+
+import math
+import os
+import sys
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+_here = os.path.dirname(os.path.abspath(__file__))
+if _here not in sys.path:
+    sys.path.append(_here)  # a vendored `fraccloth` package next to the add-on
+
+HISTORY_ITEMS = [
+    ("SOE", "Accurate (SOE)", "Full fractional memory at constant cost (the default)"),
+    ("PAPER", "Paper (u = 3)", "The paper's truncated history, to reproduce its pictures"),
+    ("OFF", "Off", "No memory (regular cloth)"),
+]
+INTEGRATOR_ITEMS = [
+    ("SYMPLECTIC", "Symplectic Euler", "Fast; small time steps (about 1 ms)"),
+    ("EXPLICIT", "Explicit Euler", "The paper's integrator; small time steps"),
+    ("IMPLICIT", "Implicit Euler", "Stable at large steps (a frame)"),
+]
+FORMAT_ITEMS = [("PC2", "PC2", "PC2 point cache"), ("MDD", "MDD", "MDD point cache")]
+
+
+class FracclothSettings(bpy.types.PropertyGroup):
+    pin_group: bpy.props.StringProperty(name="Pin group", description="Vertex group of pinned vertices", default="pins")
+    stretch_stiffness: bpy.props.FloatProperty(name="Stretch", description="Stretch spring constant, N/m", default=10.0, min=0.0)
+    shear_stiffness: bpy.props.FloatProperty(name="Shear", description="Shear spring constant, N/m", default=2.0, min=0.0)
+    bend_stiffness: bpy.props.FloatProperty(name="Bend", description="Bend spring constant, N/m", default=0.5, min=0.0)
+    spring_damping: bpy.props.FloatProperty(name="Spring damping", description="Fractional spring damping, N s^1/2 / m", default=0.35, min=0.0)
+    history_drag: bpy.props.FloatProperty(name="History drag", description="Basset history drag per 1 cm^2, N s^1/2 / m", default=2e-3, min=0.0, precision=5)
+    viscous_drag: bpy.props.FloatProperty(name="Viscous drag", description="Viscous drag per 1 cm^2, N s / m", default=1e-3, min=0.0, precision=5)
+    mass_per_area: bpy.props.FloatProperty(name="Mass per area", description="kg per m^2 of cloth", default=1.0, min=1e-6)
+    current: bpy.props.FloatVectorProperty(name="Current", description="Water current, m/s (world)", default=(0.0, 0.0, 0.0), size=3)
+    history: bpy.props.EnumProperty(name="History", items=HISTORY_ITEMS, default="SOE")
+    integrator: bpy.props.EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="SYMPLECTIC")
+    time_step: bpy.props.FloatProperty(name="Time step", description="Longest step, s", default=5e-4, min=1e-6, max=0.1, precision=5)
+    friction: bpy.props.FloatProperty(name="Collider friction", default=0.0, min=0.0)
+    cache_format: bpy.props.EnumProperty(name="Format", items=FORMAT_ITEMS, default="PC2")
+    cache_path: bpy.props.StringProperty(name="Cache file", subtype="FILE_PATH", default="//fraccloth_cache")
+
+
+def _local(obj):
+    """World -> object-local transform and its rotation (scale must be 1)."""
+    inv = obj.matrix_world.inverted()
+    rot = obj.matrix_world.to_3x3().normalized().transposed()
+    return inv, rot
+
+
+def collider_specs(obj, others):
+    """(kind, args) for every other selected object, in the cloth's local frame."""
+    inv, rot = _local(obj)
+    specs = []
+    for o in others:
+        dims = o.dimensions
+        center = inv @ o.matrix_world.translation
+        if min(dims) < 1e-6 * max(max(dims), 1e-9):
+            normal = rot @ (o.matrix_world.to_3x3() @ Vector((0.0, 0.0, 1.0))).normalized()
+            specs.append(("plane", tuple(center), tuple(normal)))
+        else:
+            specs.append(("sphere", tuple(center), 0.5 * max(dims)))
+    return specs
+
+
+def mesh_arrays(obj):
+    """Local vertex positions (N, 3) and faces: quads (M, 4) if every face is a quad, else
+    triangles (M, 3)."""
+    me = obj.data
+    pos = np.empty(3 * len(me.vertices), dtype=np.float32)
+    me.vertices.foreach_get("co", pos)
+    if all(len(p.vertices) == 4 for p in me.polygons):
+        faces = np.empty(4 * len(me.polygons), dtype=np.uint32)
+        me.polygons.foreach_get("vertices", faces)
+        return pos.reshape(-1, 3), faces.reshape(-1, 4)
+    me.calc_loop_triangles()
+    tris = np.empty(3 * len(me.loop_triangles), dtype=np.uint32)
+    me.loop_triangles.foreach_get("vertices", tris)
+    return pos.reshape(-1, 3), tris.reshape(-1, 3)
+
+
+def pin_weights(obj, name):
+    group = obj.vertex_groups.get(name)
+    w = np.zeros(len(obj.data.vertices), dtype=np.float32)
+    if group is None:
+        return w
+    for v in obj.data.vertices:
+        for g in v.groups:
+            if g.group == group.index:
+                w[v.index] = g.weight
+    return np.clip(w, 0.0, 1.0)
+
+
+def build_cloth(context, obj, others):
+    """The fraccloth cloth for `obj` with the scene's settings; returns (cloth, step plan)."""
+    import fraccloth
+
+    s = context.scene.fraccloth
+    if any(abs(c - 1.0) > 1e-6 for c in obj.matrix_world.to_scale()):
+        raise ValueError(f"{obj.name}: apply its scale first (Ctrl+A > Scale)")
+    pos, faces = mesh_arrays(obj)
+    _, rot = _local(obj)
+    desc = fraccloth.default_desc()
+    desc.total_mass = 0.0
+    desc.areal_density = s.mass_per_area
+    g = rot @ Vector((0.0, 0.0, -9.81))
+    cur = rot @ Vector(s.current)
+    for k in range(3):
+        desc.gravity[k] = g[k]
+        desc.current[k] = cur[k]
+    desc.stretch_stiffness = s.stretch_stiffness
+    desc.shear_stiffness = s.shear_stiffness
+    desc.bend_stiffness = s.bend_stiffness
+    desc.spring_damping = s.spring_damping
+    # Drags are per particle in the library; the panel's are per 1 cm^2: scale by the mean
+    # vertex area.
+    edges = np.linalg.norm(pos[faces[:, 0]] - pos[faces[:, 1]], axis=1)
+    spacing = float(np.mean(edges)) if len(edges) else 0.01
+    area_scale = (spacing / 0.01) ** 2
+    desc.history_drag = s.history_drag * area_scale
+    desc.viscous_drag = s.viscous_drag * area_scale
+    desc.history_scheme = {"SOE": fraccloth.HISTORY_SOE, "PAPER": fraccloth.HISTORY_TRUNCATED, "OFF": fraccloth.HISTORY_OFF}[s.history]
+    desc.history_u = 3
+    desc.integrator = {
+        "SYMPLECTIC": fraccloth.INTEGRATOR_SYMPLECTIC_EULER,
+        "EXPLICIT": fraccloth.INTEGRATOR_EXPLICIT_EULER,
+        "IMPLICIT": fraccloth.INTEGRATOR_IMPLICIT_EULER,
+    }[s.integrator]
+    cloth = fraccloth.Cloth.mesh(desc, pos, faces)
+    w = pin_weights(obj, s.pin_group)
+    if w.any():
+        cloth.set_pin_weights(w)
+    for spec in collider_specs(obj, others):
+        if spec[0] == "plane":
+            cid = cloth.add_plane(spec[1], spec[2])
+        else:
+            cid = cloth.add_sphere(spec[1], spec[2])
+        cloth.set_collider_friction(cid, s.friction)
+    fps = context.scene.render.fps / context.scene.render.fps_base
+    frame_dt = 1.0 / fps
+    substeps = max(1, math.ceil(frame_dt / s.time_step - 1e-9))
+    return cloth, (frame_dt, substeps)
+
+
+def simulate(context, obj, others):
+    """Yields (frame, cloth) for every frame of the scene's range: the first frame is the rest
+    state, each next one a frame's worth of steps later."""
+    cloth, (frame_dt, substeps) = build_cloth(context, obj, others)
+    scene = context.scene
+    for f in range(scene.frame_start, scene.frame_end + 1):
+        if f > scene.frame_start:
+            cloth.step_substeps(frame_dt, substeps)
+        yield f, cloth
+
+
+class FRACCLOTH_OT_bake(bpy.types.Operator):
+    """Simulate the active mesh underwater and attach the result as a point cache"""
+
+    bl_idname = "fraccloth.bake"
+    bl_label = "Bake underwater cloth"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.active_object is not None and context.active_object.type == "MESH"
+
+    def execute(self, context):
+        import fraccloth
+
+        obj = context.active_object
+        others = [o for o in context.selected_objects if o is not obj]
+        s = context.scene.fraccloth
+        scene = context.scene
+        ext = ".pc2" if s.cache_format == "PC2" else ".mdd"
+        path = bpy.path.abspath(s.cache_path)
+        if not path.endswith(ext):
+            path += ext
+        os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+        fmt = fraccloth.CACHE_PC2 if s.cache_format == "PC2" else fraccloth.CACHE_MDD
+        frames = scene.frame_end - scene.frame_start + 1
+        fps = scene.render.fps / scene.render.fps_base
+        # Remove an earlier cache modifier first, so the rest shape is the mesh's own.
+        for m in list(obj.modifiers):
+            if m.type == "MESH_CACHE" and m.name == "fraccloth":
+                obj.modifiers.remove(m)
+        try:
+            cache = None
+            for f, cloth in simulate(context, obj, others):
+                if cache is None:
+                    cache = fraccloth.Cache(path, fmt, cloth, float(scene.frame_start), fps, frames)
+                cache.write_frame(cloth)
+            cache.close()
+        except (fraccloth.Error, ValueError) as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        mod = obj.modifiers.new("fraccloth", "MESH_CACHE")
+        mod.cache_format = s.cache_format
+        mod.filepath = path
+        mod.time_mode = "FRAME"
+        mod.play_mode = "SCENE"
+        mod.frame_start = float(scene.frame_start)
+        mod.interpolation = "NONE"
+        self.report({"INFO"}, f"fraccloth: baked {frames} frames to {path}")
+        return {"FINISHED"}
+
+
+class FRACCLOTH_PT_panel(bpy.types.Panel):
+    bl_label = "fraccloth (underwater cloth)"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "physics"
+
+    def draw(self, context):
+        s = context.scene.fraccloth
+        col = self.layout.column()
+        for name in ("pin_group", "stretch_stiffness", "shear_stiffness", "bend_stiffness", "spring_damping",
+                     "history_drag", "viscous_drag", "mass_per_area", "current", "history", "integrator",
+                     "time_step", "friction", "cache_format", "cache_path"):
+            col.prop(s, name)
+        col.operator(FRACCLOTH_OT_bake.bl_idname)
+
+
+_classes = (FracclothSettings, FRACCLOTH_OT_bake, FRACCLOTH_PT_panel)
+
+
+def register():
+    for c in _classes:
+        bpy.utils.register_class(c)
+    bpy.types.Scene.fraccloth = bpy.props.PointerProperty(type=FracclothSettings)
+
+
+def unregister():
+    del bpy.types.Scene.fraccloth
+    for c in reversed(_classes):
+        bpy.utils.unregister_class(c)

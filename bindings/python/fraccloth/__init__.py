@@ -1,0 +1,416 @@
+"""fraccloth: underwater cloth without simulating the water (ctypes bindings).
+
+Units are SI: metres, kilograms, seconds. Positions and velocities cross as float32
+arrays of shape (N, 3). Every failing call raises :class:`Error`; the cloth is then
+exactly as it was before the call.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import re
+import sys
+from pathlib import Path
+from typing import Iterable, Optional, Sequence
+
+import numpy as np
+
+__all__ = [
+    "Error",
+    "Cloth",
+    "Cache",
+    "default_desc",
+    "preset_desc",
+    "library",
+    "version",
+    "FcClothDesc",
+    "PRESET_FRACTIONAL_PAPER",
+    "PRESET_REGULAR_VISCOUS_NORMAL",
+    "PRESET_REGULAR_VISCOUS",
+    "PRESET_REGULAR_NORMAL",
+    "HISTORY_OFF",
+    "HISTORY_TRUNCATED",
+    "HISTORY_FULL",
+    "HISTORY_SOE",
+    "INTEGRATOR_EXPLICIT_EULER",
+    "INTEGRATOR_SYMPLECTIC_EULER",
+    "INTEGRATOR_IMPLICIT_EULER",
+    "CACHE_PC2",
+    "CACHE_MDD",
+    "CACHE_OBJ_SEQUENCE",
+]
+
+_HERE = Path(__file__).resolve().parent
+_LIB_DIR = _HERE / "_lib"
+
+
+def _library_path() -> Path:
+    given = os.environ.get("FRACCLOTH_LIBRARY")
+    if given:
+        return Path(given)
+    for name in ("libfraccloth.so", "libfraccloth.dylib", "fraccloth.dll"):
+        if (_LIB_DIR / name).exists():
+            return _LIB_DIR / name
+    raise ImportError(
+        f"fraccloth: no shared library in {_LIB_DIR}; install with `pip install ./bindings/python` "
+        "from the repository, or set FRACCLOTH_LIBRARY"
+    )
+
+
+def _header_path() -> Path:
+    given = os.environ.get("FRACCLOTH_HEADER")
+    if given:
+        return Path(given)
+    packaged = _LIB_DIR / "fraccloth.h"
+    if packaged.exists():
+        return packaged
+    return _HERE.parent.parent.parent / "include" / "fraccloth.h"
+
+
+_C_TYPES = {
+    "uint32_t": ctypes.c_uint32,
+    "int32_t": ctypes.c_int32,
+    "float": ctypes.c_float,
+    "double": ctypes.c_double,
+    "size_t": ctypes.c_size_t,
+}
+
+
+def _struct_from_header(text: str, name: str):
+    """Builds the ctypes Structure for `typedef struct { ... } name;` from the C header."""
+    m = re.search(r"typedef struct \{(.*?)\}\s*" + name + r"\s*;", text, re.S)
+    if not m:
+        raise ImportError(f"fraccloth: {name} not found in the header")
+    fields = []
+    body = re.sub(r"/\*.*?\*/", "", m.group(1), flags=re.S)
+    for decl in body.split(";"):
+        decl = decl.strip()
+        if not decl:
+            continue
+        fm = re.fullmatch(r"(\w+)\s+(\w+)(?:\[(\d+)\])?", decl)
+        if not fm or fm.group(1) not in _C_TYPES:
+            raise ImportError(f"fraccloth: cannot read field {decl!r} of {name}")
+        ctype = _C_TYPES[fm.group(1)]
+        if fm.group(3):
+            ctype = ctype * int(fm.group(3))
+        fields.append((fm.group(2), ctype))
+    return type(name, (ctypes.Structure,), {"_fields_": fields})
+
+
+def _enum_values(text: str) -> dict:
+    return {k: int(v) for k, v in re.findall(r"\b(FC_[A-Z0-9_]+)\s*=\s*(\d+)", text)}
+
+
+_HEADER = _header_path().read_text()
+FcClothDesc = _struct_from_header(_HEADER, "FcClothDesc")
+_ENUMS = _enum_values(_HEADER)
+
+PRESET_FRACTIONAL_PAPER = _ENUMS["FC_PRESET_FRACTIONAL_PAPER"]
+PRESET_REGULAR_VISCOUS_NORMAL = _ENUMS["FC_PRESET_REGULAR_VISCOUS_NORMAL"]
+PRESET_REGULAR_VISCOUS = _ENUMS["FC_PRESET_REGULAR_VISCOUS"]
+PRESET_REGULAR_NORMAL = _ENUMS["FC_PRESET_REGULAR_NORMAL"]
+HISTORY_OFF = _ENUMS["FC_HISTORY_OFF"]
+HISTORY_TRUNCATED = _ENUMS["FC_HISTORY_TRUNCATED"]
+HISTORY_FULL = _ENUMS["FC_HISTORY_FULL"]
+HISTORY_SOE = _ENUMS["FC_HISTORY_SOE"]
+INTEGRATOR_EXPLICIT_EULER = _ENUMS["FC_INTEGRATOR_EXPLICIT_EULER"]
+INTEGRATOR_SYMPLECTIC_EULER = _ENUMS["FC_INTEGRATOR_SYMPLECTIC_EULER"]
+INTEGRATOR_IMPLICIT_EULER = _ENUMS["FC_INTEGRATOR_IMPLICIT_EULER"]
+CACHE_PC2 = _ENUMS["FC_CACHE_PC2"]
+CACHE_MDD = _ENUMS["FC_CACHE_MDD"]
+CACHE_OBJ_SEQUENCE = _ENUMS["FC_CACHE_OBJ_SEQUENCE"]
+
+library = ctypes.CDLL(str(_library_path()))
+
+_c = ctypes
+_P = ctypes.c_void_p
+_F3 = ctypes.POINTER(ctypes.c_float)
+_U32P = ctypes.POINTER(ctypes.c_uint32)
+_SIGNATURES = {
+    "fc_last_error_message": (_c.c_char_p, []),
+    "fc_status_string": (_c.c_char_p, [_c.c_int32]),
+    "fc_version": (_c.c_uint32, []),
+    "fc_cloth_desc_default": (FcClothDesc, []),
+    "fc_cloth_desc_preset": (_c.c_int, [_c.c_uint32, _c.POINTER(FcClothDesc)]),
+    "fc_cloth_create_grid": (_c.c_int, [_c.POINTER(FcClothDesc), _c.POINTER(_P)]),
+    "fc_cloth_create_mesh": (
+        _c.c_int,
+        [_c.POINTER(FcClothDesc), _F3, _c.c_size_t, _U32P, _c.c_size_t, _c.c_uint32, _c.POINTER(_P)],
+    ),
+    "fc_cloth_destroy": (None, [_P]),
+    "fc_cloth_vertex_count": (_c.c_size_t, [_P]),
+    "fc_cloth_triangle_count": (_c.c_size_t, [_P]),
+    "fc_cloth_time": (_c.c_double, [_P]),
+    "fc_cloth_set_pinned": (_c.c_int, [_P, _U32P, _c.c_size_t]),
+    "fc_cloth_set_pin_weights": (_c.c_int, [_P, _F3, _c.c_size_t]),
+    "fc_cloth_pin_group": (_c.c_int, [_P, _U32P, _c.c_size_t, _c.c_float]),
+    "fc_cloth_set_pin_targets": (_c.c_int, [_P, _U32P, _F3, _c.c_size_t]),
+    "fc_cloth_set_positions": (_c.c_int, [_P, _F3, _c.c_size_t]),
+    "fc_cloth_get_positions": (_c.c_int, [_P, _F3, _c.c_size_t]),
+    "fc_cloth_get_velocities": (_c.c_int, [_P, _F3, _c.c_size_t]),
+    "fc_cloth_set_current": (_c.c_int, [_P, _F3]),
+    "fc_cloth_step": (_c.c_int, [_P, _c.c_double]),
+    "fc_cloth_step_substeps": (_c.c_int, [_P, _c.c_double, _c.c_uint32]),
+    "fc_cloth_history_mode_count": (_c.c_uint32, [_P]),
+    "fc_cloth_history_bytes_per_particle": (_c.c_size_t, [_P]),
+    "fc_cloth_add_sphere": (_c.c_int, [_P, _F3, _c.c_float, _F3, _U32P]),
+    "fc_cloth_set_sphere": (_c.c_int, [_P, _c.c_uint32, _F3, _c.c_float, _F3]),
+    "fc_cloth_add_plane": (_c.c_int, [_P, _F3, _F3, _F3, _U32P]),
+    "fc_cloth_set_plane": (_c.c_int, [_P, _c.c_uint32, _F3, _F3, _F3]),
+    "fc_cloth_add_capsule": (_c.c_int, [_P, _F3, _F3, _c.c_float, _F3, _U32P]),
+    "fc_cloth_set_capsule": (_c.c_int, [_P, _c.c_uint32, _F3, _F3, _c.c_float, _F3]),
+    "fc_cloth_set_collider_friction": (_c.c_int, [_P, _c.c_uint32, _c.c_float]),
+    "fc_cloth_remove_collider": (_c.c_int, [_P, _c.c_uint32]),
+    "fc_cloth_write_obj": (_c.c_int, [_P, _c.c_char_p]),
+    "fc_cache_open": (
+        _c.c_int,
+        [_c.c_char_p, _c.c_uint32, _P, _c.c_double, _c.c_double, _c.c_uint32, _c.POINTER(_P)],
+    ),
+    "fc_cache_write_frame": (_c.c_int, [_P, _P]),
+    "fc_cache_close": (_c.c_int, [_P]),
+}
+for _name, (_res, _args) in _SIGNATURES.items():
+    _fn = getattr(library, _name)
+    _fn.restype = _res
+    _fn.argtypes = _args
+
+
+class Error(RuntimeError):
+    """A failed call: `status` (an FcStatus value) and the library's message."""
+
+    def __init__(self, status: int, message: str):
+        name = library.fc_status_string(status).decode()
+        super().__init__(f"{name}: {message}")
+        self.status = status
+        self.message = message
+
+
+def _check(status: int) -> None:
+    if status != 0:
+        raise Error(status, library.fc_last_error_message().decode(errors="replace"))
+
+
+def _floats(values, shape_last: Optional[int] = 3) -> np.ndarray:
+    a = np.ascontiguousarray(values, dtype=np.float32)
+    if shape_last is not None and a.size % shape_last != 0:
+        raise ValueError(f"expected a multiple of {shape_last} floats, got {a.size}")
+    return a
+
+
+def _u32(values) -> np.ndarray:
+    a = np.asarray(values)
+    if a.size and (a.min() < 0 or a.max() > 0xFFFFFFFF):
+        raise ValueError("indices must be in 0 .. 2^32 - 1")
+    return np.ascontiguousarray(a, dtype=np.uint32)
+
+
+def _fp(a: np.ndarray):
+    return a.ctypes.data_as(_F3)
+
+
+def _up(a: np.ndarray):
+    return a.ctypes.data_as(_U32P)
+
+
+def _vec3(v) -> np.ndarray:
+    a = _floats(v)
+    if a.size != 3:
+        raise ValueError(f"expected 3 floats, got {a.size}")
+    return a
+
+
+def _vel(v):
+    return None if v is None else _fp(_vec3(v))
+
+
+def default_desc() -> FcClothDesc:
+    """The library's default description (61 x 41 grid of 1 cm, fractional model, SOE history)."""
+    return library.fc_cloth_desc_default()
+
+
+def preset_desc(preset: int) -> FcClothDesc:
+    """A preset description (PRESET_FRACTIONAL_PAPER, PRESET_REGULAR_*)."""
+    d = FcClothDesc()
+    _check(library.fc_cloth_desc_preset(preset, ctypes.byref(d)))
+    return d
+
+
+class Cloth:
+    """One simulated cloth. Free it with `close()` or a `with` block (or let it be collected)."""
+
+    def __init__(self, handle: int):
+        self._h = ctypes.c_void_p(handle)
+
+    @classmethod
+    def grid(cls, desc: Optional[FcClothDesc] = None) -> "Cloth":
+        desc = default_desc() if desc is None else desc
+        h = ctypes.c_void_p()
+        _check(library.fc_cloth_create_grid(ctypes.byref(desc), ctypes.byref(h)))
+        return cls(h.value)
+
+    @classmethod
+    def mesh(cls, desc: Optional[FcClothDesc], positions, faces) -> "Cloth":
+        """A cloth from a mesh: positions (N, 3) in m, faces (M, 3) triangles or (M, 4) quads."""
+        desc = default_desc() if desc is None else desc
+        x = _floats(positions)
+        f = _u32(faces)
+        if f.ndim != 2 or f.shape[1] not in (3, 4):
+            raise ValueError("faces must have shape (M, 3) or (M, 4)")
+        h = ctypes.c_void_p()
+        _check(
+            library.fc_cloth_create_mesh(
+                ctypes.byref(desc), _fp(x), x.size // 3, _up(f), f.size, f.shape[1], ctypes.byref(h)
+            )
+        )
+        return cls(h.value)
+
+    def close(self) -> None:
+        if self._h:
+            library.fc_cloth_destroy(self._h)
+            self._h = ctypes.c_void_p()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown
+            pass
+
+    @property
+    def handle(self) -> ctypes.c_void_p:
+        return self._h
+
+    @property
+    def vertex_count(self) -> int:
+        return library.fc_cloth_vertex_count(self._h)
+
+    @property
+    def time(self) -> float:
+        return library.fc_cloth_time(self._h)
+
+    @property
+    def history_mode_count(self) -> int:
+        return library.fc_cloth_history_mode_count(self._h)
+
+    @property
+    def positions(self) -> np.ndarray:
+        out = np.empty((self.vertex_count, 3), dtype=np.float32)
+        _check(library.fc_cloth_get_positions(self._h, _fp(out), out.size))
+        return out
+
+    @positions.setter
+    def positions(self, xyz) -> None:
+        a = _floats(xyz)
+        _check(library.fc_cloth_set_positions(self._h, _fp(a), a.size))
+
+    @property
+    def velocities(self) -> np.ndarray:
+        out = np.empty((self.vertex_count, 3), dtype=np.float32)
+        _check(library.fc_cloth_get_velocities(self._h, _fp(out), out.size))
+        return out
+
+    def set_pinned(self, indices: Iterable[int]) -> None:
+        a = _u32(list(indices) if not isinstance(indices, np.ndarray) else indices)
+        _check(library.fc_cloth_set_pinned(self._h, _up(a), a.size))
+
+    def set_pin_weights(self, weights) -> None:
+        a = _floats(weights, None)
+        _check(library.fc_cloth_set_pin_weights(self._h, _fp(a), a.size))
+
+    def pin_group(self, indices, weight: float = 1.0) -> None:
+        a = _u32(indices)
+        _check(library.fc_cloth_pin_group(self._h, _up(a), a.size, weight))
+
+    def set_pin_targets(self, indices, targets) -> None:
+        i = _u32(indices)
+        t = _floats(targets)
+        if t.size != 3 * i.size:
+            raise ValueError("need one (x, y, z) target per index")
+        _check(library.fc_cloth_set_pin_targets(self._h, _up(i), _fp(t), i.size))
+
+    def set_current(self, current: Sequence[float]) -> None:
+        _check(library.fc_cloth_set_current(self._h, _fp(_vec3(current))))
+
+    def step(self, dt: float) -> None:
+        _check(library.fc_cloth_step(self._h, dt))
+
+    def step_substeps(self, dt: float, substeps: int) -> None:
+        _check(library.fc_cloth_step_substeps(self._h, dt, substeps))
+
+    def _add(self, fn, *args) -> int:
+        out = ctypes.c_uint32()
+        _check(fn(self._h, *args, ctypes.byref(out)))
+        return out.value
+
+    def add_sphere(self, center, radius: float, velocity=None) -> int:
+        return self._add(library.fc_cloth_add_sphere, _fp(_vec3(center)), radius, _vel(velocity))
+
+    def set_sphere(self, id: int, center, radius: float, velocity=None) -> None:
+        _check(library.fc_cloth_set_sphere(self._h, id, _fp(_vec3(center)), radius, _vel(velocity)))
+
+    def add_plane(self, point, normal, velocity=None) -> int:
+        return self._add(library.fc_cloth_add_plane, _fp(_vec3(point)), _fp(_vec3(normal)), _vel(velocity))
+
+    def set_plane(self, id: int, point, normal, velocity=None) -> None:
+        _check(library.fc_cloth_set_plane(self._h, id, _fp(_vec3(point)), _fp(_vec3(normal)), _vel(velocity)))
+
+    def add_capsule(self, a, b, radius: float, velocity=None) -> int:
+        return self._add(library.fc_cloth_add_capsule, _fp(_vec3(a)), _fp(_vec3(b)), radius, _vel(velocity))
+
+    def set_capsule(self, id: int, a, b, radius: float, velocity=None) -> None:
+        _check(library.fc_cloth_set_capsule(self._h, id, _fp(_vec3(a)), _fp(_vec3(b)), radius, _vel(velocity)))
+
+    def set_collider_friction(self, id: int, friction: float) -> None:
+        _check(library.fc_cloth_set_collider_friction(self._h, id, friction))
+
+    def remove_collider(self, id: int) -> None:
+        _check(library.fc_cloth_remove_collider(self._h, id))
+
+    def write_obj(self, path) -> None:
+        _check(library.fc_cloth_write_obj(self._h, os.fsencode(str(path))))
+
+
+class Cache:
+    """A point cache written frame by frame (`CACHE_PC2`, `CACHE_MDD`, `CACHE_OBJ_SEQUENCE`)."""
+
+    def __init__(self, path, format: int, cloth: Cloth, start_frame: float = 1.0,
+                 frames_per_second: float = 24.0, expected_frames: int = 0):
+        self._h = ctypes.c_void_p()
+        _check(
+            library.fc_cache_open(
+                os.fsencode(str(path)), format, cloth.handle, start_frame, frames_per_second,
+                expected_frames, ctypes.byref(self._h),
+            )
+        )
+
+    def write_frame(self, cloth: Cloth) -> None:
+        _check(library.fc_cache_write_frame(self._h, cloth.handle))
+
+    def close(self) -> None:
+        h, self._h = self._h, ctypes.c_void_p()
+        if h:
+            _check(library.fc_cache_close(h))
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+def version() -> str:
+    """The library's version, "major.minor.patch"."""
+    v = library.fc_version()
+    return f"{v // 1000000}.{v // 1000 % 1000}.{v % 1000}"

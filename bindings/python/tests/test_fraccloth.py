@@ -1,0 +1,144 @@
+"""Tests of the Python bindings: against the C example's output, numpy round trips, errors,
+meshes, colliders and caches."""
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import fraccloth
+
+REPO = Path(__file__).resolve().parents[3]
+
+
+def lib_dir() -> Path:
+    return Path(fraccloth.library._name).parent
+
+
+def compile_c(source: str, tmp_path: Path) -> Path:
+    cc = shutil.which("cc") or shutil.which("gcc")
+    if cc is None:
+        pytest.skip("no C compiler")
+    exe = tmp_path / Path(source).stem
+    header_dir = tmp_path / "include"
+    header_dir.mkdir(exist_ok=True)
+    # The header packaged with the library (identical to include/fraccloth.h).
+    shutil.copy2(lib_dir() / "fraccloth.h" if (lib_dir() / "fraccloth.h").exists() else REPO / "include" / "fraccloth.h",
+                 header_dir / "fraccloth.h")
+    lib = Path(fraccloth.library._name)
+    subprocess.run(
+        [cc, "-std=c99", "-Wall", "-Wextra", "-Werror", "-I", str(header_dir), str(REPO / "examples_c" / source),
+         "-o", str(exe), str(lib), f"-Wl,-rpath,{lib.parent}", "-lm"],
+        check=True,
+    )
+    return exe
+
+
+def test_hello_matches_the_c_example(tmp_path):
+    out = subprocess.run([str(compile_c("hello.c", tmp_path))], check=True, capture_output=True, text=True).stdout
+    corner = next(l for l in out.splitlines() if l.startswith("corner")).split()
+    desc = fraccloth.default_desc()
+    with fraccloth.Cloth.grid(desc) as cloth:
+        cloth.set_pinned(range(desc.width))
+        for _ in range(2000):
+            cloth.step(5e-4)
+        x = cloth.positions
+    k = int(corner[1])
+    assert k == cloth_vertex_count(desc) - desc.width
+    # The C program prints with %.9g: parsing gives back the float exactly.
+    assert [np.float32(v) for v in corner[2:5]] == list(x[k])
+
+
+def cloth_vertex_count(desc) -> int:
+    return desc.width * desc.height
+
+
+def test_swing_pc2_matches_the_c_example(tmp_path):
+    """examples_c/swing.c bakes the paper's swing to PC2; the same loop from Python
+    (mirrored line by line below) gives the same floats."""
+    exe = compile_c("swing.c", tmp_path)
+    pc2 = tmp_path / "swing.pc2"
+    subprocess.run([str(exe), str(pc2), "1.0"], check=True, capture_output=True)
+    data = pc2.read_bytes()
+    n = int(np.frombuffer(data[16:20], "<i4")[0])
+    frames = int(np.frombuffer(data[28:32], "<i4")[0])
+    c_frames = np.frombuffer(data[32:], "<f4").reshape(frames, n, 3)
+
+    amplitude, frequency, dt, fps, seconds = 0.08, 0.5, 5e-4, 30, 1.0
+    desc = fraccloth.preset_desc(fraccloth.PRESET_FRACTIONAL_PAPER)
+    mine = []
+    with fraccloth.Cloth.grid(desc) as cloth:
+        w = desc.width
+        top = np.arange(w)
+        rest = cloth.positions[:w].copy()
+        cloth.set_pinned(top)
+        steps = round(seconds / dt)
+        k = 0
+        for s in range(steps + 1):
+            if s == round(k / (fps * dt)):
+                mine.append(cloth.positions)
+                k += 1
+            if s == steps:
+                break
+            z = amplitude * np.sin(2.0 * 3.14159265358979323846 * frequency * (s + 1) * dt)
+            target = rest.copy()
+            target[:, 2] = rest[:, 2] + np.float32(z)
+            cloth.set_pin_targets(top, target)
+            cloth.step(dt)
+    assert len(mine) == frames
+    assert np.array_equal(np.array(mine), c_frames)
+
+
+def test_errors_raise_and_leave_the_cloth_alone():
+    with fraccloth.Cloth.grid() as cloth:
+        before = cloth.positions
+        with pytest.raises(fraccloth.Error) as e:
+            cloth.step(-1.0)
+        assert e.value.status == 2 and "dt" in e.value.message
+        with pytest.raises(fraccloth.Error) as e:
+            cloth.set_pinned([10**6])
+        assert e.value.status == 3
+        assert np.array_equal(cloth.positions, before)
+        with pytest.raises(ValueError):
+            cloth.set_current([1.0, 2.0])
+
+
+def test_mesh_colliders_and_caches(tmp_path):
+    w, h = 9, 7
+    xs, ys = np.meshgrid(np.arange(w) * 0.02, -np.arange(h) * 0.02)
+    pos = np.stack([xs.ravel(), ys.ravel(), np.zeros(w * h)], axis=1)
+    quads = [[j * w + i, (j + 1) * w + i, (j + 1) * w + i + 1, j * w + i + 1] for j in range(h - 1) for i in range(w - 1)]
+    with fraccloth.Cloth.mesh(None, pos, quads) as cloth:
+        assert cloth.vertex_count == w * h
+        cloth.pin_group(range(w), 1.0)
+        cloth.set_current([0.0, 0.0, 0.2])
+        plane = cloth.add_plane([0, -0.2, 0], [0, 1, 0])
+        cap = cloth.add_capsule([0, -0.1, 0.05], [0.2, -0.1, 0.05], 0.02)
+        cloth.set_collider_friction(cap, 0.4)
+        cloth.remove_collider(plane)
+        mdd = tmp_path / "m.mdd"
+        with fraccloth.Cache(mdd, fraccloth.CACHE_MDD, cloth, 1.0, 24.0, expected_frames=3) as cache:
+            frames = []
+            for _ in range(3):
+                for _ in range(20):
+                    cloth.step(1e-3)
+                cache.write_frame(cloth)
+                frames.append(cloth.positions)
+        data = mdd.read_bytes()
+        assert np.frombuffer(data[:8], ">i4").tolist() == [3, w * h]
+        assert np.array_equal(np.frombuffer(data[20:], ">f4").reshape(3, w * h, 3), np.array(frames))
+    with pytest.raises(fraccloth.Error) as e:
+        fraccloth.Cloth.mesh(None, pos, [[0, 1, 99]])
+    assert e.value.status == 3 and "99" in e.value.message
+
+
+def test_description_layout_matches_the_library():
+    d = fraccloth.default_desc()
+    assert (d.width, d.height) == (61, 41)
+    assert d.history_scheme == fraccloth.HISTORY_SOE
+    p = fraccloth.preset_desc(fraccloth.PRESET_FRACTIONAL_PAPER)
+    assert (p.history_scheme, p.history_u) == (fraccloth.HISTORY_TRUNCATED, 3)
+    assert fraccloth.version().count(".") == 2
