@@ -6,6 +6,10 @@
 //! than [`ClothConfig::max_speed`] (an underwater cloth never moves at 100 m/s; a
 //! state that does has exploded).
 
+mod snapshot;
+
+pub use snapshot::SNAPSHOT_VERSION;
+
 use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
 use crate::forces::{self, Collider, ForceInput, ForceScratch, Plane, Sphere};
 use crate::history::{HalfDerivative, History, Scheme};

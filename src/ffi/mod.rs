@@ -21,6 +21,7 @@ pub mod cloth;
 pub mod collider;
 pub mod desc;
 pub mod mesh;
+pub mod snapshot;
 pub mod version;
 
 pub use cache::*;
@@ -28,5 +29,6 @@ pub use cloth::*;
 pub use collider::*;
 pub use desc::*;
 pub use mesh::*;
+pub use snapshot::*;
 pub use status::*;
 pub use version::*;

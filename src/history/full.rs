@@ -67,6 +67,23 @@ impl Full {
     pub fn is_empty(&self) -> bool {
         self.times.is_empty()
     }
+
+    /// Writes the state a later step depends on (weights are recomputed by `prepare`).
+    pub(crate) fn write_state(&self, w: &mut crate::bytes::ByteWriter) {
+        w.f64s(&self.times);
+        w.vec3s(&self.samples);
+        w.f64(self.now);
+    }
+
+    /// Reads what `write_state` wrote, for the same particle count.
+    pub(crate) fn read_state(&mut self, r: &mut crate::bytes::ByteReader<'_>) -> Result<(), crate::Error> {
+        r.f64s_into(None, &mut self.times)?;
+        r.vec3s_into(Some(self.times.len() * self.n), &mut self.samples)?;
+        self.now = r.f64()?;
+        self.weights.clear();
+        self.w0 = 0.0;
+        Ok(())
+    }
 }
 
 impl HalfDerivative for Full {

@@ -204,6 +204,36 @@ impl History {
         matches!(self, History::Off)
     }
 
+    /// Tag of the scheme held (0 off, 1 truncated, 2 full, 3 SOE), for snapshots.
+    pub(crate) fn tag(&self) -> u8 {
+        match self {
+            History::Off => 0,
+            History::Truncated(_) => 1,
+            History::Full(_) => 2,
+            History::SumOfExponentials(_) => 3,
+        }
+    }
+
+    /// Writes the state (see each scheme's `write_state`).
+    pub(crate) fn write_state(&self, w: &mut crate::bytes::ByteWriter) {
+        match self {
+            History::Off => {}
+            History::Truncated(s) => s.write_state(w),
+            History::Full(s) => s.write_state(w),
+            History::SumOfExponentials(s) => s.write_state(w),
+        }
+    }
+
+    /// Reads a state written by `write_state` of a history of the same scheme and size.
+    pub(crate) fn read_state(&mut self, r: &mut crate::bytes::ByteReader<'_>) -> Result<(), Error> {
+        match self {
+            History::Off => Ok(()),
+            History::Truncated(s) => s.read_state(r),
+            History::Full(s) => s.read_state(r),
+            History::SumOfExponentials(s) => s.read_state(r),
+        }
+    }
+
     /// Exponential modes in use (SOE only; 0 otherwise).
     pub fn mode_count(&self) -> usize {
         match self {

@@ -155,6 +155,26 @@ impl SumOfExponentials {
     pub fn kernel(&self) -> &SoeKernel {
         &self.kernel
     }
+
+    /// Writes the state a later step depends on (the step weights are recomputed by `prepare`).
+    pub(crate) fn write_state(&self, w: &mut crate::bytes::ByteWriter) {
+        w.f64s(&self.modes);
+        w.vec3s(&self.prev);
+        w.vec3s(&self.pending);
+        w.u8(u8::from(self.has_prev));
+        w.f64(self.gap);
+    }
+
+    /// Reads what `write_state` wrote, for the same kernel and particle count.
+    pub(crate) fn read_state(&mut self, r: &mut crate::bytes::ByteReader<'_>) -> Result<(), crate::Error> {
+        let modes = self.modes.len();
+        r.f64s_into(Some(modes), &mut self.modes)?;
+        r.vec3s_into(Some(self.n), &mut self.prev)?;
+        r.vec3s_into(Some(self.n), &mut self.pending)?;
+        self.has_prev = r.u8()? != 0;
+        self.gap = r.f64()?;
+        Ok(())
+    }
 }
 
 impl HalfDerivative for SumOfExponentials {

@@ -112,6 +112,30 @@ impl Truncated {
         self.u
     }
 
+    /// Writes the state a later step depends on (weights are recomputed by `prepare`).
+    pub(crate) fn write_state(&self, w: &mut crate::bytes::ByteWriter) {
+        w.vec3s(&self.slots);
+        w.u64(self.head as u64);
+        w.u64(self.pushed);
+        w.f64(self.h);
+    }
+
+    /// Reads what `write_state` wrote, for the same u and particle count.
+    pub(crate) fn read_state(&mut self, r: &mut crate::bytes::ByteReader<'_>) -> Result<(), crate::Error> {
+        r.vec3s_into(Some(self.u * self.n), &mut self.slots)?;
+        let head = r.u64()?;
+        if head >= self.u as u64 {
+            return Err(crate::Error::invalid(
+                "snapshot: truncated history head out of range",
+            ));
+        }
+        self.head = head as usize;
+        self.pushed = r.u64()?;
+        self.h = r.f64()?;
+        self.weights.clear();
+        Ok(())
+    }
+
     fn slot(&self, k: usize) -> &[Vec3] {
         let s = (self.head + self.u - k) % self.u;
         &self.slots[s * self.n..(s + 1) * self.n]

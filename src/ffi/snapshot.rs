@@ -1,0 +1,79 @@
+//! Snapshots through the ABI: save a cloth's complete state to a caller buffer and restore it.
+
+use std::ffi::c_void;
+
+use super::cloth::{handle, handle_mut, slice_in, FcCloth};
+use super::status::{guard, guard_value, FcStatus, FfiError};
+
+/// Bytes `fc_cloth_save_snapshot` needs now (it grows with the history for `FC_HISTORY_FULL`;
+/// constant otherwise). 0 for NULL.
+///
+/// # Safety
+/// `cloth` NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_snapshot_size(cloth: *const FcCloth) -> usize {
+    // SAFETY: forwarded caller promise.
+    guard_value(0, || unsafe { handle(cloth) }.map_or(0, |c| c.snapshot_size()))
+}
+
+/// Writes the cloth's complete state (positions, velocities, pins and targets, colliders with
+/// friction, current, solver settings, time, and the fractional history) into `buffer`:
+/// a versioned, CRC-32-checked binary snapshot. `capacity` is the buffer size in bytes; the
+/// size written goes to `*out_written` (may be NULL). A buffer smaller than
+/// `fc_cloth_snapshot_size` gives `FC_ERROR_INVALID_ARGUMENT` and writes nothing.
+///
+/// # Safety
+/// `cloth` NULL or live; `buffer` NULL or `capacity` writable bytes; `out_written` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_save_snapshot(
+    cloth: *const FcCloth,
+    buffer: *mut c_void,
+    capacity: usize,
+    out_written: *mut usize,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle(cloth) }?;
+        if buffer.is_null() {
+            return Err(FfiError::null("buffer"));
+        }
+        let bytes = cloth.save_snapshot();
+        if bytes.len() > capacity {
+            return Err(FfiError::invalid(format!(
+                "snapshot needs {} bytes, buffer has {capacity}",
+                bytes.len()
+            )));
+        }
+        // SAFETY: non-NULL; the caller promises `capacity` >= bytes.len() writable bytes.
+        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), buffer.cast::<u8>(), bytes.len()) };
+        if !out_written.is_null() {
+            // SAFETY: non-NULL; the caller promises it is writable.
+            unsafe { *out_written = bytes.len() };
+        }
+        Ok(())
+    })
+}
+
+/// Restores a snapshot saved from a cloth of the same mesh and history settings. Stepping on
+/// gives bitwise the same results as the saved cloth would have. A truncated, corrupted or
+/// foreign snapshot gives `FC_ERROR_INVALID_ARGUMENT` (the message says why) and leaves the
+/// cloth exactly as it was.
+///
+/// # Safety
+/// `cloth` NULL or live; `data` NULL or `size` readable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_load_snapshot(
+    cloth: *mut FcCloth,
+    data: *const c_void,
+    size: usize,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        if data.is_null() {
+            return Err(FfiError::null("data"));
+        }
+        let bytes = unsafe { slice_in(data.cast::<u8>(), size, "data") }?;
+        Ok(cloth.load_snapshot(bytes)?)
+    })
+}
