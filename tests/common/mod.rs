@@ -37,6 +37,13 @@ pub fn compile_c(source: &str, out_dir: &Path) -> PathBuf {
     compile("cc", &["-std=c99"], "examples_c", source, out_dir)
 }
 
+/// As [`compile_c`], with extra flags (e.g. sanitizers); the executable is `out_dir/stem`.
+pub fn compile_c_with(source: &str, flags: &[&str], out_dir: &Path) -> PathBuf {
+    let mut all = vec!["-std=c99"];
+    all.extend_from_slice(flags);
+    compile("cc", &all, "examples_c", source, out_dir)
+}
+
 /// Compiles one C++ file from `examples_cpp/` against `bindings/cpp/fraccloth.hpp` with
 /// `c++ -std=c++17 -Wall -Wextra -Werror`.
 pub fn compile_cpp(source: &str, out_dir: &Path) -> PathBuf {
