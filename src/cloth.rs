@@ -525,6 +525,7 @@ impl Cloth {
     /// One step of size `h`. Pins go to `pin_start + fraction (target - pin_start)`, or to
     /// their targets when `fraction` is None.
     fn advance(&mut self, h: f64, fraction: Option<f64>) -> Result<(), Error> {
+        self.history.reserve_step()?;
         let n = self.vertex_count();
         let s = &mut self.scratch;
         for buf in [

@@ -68,6 +68,28 @@ impl Full {
         self.times.is_empty()
     }
 
+    /// Makes room for one more step, or says why there is none: the history may not exceed
+    /// [`super::MAX_HISTORY_BYTES`], and a failed allocation is an error, not an abort.
+    pub(crate) fn reserve_step(&mut self) -> Result<(), crate::Error> {
+        self.reserve_within(super::MAX_HISTORY_BYTES)
+    }
+
+    fn reserve_within(&mut self, limit: u64) -> Result<(), crate::Error> {
+        let bytes = (self.times.len() as u64 + 1)
+            .saturating_mul(self.n as u64)
+            .saturating_mul(std::mem::size_of::<Vec3>() as u64);
+        if bytes > limit {
+            return Err(crate::Error::invalid(format!(
+                "the full history would exceed {limit} bytes after {} steps; use the SOE history for long runs",
+                self.times.len()
+            )));
+        }
+        let room = |e| crate::Error::invalid(format!("out of memory for the full history: {e}"));
+        self.samples.try_reserve(self.n).map_err(room)?;
+        self.times.try_reserve(1).map_err(room)?;
+        Ok(())
+    }
+
     /// Writes the state a later step depends on (weights are recomputed by `prepare`).
     pub(crate) fn write_state(&self, w: &mut crate::bytes::ByteWriter) {
         w.f64s(&self.times);
@@ -140,5 +162,24 @@ impl HalfDerivative for Full {
         self.weights.clear();
         self.w0 = 0.0;
         self.now = 0.0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn growth_stops_at_the_byte_limit_with_an_error() {
+        let mut f = Full::new(10);
+        let v = vec![Vec3::zeros(); 10];
+        let limit = 3 * 10 * 24;
+        for _ in 0..3 {
+            f.reserve_within(limit).unwrap();
+            f.push(&v, 1e-3);
+        }
+        let e = f.reserve_within(limit).unwrap_err();
+        assert!(e.message.contains("SOE"), "{}", e.message);
+        assert_eq!(f.len(), 3);
     }
 }

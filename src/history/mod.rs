@@ -214,6 +214,14 @@ impl History {
         }
     }
 
+    /// Makes room for the next step's history (only `Full` grows); an error when it may not.
+    pub(crate) fn reserve_step(&mut self) -> Result<(), Error> {
+        match self {
+            History::Full(s) => s.reserve_step(),
+            _ => Ok(()),
+        }
+    }
+
     /// Writes the state (see each scheme's `write_state`).
     pub(crate) fn write_state(&self, w: &mut crate::bytes::ByteWriter) {
         match self {
