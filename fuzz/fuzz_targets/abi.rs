@@ -139,11 +139,14 @@ fuzz_target!(|data: &[u8]| {
                     let xyz = b.floats(3 * n);
                     let faces = usize::from(b.u8() % 30);
                     let face_size = u32::from(b.u8() % 6);
-                    let idx: Vec<u32> = (0..faces * 4).map(|_| u32::from(b.u8()) % (n as u32 + 2)).collect();
+                    let idx: Vec<u32> = (0..faces * 4)
+                        .map(|_| u32::from(b.u8()) % (n as u32 + 2))
+                        .collect();
                     let count = b.len(idx.len());
                     let count = count.min(idx.len());
                     let mut out = null_mut();
-                    let s = fc_cloth_create_mesh(&d, xyz.as_ptr(), n, idx.as_ptr(), count, face_size, &mut out);
+                    let s =
+                        fc_cloth_create_mesh(&d, xyz.as_ptr(), n, idx.as_ptr(), count, face_size, &mut out);
                     if s == FcStatus::FC_OK {
                         cloths.push(out);
                     }
@@ -174,8 +177,14 @@ fuzz_target!(|data: &[u8]| {
                 }
                 7 => {
                     let k = usize::from(b.u8() % 40);
-                    let idx: Vec<u32> = (0..k).map(|_| u32::from(b.u8()) * if pick % 5 == 0 { 1 << 20 } else { 1 }).collect();
-                    let _ = fc_cloth_set_pinned(c, if pick % 9 == 0 { null() } else { idx.as_ptr() }, b.len(idx.len()).min(idx.len()));
+                    let idx: Vec<u32> = (0..k)
+                        .map(|_| u32::from(b.u8()) * if pick % 5 == 0 { 1 << 20 } else { 1 })
+                        .collect();
+                    let _ = fc_cloth_set_pinned(
+                        c,
+                        if pick % 9 == 0 { null() } else { idx.as_ptr() },
+                        b.len(idx.len()).min(idx.len()),
+                    );
                 }
                 8 => {
                     let k = usize::from(b.u8() % 20);
@@ -203,7 +212,15 @@ fuzz_target!(|data: &[u8]| {
                     let mut out = vec![0f32; 3 * n + 3];
                     let len = b.len(3 * n).min(out.len());
                     let _ = fc_cloth_get_positions(c, out.as_mut_ptr(), len);
-                    let _ = fc_cloth_get_velocities(c, if pick % 3 == 0 { null_mut() } else { out.as_mut_ptr() }, len);
+                    let _ = fc_cloth_get_velocities(
+                        c,
+                        if pick % 3 == 0 {
+                            null_mut()
+                        } else {
+                            out.as_mut_ptr()
+                        },
+                        len,
+                    );
                 }
                 13 => {
                     let xyz = b.floats(3);
@@ -240,7 +257,9 @@ fuzz_target!(|data: &[u8]| {
                         let mut buf = vec![0u8; size];
                         let cap = b.len(size).min(size);
                         let mut written = 0;
-                        if fc_cloth_save_snapshot(c, buf.as_mut_ptr().cast::<c_void>(), cap, &mut written) == FcStatus::FC_OK {
+                        if fc_cloth_save_snapshot(c, buf.as_mut_ptr().cast::<c_void>(), cap, &mut written)
+                            == FcStatus::FC_OK
+                        {
                             buf.truncate(written);
                             snapshot = buf;
                         }
@@ -266,7 +285,17 @@ fuzz_target!(|data: &[u8]| {
                 20 => {
                     let mut cache = null_mut();
                     let format = u32::from(b.u8() % 4);
-                    if format != 2 && fc_cache_open(cache_path.as_ptr(), format, c, b.f64(), b.f64(), u32::from(b.u8() % 4), &mut cache) == FcStatus::FC_OK {
+                    if format != 2
+                        && fc_cache_open(
+                            cache_path.as_ptr(),
+                            format,
+                            c,
+                            b.f64(),
+                            b.f64(),
+                            u32::from(b.u8() % 4),
+                            &mut cache,
+                        ) == FcStatus::FC_OK
+                    {
                         for _ in 0..b.u8() % 6 {
                             let _ = fc_cache_write_frame(cache, c);
                         }
@@ -283,7 +312,10 @@ fuzz_target!(|data: &[u8]| {
                 }
                 22 => {
                     let mut d = fc_cloth_desc_default();
-                    let _ = fc_cloth_desc_preset(u32::from(b.u8() % 6), if pick % 5 == 0 { null_mut() } else { &mut d });
+                    let _ = fc_cloth_desc_preset(
+                        u32::from(b.u8() % 6),
+                        if pick % 5 == 0 { null_mut() } else { &mut d },
+                    );
                 }
                 _ => {
                     // A failed call must leave a handle usable: a sane step on every live cloth.
