@@ -73,13 +73,7 @@ impl MddWriter {
                 format!("the MDD cache was opened for {} frames", self.expected),
             ));
         }
-        let mut buf = Vec::with_capacity(12 * positions.len());
-        for p in positions {
-            for c in p.iter() {
-                buf.extend_from_slice(&(*c as f32).to_be_bytes());
-            }
-        }
-        self.out.write_all(&buf)?;
+        self.out.write_all(&super::encode_frame(positions, true))?;
         self.written += 1;
         Ok(())
     }

@@ -42,13 +42,7 @@ impl<W: Write + Seek> Pc2Writer<W> {
         if positions.len() != self.vertex_count {
             return Err(io::Error::new(io::ErrorKind::InvalidInput, "wrong vertex count"));
         }
-        let mut buf = Vec::with_capacity(12 * positions.len());
-        for p in positions {
-            for c in p.iter() {
-                buf.extend_from_slice(&(*c as f32).to_le_bytes());
-            }
-        }
-        self.out.write_all(&buf)?;
+        self.out.write_all(&super::encode_frame(positions, false))?;
         self.samples += 1;
         Ok(())
     }

@@ -90,12 +90,20 @@ pub unsafe extern "C" fn fc_cloth_create_grid(
         let desc = unsafe { desc.as_ref() }.ok_or_else(|| FfiError::null("desc"))?;
         let config = desc.config()?;
         let topology = desc.grid_spec().build()?;
-        let cloth = Cloth::new(topology, config)?;
-        let raw = Box::into_raw(Box::new(FcCloth { cloth }));
         // SAFETY: checked non-NULL; the caller promises it is writable.
-        unsafe { *out_cloth = raw };
+        unsafe { hand_out(Cloth::new(topology, config)?, out_cloth) };
         Ok(())
     })
+}
+
+/// Boxes `cloth` and writes the handle to `*out`.
+///
+/// # Safety
+/// `out` must be non-NULL and writable.
+pub(crate) unsafe fn hand_out(cloth: Cloth, out: *mut *mut FcCloth) {
+    let raw = Box::into_raw(Box::new(FcCloth { cloth }));
+    // SAFETY: the caller promises `out` is non-NULL and writable.
+    unsafe { *out = raw };
 }
 
 /// Frees a cloth. NULL is fine. Using the handle afterwards is the host's bug.

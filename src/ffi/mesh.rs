@@ -3,7 +3,7 @@
 use crate::topology::{MeshMass, MeshSpec};
 use crate::Cloth;
 
-use super::cloth::{slice_in, triples, FcCloth};
+use super::cloth::{hand_out, slice_in, triples, FcCloth};
 use super::desc::FcClothDesc;
 use super::status::{guard, FcStatus, FfiError};
 
@@ -68,10 +68,8 @@ pub unsafe extern "C" fn fc_cloth_create_mesh(
             mass,
         }
         .build()?;
-        let cloth = Cloth::new(topology, config)?;
-        let raw = Box::into_raw(Box::new(FcCloth { cloth }));
         // SAFETY: checked non-NULL; the caller promises it is writable.
-        unsafe { *out_cloth = raw };
+        unsafe { hand_out(Cloth::new(topology, config)?, out_cloth) };
         Ok(())
     })
 }
