@@ -1,7 +1,7 @@
 //! Memory checking of the C ABI from C: every C example and a stress program
 //! (`examples_c/stress.c`: every call, good and bad arguments, caches, snapshots, thousands of
 //! checks) built with AddressSanitizer + UndefinedBehaviorSanitizer (leak checking on) must run
-//! clean; the stress program and `bad_input.c` must also run clean under valgrind memcheck
+//! clean; the stress program and every C example must also run clean under valgrind memcheck
 //! (zero errors, zero definite/indirect/possible leaks). The library itself is the normal
 //! build: ASan checks what it does to the heap through malloc, valgrind checks every access.
 //!
@@ -81,6 +81,11 @@ fn c_programs_under_valgrind_memcheck() {
     for (source, args) in [
         ("stress.c", vec![dir.to_str().unwrap().to_string(), "1".into()]),
         ("bad_input.c", vec![]),
+        ("hello.c", vec![]),
+        (
+            "swing.c",
+            vec![dir.join("s.pc2").to_str().unwrap().to_string(), "0.2".into()],
+        ),
     ] {
         let exe = compile_c_with(source, &["-g"], &dir);
         let out = Command::new("valgrind")
