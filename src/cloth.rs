@@ -584,24 +584,22 @@ impl Cloth {
         forces::accumulate(&input, &mut s.forces, &mut s.force);
         let masses = &self.topology.masses;
         match self.config.integrator {
-            Integrator::ExplicitEuler => explicit_euler(
-                h,
-                &self.x,
-                &s.v_step,
-                &s.force,
-                masses,
-                &mut s.x_new,
-                &mut s.v_new,
-            ),
-            Integrator::SymplecticEuler => symplectic_euler(
-                h,
-                &self.x,
-                &s.v_step,
-                &s.force,
-                masses,
-                &mut s.x_new,
-                &mut s.v_new,
-            ),
+            Integrator::ExplicitEuler | Integrator::SymplecticEuler => {
+                let step = if self.config.integrator == Integrator::ExplicitEuler {
+                    explicit_euler
+                } else {
+                    symplectic_euler
+                };
+                step(
+                    h,
+                    &self.x,
+                    &s.v_step,
+                    &s.force,
+                    masses,
+                    &mut s.x_new,
+                    &mut s.v_new,
+                )
+            }
             Integrator::ImplicitEuler => {
                 forces::linearise(&input, w0, s.forces.normals(), &mut s.implicit.lin);
                 let inp = ImplicitInput {

@@ -24,7 +24,7 @@ use super::{check_weight, checked_collider, Cloth};
 use crate::bytes::{ByteReader, ByteWriter};
 use crate::error::{check_finite_vec, Error};
 use crate::forces::{Capsule, Collider, Plane, Sphere};
-use crate::history::{HalfDerivative, History, Scheme};
+use crate::history::{History, Scheme};
 use crate::integrate::SolverSettings;
 
 const MAGIC: &[u8; 8] = b"FCSNAP\0\0";
@@ -293,9 +293,6 @@ impl Cloth {
             return Err(Error::invalid(
                 "snapshot: pin list does not match the pin weights",
             ));
-        }
-        if history.bytes_per_particle() > 0 && history.tag() == 0 {
-            return Err(Error::invalid("snapshot: history state without a scheme"));
         }
         // Commit.
         self.time = time;

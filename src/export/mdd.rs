@@ -78,11 +78,6 @@ impl MddWriter {
         Ok(())
     }
 
-    /// Frames written so far.
-    pub fn frames(&self) -> u32 {
-        self.written
-    }
-
     /// Flushes; if fewer frames than announced were written, compacts the file so its header
     /// tells the truth.
     pub fn finish(self) -> io::Result<()> {

@@ -82,28 +82,33 @@ pub unsafe extern "C" fn fc_cloth_create_grid(
     desc: *const FcClothDesc,
     out_cloth: *mut *mut FcCloth,
 ) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { create(desc, out_cloth, |d| Ok(d.grid_spec().build()?)) }
+}
+
+/// The shared path of the constructors: checks `out`, reads the description, builds the
+/// topology with `topology`, creates the cloth and writes its handle to `*out` (only on success).
+///
+/// # Safety
+/// `desc` NULL or an initialised description; `out` NULL or writable.
+pub(crate) unsafe fn create(
+    desc: *const FcClothDesc,
+    out: *mut *mut FcCloth,
+    topology: impl FnOnce(&FcClothDesc) -> Result<crate::Topology, FfiError>,
+) -> FcStatus {
     guard(|| {
-        if out_cloth.is_null() {
+        if out.is_null() {
             return Err(FfiError::null("out_cloth"));
         }
         // SAFETY: the caller promises a valid description or NULL.
         let desc = unsafe { desc.as_ref() }.ok_or_else(|| FfiError::null("desc"))?;
         let config = desc.config()?;
-        let topology = desc.grid_spec().build()?;
+        let cloth = Cloth::new(topology(desc)?, config)?;
+        let raw = Box::into_raw(Box::new(FcCloth { cloth }));
         // SAFETY: checked non-NULL; the caller promises it is writable.
-        unsafe { hand_out(Cloth::new(topology, config)?, out_cloth) };
+        unsafe { *out = raw };
         Ok(())
     })
-}
-
-/// Boxes `cloth` and writes the handle to `*out`.
-///
-/// # Safety
-/// `out` must be non-NULL and writable.
-pub(crate) unsafe fn hand_out(cloth: Cloth, out: *mut *mut FcCloth) {
-    let raw = Box::into_raw(Box::new(FcCloth { cloth }));
-    // SAFETY: the caller promises `out` is non-NULL and writable.
-    unsafe { *out = raw };
 }
 
 /// Frees a cloth. NULL is fine. Using the handle afterwards is the host's bug.

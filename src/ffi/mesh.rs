@@ -1,11 +1,10 @@
 //! Cloths from arbitrary triangle or quad meshes.
 
 use crate::topology::{MeshMass, MeshSpec};
-use crate::Cloth;
 
-use super::cloth::{hand_out, slice_in, triples, FcCloth};
+use super::cloth::{create, slice_in, triples, FcCloth};
 use super::desc::FcClothDesc;
-use super::status::{guard, FcStatus, FfiError};
+use super::status::{FcStatus, FfiError};
 
 /// Creates a cloth from a mesh at rest: `vertex_count` positions (xyz floats, m) and
 /// `index_count` corner indices, `face_size` (3: triangles, 4: quads with corners in order
@@ -36,40 +35,33 @@ pub unsafe extern "C" fn fc_cloth_create_mesh(
     face_size: u32,
     out_cloth: *mut *mut FcCloth,
 ) -> FcStatus {
-    guard(|| {
-        if out_cloth.is_null() {
-            return Err(FfiError::null("out_cloth"));
-        }
-        // SAFETY: the caller promises a valid description or NULL.
-        let desc = unsafe { desc.as_ref() }.ok_or_else(|| FfiError::null("desc"))?;
-        let config = desc.config()?;
-        if positions.is_null() {
-            return Err(FfiError::null("positions"));
-        }
-        if indices.is_null() {
-            return Err(FfiError::null("indices"));
-        }
-        let floats = vertex_count
-            .checked_mul(3)
-            .ok_or_else(|| FfiError::invalid("vertex_count too large"))?;
-        // SAFETY: forwarded caller promises.
-        let xyz = unsafe { slice_in(positions, floats, "positions") }?;
-        let indices = unsafe { slice_in(indices, index_count, "indices") }?;
-        let positions = triples(xyz, "position")?;
-        let mass = if desc.total_mass > 0.0 {
-            MeshMass::Total(desc.total_mass)
-        } else {
-            MeshMass::ArealDensity(desc.areal_density)
-        };
-        let topology = MeshSpec {
-            positions: &positions,
-            indices,
-            face_size: face_size as usize,
-            mass,
-        }
-        .build()?;
-        // SAFETY: checked non-NULL; the caller promises it is writable.
-        unsafe { hand_out(Cloth::new(topology, config)?, out_cloth) };
-        Ok(())
-    })
+    // SAFETY: forwarded caller promises.
+    unsafe {
+        create(desc, out_cloth, |desc| {
+            if positions.is_null() {
+                return Err(FfiError::null("positions"));
+            }
+            if indices.is_null() {
+                return Err(FfiError::null("indices"));
+            }
+            let floats = vertex_count
+                .checked_mul(3)
+                .ok_or_else(|| FfiError::invalid("vertex_count too large"))?;
+            let xyz = slice_in(positions, floats, "positions")?;
+            let indices = slice_in(indices, index_count, "indices")?;
+            let positions = triples(xyz, "position")?;
+            let mass = if desc.total_mass > 0.0 {
+                MeshMass::Total(desc.total_mass)
+            } else {
+                MeshMass::ArealDensity(desc.areal_density)
+            };
+            Ok(MeshSpec {
+                positions: &positions,
+                indices,
+                face_size: face_size as usize,
+                mass,
+            }
+            .build()?)
+        })
+    }
 }

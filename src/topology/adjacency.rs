@@ -71,11 +71,6 @@ impl Adjacency {
         Self::from_pairs(n.div_ceil(chunk), pairs)
     }
 
-    /// Number of rows.
-    pub fn rows(&self) -> usize {
-        self.offsets.len() - 1
-    }
-
     /// Entries of vertex `p`.
     #[inline]
     pub fn row(&self, p: usize) -> &[u32] {
