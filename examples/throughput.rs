@@ -4,7 +4,8 @@
 //! `cargo run --release --example throughput` (about 3 minutes on 2 cores) prints a table and
 //! writes docs/throughput.csv, docs/scaling.png and docs/scaling.svg. `-- --quick` (sizes up to
 //! 100k, shorter runs) writes them under target/ instead. `-- --sizes 61x41` limits the sizes
-//! (and also writes under target/).
+//! (and also writes under target/). `-- --only TEXT` runs only the configurations whose name
+//! contains TEXT (for profiling; writes under target/).
 //!
 //! The cloth: a grid at 1 cm spacing (so every size is equally stiff and the same dt is stable),
 //! 0.096 g per particle, top row pinned, in a 0.2 m/s cross current so it keeps moving; dt = 1 ms
@@ -165,9 +166,13 @@ fn main() -> Result<(), Box<dyn Error>> {
             })
             .collect::<Result<_, _>>()?;
     }
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|k| args.get(k + 1).cloned());
     let min_secs = if quick { 0.15 } else { 0.5 };
     // Only the full run writes into docs/; quick or partial runs go to target/.
-    let partial = quick || args.iter().any(|a| a == "--sizes");
+    let partial = quick || only.is_some() || args.iter().any(|a| a == "--sizes");
     let out_dir = if partial {
         Path::new("target")
     } else {
@@ -180,6 +185,9 @@ fn main() -> Result<(), Box<dyn Error>> {
         "configuration", "particles", "1 thread M/s", "2 threads M/s", "speedup"
     );
     for c in configs() {
+        if only.as_ref().is_some_and(|o| !c.name.contains(o.as_str())) {
+            continue;
+        }
         for &(w, h) in &sizes {
             let one = measure(&c, w, h, 1, min_secs)?;
             let two = measure(&c, w, h, 2, min_secs)?;

@@ -84,26 +84,73 @@ fn run_kernel(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: &mut [V
     let (qi, qj) = (&p.q[i0..i0 + n], &p.q[j0..j0 + n]);
     let rest = &p.rest[first_spring..first_spring + n];
     let kd = p.kd;
-    if kd == 0.0 {
-        for t in 0..n {
-            let l = xi[t] - xj[t];
-            let len = (l.x * l.x + l.y * l.y + l.z * l.z).sqrt();
-            let mag = -ks * (len - rest[t]);
-            // A zero-length spring has no direction: no force rather than NaN.
-            let s = if len > 0.0 { mag / len } else { 0.0 };
-            out[t] = Vec3::new(s * l.x, s * l.y, s * l.z);
-        }
-    } else {
-        for t in 0..n {
-            let l = xi[t] - xj[t];
-            let dq = qi[t] - qj[t];
-            let len = (l.x * l.x + l.y * l.y + l.z * l.z).sqrt();
+    // Out-of-range squared lengths (see `inverse_length`) fall back to the exact kernel.
+    let mut outside = false;
+    for t in 0..n {
+        let l = xi[t] - xj[t];
+        let dq = qi[t] - qj[t];
+        let l2 = l.x * l.x + l.y * l.y + l.z * l.z;
+        outside |= !(SEED_MIN..=SEED_MAX).contains(&l2);
+        let inv = inverse_length(l2);
+        let len = l2 * inv;
+        // F = (mag / |l|) l with mag = -k_s (|l| - r) - k_d (dq . l) / |l|.
+        let mag = if kd == 0.0 {
+            -ks * (len - rest[t])
+        } else {
             let dql = dq.x * l.x + dq.y * l.y + dq.z * l.z;
-            // F = (mag / |l|) l with mag = -k_s (|l| - r) - k_d (dq . l) / |l|.
-            let inv = 1.0 / len;
-            let mag = -ks * (len - rest[t]) - kd * dql * inv;
-            let s = if len > 0.0 { mag * inv } else { 0.0 };
-            out[t] = Vec3::new(s * l.x, s * l.y, s * l.z);
-        }
+            -ks * (len - rest[t]) - kd * dql * inv
+        };
+        let s = mag * inv;
+        out[t] = Vec3::new(s * l.x, s * l.y, s * l.z);
+    }
+    if outside {
+        exact_kernel(ks, kd, xi, xj, qi, qj, rest, out);
+    }
+}
+
+/// Squared lengths inside which the f32 seed of [`inverse_length`] is a normal f32 number.
+const SEED_MIN: f64 = 1e-30;
+const SEED_MAX: f64 = 1e30;
+
+/// `1 / sqrt(l2)` for `l2` in `[SEED_MIN, SEED_MAX]`, to about 1e-14 relative, without an f64
+/// square root or division (the divider is what bounds the spring pass): an f32 seed (square
+/// root and division in f32, correctly rounded, ~1e-7), then one Newton step in f64
+/// (`y (3 - l2 y^2) / 2` squares the error). Every operation is IEEE and correctly rounded,
+/// so the result is the same bits at every vector width.
+#[inline(always)]
+fn inverse_length(l2: f64) -> f64 {
+    let a = l2.clamp(SEED_MIN, SEED_MAX) as f32;
+    let y = f64::from(1.0 / a.sqrt());
+    y * (1.5 - 0.5 * l2 * (y * y))
+}
+
+/// The spring pass with f64 square root and division, for slices with a squared length outside
+/// `[SEED_MIN, SEED_MAX]` (collapsed or absurdly long springs). A zero-length spring has no
+/// direction: no force rather than NaN.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn exact_kernel(
+    ks: f64,
+    kd: f64,
+    xi: &[Vec3],
+    xj: &[Vec3],
+    qi: &[Vec3],
+    qj: &[Vec3],
+    rest: &[f64],
+    out: &mut [Vec3],
+) {
+    for t in 0..out.len() {
+        let l = xi[t] - xj[t];
+        let dq = qi[t] - qj[t];
+        let len = (l.x * l.x + l.y * l.y + l.z * l.z).sqrt();
+        let dql = dq.x * l.x + dq.y * l.y + dq.z * l.z;
+        let inv = 1.0 / len;
+        let mag = if kd == 0.0 {
+            -ks * (len - rest[t])
+        } else {
+            -ks * (len - rest[t]) - kd * dql * inv
+        };
+        let s = if len > 0.0 { mag * inv } else { 0.0 };
+        out[t] = Vec3::new(s * l.x, s * l.y, s * l.z);
     }
 }

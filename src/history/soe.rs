@@ -236,15 +236,9 @@ impl HalfDerivative for SumOfExponentials {
                 (&mut self.pending, LANES),
                 blocks_per_chunk,
                 |first_block, modes, pending| {
-                    for (b, (m, out)) in modes
-                        .chunks_exact_mut(block)
-                        .zip(pending.chunks_mut(LANES))
-                        .enumerate()
-                    {
-                        let p0 = (first_block + b) * LANES;
-                        let lanes = out.len().min(n - p0);
-                        fold_block(&coefficients, &prev[p0..p0 + lanes], &v[p0..p0 + lanes], m, out);
-                    }
+                    let p0 = first_block * LANES;
+                    let p1 = (p0 + pending.len()).min(n);
+                    fold_blocks_widest(&coefficients, &prev[p0..p1], &v[p0..p1], modes, pending);
                 },
             );
         }
@@ -274,10 +268,28 @@ struct Coefficients<'a> {
     next: &'a [f64],
 }
 
+crate::simd_dispatch! { fn fold_blocks_widest(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64], out: &mut [Vec3]) => fold_blocks }
+
+/// [`fold_block`] for consecutive blocks: `prev` and `v` hold their particles (the last block
+/// may be partial), `modes` and `out` their modes and sums.
+#[inline(always)]
+fn fold_blocks(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64], out: &mut [Vec3]) {
+    let block = c.decay.len() * 3 * LANES;
+    for (b, (m, o)) in modes
+        .chunks_exact_mut(block)
+        .zip(out.chunks_mut(LANES))
+        .enumerate()
+    {
+        let p0 = b * LANES;
+        let p1 = (p0 + LANES).min(prev.len());
+        fold_block(c, &prev[p0..p1], &v[p0..p1], m, o);
+    }
+}
+
 /// Folds the panel (`prev`, `v`) into the modes of one block of up to [`LANES`] particles and
 /// writes each particle's next-step sum into `out`. Same arithmetic, in the same order, for
 /// every particle as a scalar loop over its modes; laid out so it vectorises across lanes.
-#[inline]
+#[inline(always)]
 fn fold_block(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64], out: &mut [Vec3]) {
     let mut pv = [[0.0; LANES]; 3];
     let mut vn = [[0.0; LANES]; 3];

@@ -101,8 +101,23 @@ pub fn build_lib() {
 
 fn build_lib_now() {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    // The profile of this test binary (target/<profile>/deps/<binary>): `cargo test --release`
+    // must link the C programs against the release library, not a stale one.
+    let exe = std::env::current_exe().expect("current exe");
+    let profile_dir = exe
+        .parent()
+        .and_then(Path::parent)
+        .and_then(Path::file_name)
+        .and_then(|d| d.to_str())
+        .unwrap_or("debug")
+        .to_string();
+    let profile = if profile_dir == "debug" {
+        "dev".to_string()
+    } else {
+        profile_dir
+    };
     let status = Command::new(cargo)
-        .args(["build", "--lib", "--quiet"])
+        .args(["build", "--lib", "--quiet", "--profile", &profile])
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .status()
         .expect("cargo runs");
