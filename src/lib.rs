@@ -44,6 +44,7 @@ pub mod parallel;
 pub mod render;
 pub mod scenes;
 pub mod simd;
+pub mod soa;
 pub mod topology;
 
 /// 3-vector of f64, the core's only vector type.

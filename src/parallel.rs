@@ -67,6 +67,27 @@ pub fn chunks2<A, B, F>(
     }
 }
 
+/// As [`chunks`], over three equally long `f64` slices cut at the same boundaries (the
+/// component arrays of a [`crate::soa::Soa3`]).
+pub fn chunks3<F>(parallel: bool, [a, b, c]: [&mut [f64]; 3], chunk: usize, f: F)
+where
+    F: Fn(usize, [&mut [f64]; 3]) + Sync + Send,
+{
+    if parallel {
+        a.par_chunks_mut(chunk)
+            .zip(b.par_chunks_mut(chunk))
+            .zip(c.par_chunks_mut(chunk))
+            .enumerate()
+            .for_each(|(k, ((x, y), z))| f(k * chunk, [x, y, z]));
+    } else {
+        a.chunks_mut(chunk)
+            .zip(b.chunks_mut(chunk))
+            .zip(c.chunks_mut(chunk))
+            .enumerate()
+            .for_each(|(k, ((x, y), z))| f(k * chunk, [x, y, z]));
+    }
+}
+
 /// The smallest index in `0..n` for which `bad` holds, searched in parallel chunks when
 /// `parallel`; the answer does not depend on the split.
 pub fn first_failing<F>(parallel: bool, n: usize, bad: F) -> Option<usize>

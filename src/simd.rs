@@ -27,8 +27,8 @@ pub fn level() -> &'static str {
 #[macro_export]
 #[doc(hidden)]
 macro_rules! simd_dispatch {
-    (fn $name:ident ( $($p:ident : $t:ty),* $(,)? ) => $body:ident) => {
-        fn $name($($p: $t),*) {
+    ($vis:vis fn $name:ident ( $($p:ident : $t:ty),* $(,)? ) => $body:ident) => {
+        $vis fn $name($($p: $t),*) {
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx512f")]

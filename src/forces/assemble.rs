@@ -72,7 +72,69 @@ where
     }
 }
 
-crate::simd_dispatch! { fn add_scaled_widest(sign: f64, src: &[f64], dst: &mut [f64]) => add_scaled }
+/// Particles per tile of [`add_spring_forces`]: the tile's three sums stay in L1 cache.
+pub(super) const TILE: usize = 256;
+
+/// Sets `acc[c][k]` to the sum of the forces of every spring touching particle `p0 + k`
+/// (`+f` at its `i` end, `-f` at its `j` end), for `k < len <= TILE`, from the per-spring
+/// component arrays `f`. The tile must lie inside one [`crate::parallel::CHUNK`]. Each
+/// particle's springs are added in a fixed order (run by run, or along its adjacency row), so
+/// the sums do not depend on tiles, chunks or threads.
+pub(super) fn add_spring_forces(
+    t: &Topology,
+    p0: usize,
+    len: usize,
+    f: [&[f64]; 3],
+    acc: &mut [[f64; TILE]; 3],
+) {
+    for a in acc.iter_mut() {
+        a[..len].fill(0.0);
+    }
+    let end = p0 + len;
+    if t.long_runs() {
+        for &r in t.chunk_runs.row(p0 / crate::parallel::CHUNK) {
+            let run = &t.spring_runs[r as usize];
+            let s0 = run.first_spring as usize;
+            let n = run.len as usize;
+            let i0 = run.first_vertex as usize;
+            for (start, sign) in [(i0, 1.0), (i0 + run.offset as usize, -1.0)] {
+                let (lo, hi) = (start.max(p0), (start + n).min(end));
+                if lo < hi {
+                    let src = (s0 + lo - start)..(s0 + hi - start);
+                    for c in 0..3 {
+                        add_scaled_widest(sign, &f[c][src.clone()], &mut acc[c][lo - p0..hi - p0]);
+                    }
+                }
+            }
+        }
+    } else {
+        for k in 0..len {
+            let row = t.vertex_springs.row(p0 + k);
+            for c in 0..3 {
+                let fc = f[c];
+                let term = |e: u32| {
+                    if e & 1 == 0 {
+                        fc[(e >> 1) as usize]
+                    } else {
+                        -fc[(e >> 1) as usize]
+                    }
+                };
+                let (mut even, mut odd) = (0.0, 0.0);
+                let mut pairs = row.chunks_exact(2);
+                for pair in &mut pairs {
+                    even += term(pair[0]);
+                    odd += term(pair[1]);
+                }
+                if let [last] = pairs.remainder() {
+                    even += term(*last);
+                }
+                acc[c][k] = even + odd;
+            }
+        }
+    }
+}
+
+crate::simd_dispatch! { pub(super) fn add_scaled_widest(sign: f64, src: &[f64], dst: &mut [f64]) => add_scaled }
 
 /// `dst += sign * src`, element by element.
 #[inline(always)]

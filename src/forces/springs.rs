@@ -18,46 +18,76 @@
 use super::ForceInput;
 use crate::model::SpringDamping;
 use crate::parallel;
+use crate::soa::Soa3;
 use crate::topology::{SpringKind, SpringRun};
-use crate::Vec3;
 
 /// What the spring pass reads besides the springs.
-struct Params<'a> {
-    stiffness: [f64; 3],
+#[derive(Clone, Copy)]
+pub(super) struct Params<'a> {
+    pub stiffness: [f64; 3],
     /// Damping coefficient, 0 when the springs are undamped.
-    kd: f64,
-    x: &'a [Vec3],
+    pub kd: f64,
+    /// Positions, one array per component.
+    pub x: [&'a [f64]; 3],
     /// Rate the damping acts on (v or D^{1/2}x); `x` when undamped (then never read).
-    q: &'a [Vec3],
-    rest: &'a [f64],
-    kinds: &'a [u8],
+    pub q: [&'a [f64]; 3],
+    /// Rest length and family of each spring (or slot of a padded run).
+    pub rest: &'a [f64],
+    pub kinds: &'a [u8],
+    /// 1 for a real spring, 0 for a padding slot (read only by [`run_padded_widest`]).
+    pub live: &'a [f64],
 }
 
-/// Writes the force each spring exerts on its `i` end into `out` (one entry per spring).
-pub(super) fn compute(input: &ForceInput<'_>, parallel: bool, out: &mut [Vec3]) {
+/// Copies of the positions and of the damping rate in component arrays, reused between steps.
+#[derive(Clone, Debug, Default)]
+pub(super) struct SpringScratch {
+    x: Soa3,
+    q: Soa3,
+}
+
+/// Copies what the spring pass reads into `scratch` (component arrays) and returns it.
+pub(super) fn params<'a>(
+    input: &ForceInput<'a>,
+    parallel: bool,
+    scratch: &'a mut SpringScratch,
+) -> Params<'a> {
     let m = input.model;
-    let rate: Option<&[Vec3]> = match m.spring_damping_mode {
+    let rate: Option<&[crate::Vec3]> = match m.spring_damping_mode {
         _ if m.spring_damping == 0.0 => None,
         SpringDamping::None => None,
         SpringDamping::Velocity => Some(input.v),
         SpringDamping::Fractional => Some(input.half_derivative),
     };
     let t = input.topology;
-    let p = Params {
+    scratch.x.fill_from(parallel, input.x);
+    if let Some(q) = rate {
+        scratch.q.fill_from(parallel, q);
+    }
+    Params {
         stiffness: [
             m.stiffness(SpringKind::Stretch),
             m.stiffness(SpringKind::Shear),
             m.stiffness(SpringKind::Bend),
         ],
         kd: if rate.is_some() { m.spring_damping } else { 0.0 },
-        x: input.x,
-        q: rate.unwrap_or(input.x),
+        x: scratch.x.slices(),
+        q: if rate.is_some() {
+            scratch.q.slices()
+        } else {
+            scratch.x.slices()
+        },
         rest: &t.spring_rest,
         kinds: &t.spring_kinds,
-    };
-    let runs = &t.spring_runs;
-    parallel::chunks(parallel, out, parallel::CHUNK, |first, chunk| {
-        let end = first + chunk.len();
+        live: &[],
+    }
+}
+
+/// Writes the force each spring exerts on its `i` end into `out` (component arrays, one entry
+/// per spring).
+pub(super) fn compute(p: &Params<'_>, runs: &[SpringRun], parallel: bool, out: &mut Soa3) {
+    out.resize(p.rest.len());
+    parallel::chunks3(parallel, out.slices_mut(), parallel::CHUNK, |first, mut chunk| {
+        let end = first + chunk[0].len();
         let mut r = runs.partition_point(|r| (r.first_spring + r.len) as usize <= first);
         while let Some(run) = runs.get(r) {
             let (a, b) = (run.first_spring as usize, (run.first_spring + run.len) as usize);
@@ -65,31 +95,62 @@ pub(super) fn compute(input: &ForceInput<'_>, parallel: bool, out: &mut [Vec3]) 
                 break;
             }
             let (lo, hi) = (a.max(first), b.min(end));
-            run_widest(&p, run, lo, &mut chunk[lo - first..hi - first]);
+            let [ox, oy, oz] = &mut chunk;
+            let piece = [
+                &mut ox[lo - first..hi - first],
+                &mut oy[lo - first..hi - first],
+                &mut oz[lo - first..hi - first],
+            ];
+            run_widest(p, run, lo, piece);
             r += 1;
         }
     });
 }
 
-crate::simd_dispatch! { fn run_widest(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: &mut [Vec3]) => run_kernel }
+crate::simd_dispatch! { pub(super) fn run_widest(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) => run_kernel_plain }
+crate::simd_dispatch! { pub(super) fn run_padded_widest(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) => run_kernel_padded }
 
-/// Springs `first_spring ..` of `run`, as many as `out` holds.
 #[inline(always)]
-fn run_kernel(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: &mut [Vec3]) {
-    let n = out.len();
+fn run_kernel_plain(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) {
+    run_kernel::<false>(p, run, first_spring, out)
+}
+
+#[inline(always)]
+fn run_kernel_padded(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) {
+    run_kernel::<true>(p, run, first_spring, out)
+}
+
+/// Springs `first_spring ..` of `run`, as many as `out` holds. With `PADDED`, `run` is a
+/// padded run ([`crate::topology::TileRuns`]) and each force is multiplied by its slot's `live`
+/// (0 for padding).
+#[inline(always)]
+fn run_kernel<'a, const PADDED: bool>(
+    p: &Params<'a>,
+    run: &SpringRun,
+    first_spring: usize,
+    out: [&mut [f64]; 3],
+) {
+    let [fx, fy, fz] = out;
+    let n = fx.len();
+    let (fy, fz) = (&mut fy[..n], &mut fz[..n]);
     let i0 = run.first_vertex as usize + (first_spring - run.first_spring as usize);
     let j0 = i0 + run.offset as usize;
     let ks = p.stiffness[p.kinds[first_spring] as usize];
-    let (xi, xj) = (&p.x[i0..i0 + n], &p.x[j0..j0 + n]);
-    let (qi, qj) = (&p.q[i0..i0 + n], &p.q[j0..j0 + n]);
+    let ends = |a: [&'a [f64]; 3], s: usize| [&a[0][s..s + n], &a[1][s..s + n], &a[2][s..s + n]];
+    let ([xi, yi, zi], [xj, yj, zj]) = (ends(p.x, i0), ends(p.x, j0));
+    let ([qxi, qyi, qzi], [qxj, qyj, qzj]) = (ends(p.q, i0), ends(p.q, j0));
     let rest = &p.rest[first_spring..first_spring + n];
+    let live = if PADDED {
+        &p.live[first_spring..first_spring + n]
+    } else {
+        &[]
+    };
     let kd = p.kd;
     // Out-of-range squared lengths (see `inverse_length`) fall back to the exact kernel.
     let mut outside = false;
     for t in 0..n {
-        let l = xi[t] - xj[t];
-        let dq = qi[t] - qj[t];
-        let l2 = l.x * l.x + l.y * l.y + l.z * l.z;
+        let (lx, ly, lz) = (xi[t] - xj[t], yi[t] - yj[t], zi[t] - zj[t]);
+        let l2 = lx * lx + ly * ly + lz * lz;
         outside |= !(SEED_MIN..=SEED_MAX).contains(&l2);
         let inv = inverse_length(l2);
         let len = l2 * inv;
@@ -97,14 +158,27 @@ fn run_kernel(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: &mut [V
         let mag = if kd == 0.0 {
             -ks * (len - rest[t])
         } else {
-            let dql = dq.x * l.x + dq.y * l.y + dq.z * l.z;
+            let dql = (qxi[t] - qxj[t]) * lx + (qyi[t] - qyj[t]) * ly + (qzi[t] - qzj[t]) * lz;
             -ks * (len - rest[t]) - kd * dql * inv
         };
-        let s = mag * inv;
-        out[t] = Vec3::new(s * l.x, s * l.y, s * l.z);
+        let s = if PADDED { mag * inv * live[t] } else { mag * inv };
+        fx[t] = s * lx;
+        fy[t] = s * ly;
+        fz[t] = s * lz;
     }
     if outside {
-        exact_kernel(ks, kd, xi, xj, qi, qj, rest, out);
+        let live = PADDED.then_some(live);
+        exact_kernel(
+            ks,
+            kd,
+            [xi, yi, zi],
+            [xj, yj, zj],
+            [qxi, qyi, qzi],
+            [qxj, qyj, qzj],
+            rest,
+            live,
+            [fx, fy, fz],
+        );
     }
 }
 
@@ -126,31 +200,39 @@ fn inverse_length(l2: f64) -> f64 {
 
 /// The spring pass with f64 square root and division, for slices with a squared length outside
 /// `[SEED_MIN, SEED_MAX]` (collapsed or absurdly long springs). A zero-length spring has no
-/// direction: no force rather than NaN.
+/// direction: no force rather than NaN. `live` multiplies each force (padded runs).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn exact_kernel(
     ks: f64,
     kd: f64,
-    xi: &[Vec3],
-    xj: &[Vec3],
-    qi: &[Vec3],
-    qj: &[Vec3],
+    xi: [&[f64]; 3],
+    xj: [&[f64]; 3],
+    qi: [&[f64]; 3],
+    qj: [&[f64]; 3],
     rest: &[f64],
-    out: &mut [Vec3],
+    live: Option<&[f64]>,
+    out: [&mut [f64]; 3],
 ) {
-    for t in 0..out.len() {
-        let l = xi[t] - xj[t];
-        let dq = qi[t] - qj[t];
-        let len = (l.x * l.x + l.y * l.y + l.z * l.z).sqrt();
-        let dql = dq.x * l.x + dq.y * l.y + dq.z * l.z;
+    let [fx, fy, fz] = out;
+    for t in 0..rest.len() {
+        let l = [xi[0][t] - xj[0][t], xi[1][t] - xj[1][t], xi[2][t] - xj[2][t]];
+        let dq = [qi[0][t] - qj[0][t], qi[1][t] - qj[1][t], qi[2][t] - qj[2][t]];
+        let len = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+        let dql = dq[0] * l[0] + dq[1] * l[1] + dq[2] * l[2];
         let inv = 1.0 / len;
         let mag = if kd == 0.0 {
             -ks * (len - rest[t])
         } else {
             -ks * (len - rest[t]) - kd * dql * inv
         };
-        let s = if len > 0.0 { mag * inv } else { 0.0 };
-        out[t] = Vec3::new(s * l.x, s * l.y, s * l.z);
+        let s = if len > 0.0 {
+            mag * inv * live.map_or(1.0, |m| m[t])
+        } else {
+            0.0
+        };
+        fx[t] = s * l[0];
+        fy[t] = s * l[1];
+        fz[t] = s * l[2];
     }
 }

@@ -13,7 +13,7 @@ mod spring;
 pub use adjacency::Adjacency;
 pub use grid::{grid_index, GridSpec};
 pub use mesh::{MeshMass, MeshSpec, MAX_MESH_VERTICES};
-pub use runs::SpringRun;
+pub use runs::{SpringRun, TileRuns};
 pub use spring::{Spring, SpringKind};
 
 use crate::Vec3;
@@ -43,6 +43,8 @@ pub struct Topology {
     pub vertex_triangles: Adjacency,
     /// Spring runs touching each chunk of vertices (see [`Adjacency::chunk_runs`]).
     pub chunk_runs: Adjacency,
+    /// The runs joined over small gaps, for the tiled force pass (see [`TileRuns`]).
+    pub tile_runs: TileRuns,
 }
 
 impl Topology {
@@ -63,6 +65,7 @@ impl Topology {
             spring_kinds: springs.iter().map(|s| s.kind as u8).collect(),
             vertex_springs: Adjacency::springs(n, &springs),
             chunk_runs: Adjacency::chunk_runs(n, &spring_runs),
+            tile_runs: TileRuns::new(n, &springs, &spring_runs),
             spring_runs,
             vertex_triangles: Adjacency::triangles(n, &triangles),
             rest_positions,

@@ -42,6 +42,69 @@ pub fn order_into_runs(springs: &mut [Spring]) -> Vec<SpringRun> {
     runs
 }
 
+/// Largest gap (missing springs) between two runs of one family that [`TileRuns`] pads over.
+const MAX_GAP: u32 = 4;
+
+/// The runs again, with runs of the same family and offset that are separated by a few missing
+/// springs joined into one by padding slots (a grid's rows break every horizontal, shear and
+/// bend run at the row end: padding makes each family one run). A slot is a real spring
+/// (`live` = 1) or padding (`live` = 0, rest 0: its force is multiplied by 0).
+/// `SpringRun::first_spring` indexes slots here. Used by the tiled force pass, where fewer, longer runs mean fewer,
+/// longer vector loops.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TileRuns {
+    pub runs: Vec<SpringRun>,
+    /// Rest length of each slot, m (0 for padding).
+    pub rest: Vec<f64>,
+    /// Family of each slot (`SpringKind as u8`).
+    pub kinds: Vec<u8>,
+    /// 1 for a spring, 0 for padding.
+    pub live: Vec<f64>,
+    /// Runs touching each chunk of vertices.
+    pub chunk_runs: super::Adjacency,
+    /// Largest offset of any run.
+    pub max_offset: usize,
+}
+
+impl TileRuns {
+    /// Pads `runs` (from [`order_into_runs`] on `springs`) for `n` vertices.
+    pub fn new(n: usize, springs: &[Spring], runs: &[SpringRun]) -> Self {
+        let mut t = Self::default();
+        for r in runs {
+            let kind = springs[r.first_spring as usize].kind as u8;
+            let gap = t.runs.last().and_then(|last| {
+                let end = last.first_vertex + last.len;
+                let same = t.kinds[last.first_spring as usize] == kind && last.offset == r.offset;
+                (same && r.first_vertex >= end && r.first_vertex - end <= MAX_GAP)
+                    .then(|| r.first_vertex - end)
+            });
+            match (gap, t.runs.last_mut()) {
+                (Some(gap), Some(last)) => {
+                    for _ in 0..gap {
+                        t.rest.push(0.0);
+                        t.kinds.push(kind);
+                        t.live.push(0.0);
+                    }
+                    last.len += gap + r.len;
+                }
+                _ => t.runs.push(SpringRun {
+                    first_spring: t.rest.len() as u32,
+                    len: r.len,
+                    ..*r
+                }),
+            }
+            for s in &springs[r.first_spring as usize..(r.first_spring + r.len) as usize] {
+                t.rest.push(s.rest);
+                t.kinds.push(kind);
+                t.live.push(1.0);
+            }
+        }
+        t.chunk_runs = super::Adjacency::chunk_runs(n, &t.runs);
+        t.max_offset = t.runs.iter().map(|r| r.offset as usize).max().unwrap_or(0);
+        t
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use crate::topology::GridSpec;
@@ -70,5 +133,40 @@ mod tests {
         assert_eq!(covered, t.springs.len());
         // The vertical stretch family is one run over all rows but the last.
         assert!(t.spring_runs.iter().any(|r| r.offset == 7 && r.len == 7 * 4));
+    }
+
+    #[test]
+    fn padded_runs_hold_every_spring_once_and_pad_only_gaps() {
+        let t = GridSpec {
+            width: 7,
+            height: 5,
+            spacing: 0.1,
+            total_mass: 1.0,
+        }
+        .build()
+        .unwrap();
+        let p = &t.tile_runs;
+        // A grid's eight families (stretch and bend along rows and columns, the two shear
+        // diagonals, the two skip-one bend diagonals) become eight runs.
+        assert_eq!(p.runs.len(), 8);
+        let mut seen = vec![0; t.springs.len()];
+        for r in &p.runs {
+            for k in 0..r.len {
+                let slot = (r.first_spring + k) as usize;
+                let (i, j) = (r.first_vertex + k, r.first_vertex + k + r.offset);
+                let found = t.springs.iter().position(|s| s.i == i && s.j == j);
+                match found {
+                    Some(s) => {
+                        assert_eq!(p.live[slot], 1.0);
+                        assert_eq!(p.rest[slot], t.springs[s].rest);
+                        assert_eq!(p.kinds[slot], t.springs[s].kind as u8);
+                        seen[s] += 1;
+                    }
+                    None => assert_eq!((p.live[slot], p.rest[slot]), (0.0, 0.0)),
+                }
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 1));
+        assert_eq!(p.max_offset, 16);
     }
 }

@@ -1,0 +1,216 @@
+//! Spring forces summed tile by tile, with no per-spring buffer: the fast path for topologies
+//! whose springs form long runs with short offsets (grids, row-ordered meshes).
+//!
+//! A chunk of particles `[c0, c1)` is walked in tiles of [`TILE`] particles. For each tile,
+//! every run's springs whose `i` end lies in the tile are evaluated into a small buffer, added
+//! with `+` at their `i` ends and with `-` at their `j` ends (`j = i + offset`, later in the
+//! array), into a rolling window of sums that covers the tile and the `max offset` particles
+//! after it. When a tile's springs are done, every spring touching a particle of the tile has
+//! been added (its `i` end is never after its `j` end), so the tile is handed to `finish`, and
+//! the window slides on. Before the first tile, the springs whose `i` end lies before `c0` and
+//! whose `j` end lies in the chunk are evaluated too (the previous chunk evaluates them as well,
+//! for its own `i` ends; a few per chunk boundary).
+//!
+//! Everything a tile touches (positions around it, the window) stays in L1 cache, and a
+//! spring's force is used where it is computed instead of being written out and read back.
+//! Each particle receives its springs in an order fixed by the topology and the chunk grid, so
+//! the sums do not depend on the thread count.
+
+use super::assemble::add_scaled_widest;
+use super::springs::{run_padded_widest, Params};
+use crate::topology::Topology;
+
+/// Particles per tile.
+pub const TILE: usize = 256;
+
+/// Largest run offset the rolling window accepts (beyond it, the window would leave L1 and
+/// the per-spring buffer path is used).
+const MAX_OFFSET: usize = 1024;
+
+/// Length of each component's window for `t`, or None when the tile path does not apply.
+pub(super) fn window(t: &Topology) -> Option<usize> {
+    let tr = &t.tile_runs;
+    let long = tr.rest.len() >= 8 * tr.runs.len();
+    (long && tr.max_offset <= MAX_OFFSET).then_some(TILE + tr.max_offset)
+}
+
+/// Sums the spring forces of particles `c0 .. c0 + len` (one chunk) tile by tile and calls
+/// `finish(p0, sums)` for each tile, `sums[c][k]` being component c of the spring force on
+/// particle `p0 + k`. `window` holds `3 * w` numbers, `w` from [`window`].
+pub(super) fn spring_forces<F>(
+    p: &Params<'_>,
+    t: &Topology,
+    c0: usize,
+    len: usize,
+    window: &mut [f64],
+    mut finish: F,
+) where
+    F: FnMut(usize, [&[f64]; 3]),
+{
+    let w = window.len() / 3;
+    let c1 = c0 + len;
+    let runs = t.tile_runs.chunk_runs.row(c0 / crate::parallel::CHUNK);
+    let p = &Params {
+        rest: &t.tile_runs.rest,
+        kinds: &t.tile_runs.kinds,
+        live: &t.tile_runs.live,
+        ..*p
+    };
+    window.fill(0.0);
+    let mut temp = [[0.0; TILE]; 3];
+    // Springs from before the chunk into it: only their j ends are ours.
+    add_range(p, t, runs, None, c0, c1, c0, w, window, &mut temp);
+    let mut base = c0;
+    while base < c1 {
+        let end = (base + TILE).min(c1);
+        add_range(p, t, runs, Some((base, end)), c0, c1, base, w, window, &mut temp);
+        let n = end - base;
+        {
+            let (x, rest) = window.split_at(w);
+            let (y, z) = rest.split_at(w);
+            finish(base, [&x[..n], &y[..n], &z[..n]]);
+        }
+        // Slide the window by one tile.
+        for c in 0..3 {
+            let comp = &mut window[c * w..(c + 1) * w];
+            comp.copy_within(TILE.min(w).., 0);
+            comp[w - TILE..].fill(0.0);
+        }
+        base += TILE;
+    }
+}
+
+/// Evaluates the springs of `runs` whose `i` end is in `tile` (or, for `None`, whose `i` end is
+/// before `c0` and `j` end in `[c0, c1)`) and adds them to the window (which starts at particle
+/// `base`): `+f` at `i` ends inside `[c0, c1)`, `-f` at `j` ends inside `[c0, c1)`.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn add_range(
+    p: &Params<'_>,
+    t: &Topology,
+    runs: &[u32],
+    tile: Option<(usize, usize)>,
+    c0: usize,
+    c1: usize,
+    base: usize,
+    w: usize,
+    window: &mut [f64],
+    temp: &mut [[f64; TILE]; 3],
+) {
+    for &r in runs {
+        let run = &t.tile_runs.runs[r as usize];
+        let i0 = run.first_vertex as usize;
+        let off = run.offset as usize;
+        let i_end = i0 + run.len as usize;
+        let (mut lo, hi) = match tile {
+            Some((a, b)) => (i0.max(a), i_end.min(b)),
+            None => (
+                i0.max(c0.saturating_sub(off)),
+                i_end.min(c0).min(c1.saturating_sub(off)),
+            ),
+        };
+        while lo < hi {
+            let m = (hi - lo).min(TILE);
+            let s = run.first_spring as usize + (lo - i0);
+            let [tx, ty, tz] = temp;
+            run_padded_widest(p, run, s, [&mut tx[..m], &mut ty[..m], &mut tz[..m]]);
+            // +f at the i ends inside the chunk.
+            let (a, b) = (lo.max(c0), (lo + m).min(c1));
+            if a < b {
+                add3(1.0, temp, a - lo, b - lo, window, a - base, w);
+            }
+            // -f at the j ends inside the chunk.
+            let (a, b) = ((lo + off).max(c0), (lo + m + off).min(c1));
+            if a < b {
+                add3(-1.0, temp, a - lo - off, b - lo - off, window, a - base, w);
+            }
+            lo += m;
+        }
+    }
+}
+
+/// `window[c][at..] += sign * temp[c][from..to]` for the three components.
+#[inline]
+fn add3(sign: f64, temp: &[[f64; TILE]; 3], from: usize, to: usize, window: &mut [f64], at: usize, w: usize) {
+    for c in 0..3 {
+        let dst = &mut window[c * w + at..c * w + at + (to - from)];
+        add_scaled_widest(sign, &temp[c][from..to], dst);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{accumulate, ForceInput, ForceScratch};
+    use crate::model::Model;
+    use crate::topology::{GridSpec, Topology};
+    use crate::Vec3;
+
+    /// Spring forces the plain way: every spring once, f64 square root and division, scattered.
+    fn reference(m: &Model, t: &Topology, x: &[Vec3], q: &[Vec3]) -> Vec<Vec3> {
+        let mut f = vec![Vec3::zeros(); x.len()];
+        for s in &t.springs {
+            let (i, j) = (s.i as usize, s.j as usize);
+            let l = x[i] - x[j];
+            let len = l.norm();
+            let dir = l / len;
+            let mag = -m.stiffness(s.kind) * (len - s.rest) - m.spring_damping * (q[i] - q[j]).dot(&dir);
+            f[i] += mag * dir;
+            f[j] -= mag * dir;
+        }
+        f
+    }
+
+    #[test]
+    fn tiled_and_buffered_spring_sums_match_the_plain_sum_across_chunks() {
+        // 101 x 101 = 10 201 particles: three chunks, so the prologue across chunk boundaries runs.
+        let t = GridSpec {
+            width: 101,
+            height: 101,
+            spacing: 0.01,
+            total_mass: 1.0,
+        }
+        .build()
+        .unwrap();
+        let n = t.vertex_count();
+        assert!(super::window(&t).is_some());
+        let mut buffered = t.clone();
+        buffered.tile_runs.max_offset = usize::MAX;
+        assert!(super::window(&buffered).is_none());
+        // Deterministic pseudo-random displacements and rates.
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let x: Vec<Vec3> = t
+            .rest_positions
+            .iter()
+            .map(|p| p + 0.002 * Vec3::new(rnd(), rnd(), rnd()))
+            .collect();
+        let q: Vec<Vec3> = (0..n).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+        // Springs only: no gravity, no drag.
+        let mut m = Model::fractional();
+        m.gravity = Vec3::zeros();
+        m.viscous_drag = 0.0;
+        m.history_drag = 0.0;
+        let want = reference(&m, &t, &x, &q);
+        for topology in [&t, &buffered] {
+            let input = ForceInput {
+                model: &m,
+                topology,
+                x: &x,
+                v: &q,
+                half_derivative: &q,
+                colliders: &[],
+            };
+            let mut f = vec![Vec3::zeros(); n];
+            accumulate(&input, &mut ForceScratch::default(), &mut f);
+            let scale = want.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            for (p, (a, b)) in f.iter().zip(&want).enumerate() {
+                assert!((a - b).norm() <= 1e-12 * scale, "particle {p}: {a} vs {b}");
+            }
+        }
+    }
+}
