@@ -5,12 +5,14 @@
 //! writes docs/throughput.csv, docs/scaling.png and docs/scaling.svg. `-- --quick` (sizes up to
 //! 100k, shorter runs) writes them under target/ instead. `-- --sizes 61x41` limits the sizes
 //! (and also writes under target/). `-- --only TEXT` runs only the configurations whose name
-//! contains TEXT (for profiling; writes under target/).
+//! contains TEXT and skips the memory table (for profiling; writes nothing).
 //!
 //! The cloth: a grid at 1 cm spacing (so every size is equally stiff and the same dt is stable),
-//! 0.096 g per particle, top row pinned, in a 0.2 m/s cross current so it keeps moving; dt = 1 ms
-//! (the issue's setting). Timed: the stepping loop only (`Cloth::step`), after 20 warm-up steps,
-//! for at least 0.5 s of wall clock (0.15 s with --quick). Threads: a rayon pool of that many
+//! 0.096 g per particle, top row pinned, in a 0.2 m/s cross current so it keeps moving; dt =
+//! 0.5 ms (the issue names 1 ms, at which the regular model is refused as unstable on this
+//! cloth; a step costs the same at any dt). Timed: the stepping loop only (`Cloth::step`), after 20 warm-up steps,
+//! for at least 0.5 s of wall clock (0.15 s with --quick), split into 7 windows whose median
+//! rate is reported. Threads: a rayon pool of that many
 //! threads around the loop. Every step must succeed; a failed step aborts the run.
 
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -57,6 +59,8 @@ static GLOBAL: Tracking = Tracking;
 const SPACING: f64 = 0.01;
 const PARTICLE_MASS: f64 = 0.24 / 2501.0;
 const DT: f64 = 5e-4;
+/// Timed windows per measurement; the median is reported.
+const WINDOWS: usize = 7;
 
 #[derive(Clone, Copy)]
 struct Config {
@@ -126,16 +130,23 @@ fn measure(c: &Config, w: u32, h: u32, threads: usize, min_secs: f64) -> Result<
         for _ in 0..20 {
             cloth.step(DT)?;
         }
-        let start = Instant::now();
-        let mut steps = 0u64;
-        while start.elapsed().as_secs_f64() < min_secs || steps < 5 {
-            for _ in 0..5 {
-                cloth.step(DT)?;
+        // The median of WINDOWS timed windows: this machine is shared, and a median is not
+        // moved by a window that another tenant slowed down.
+        let mut rates = Vec::with_capacity(WINDOWS);
+        for _ in 0..WINDOWS {
+            let start = Instant::now();
+            let mut steps = 0u64;
+            while start.elapsed().as_secs_f64() < min_secs / WINDOWS as f64 || steps < 5 {
+                for _ in 0..5 {
+                    cloth.step(DT)?;
+                }
+                steps += 5;
             }
-            steps += 5;
+            let secs = start.elapsed().as_secs_f64();
+            rates.push(steps as f64 * cloth.vertex_count() as f64 / secs);
         }
-        let secs = start.elapsed().as_secs_f64();
-        Ok(steps as f64 * cloth.vertex_count() as f64 / secs)
+        rates.sort_by(f64::total_cmp);
+        Ok(rates[WINDOWS / 2])
     })?;
     Ok(rate)
 }
@@ -213,6 +224,9 @@ fn main() -> Result<(), Box<dyn Error>> {
                 rate: two,
             });
         }
+    }
+    if only.is_some() {
+        return Ok(());
     }
     println!("\nmemory: live heap bytes per particle of a 317 x 317 cloth after 20 steps (everything: topology, state, scratch, history)");
     for (name, variant, scheme) in [

@@ -660,7 +660,20 @@ impl Cloth {
             let finite = x[i].iter().chain(v[i].iter()).all(|c| c.is_finite());
             !finite || v[i].norm_squared() > vmax2
         };
-        match parallel::first_failing(parallel::worth_it(x.len()), x.len(), bad) {
+        // Branch-free over a chunk (so it vectorises): `c * 0` is NaN exactly when c is not
+        // finite, and NaN fails every comparison.
+        let clean = |r: std::ops::Range<usize>| {
+            let (xs, vs) = (&x[r.clone()], &v[r]);
+            let mut nonfinite = 0.0;
+            let mut fastest: f64 = 0.0;
+            for (a, b) in xs.iter().zip(vs) {
+                nonfinite += (a.x * 0.0 + a.y * 0.0) + (a.z * 0.0 + b.x * 0.0) + (b.y * 0.0 + b.z * 0.0);
+                let s = b.x * b.x + b.y * b.y + b.z * b.z;
+                fastest = if s > fastest { s } else { fastest };
+            }
+            nonfinite == 0.0 && fastest <= vmax2
+        };
+        match parallel::first_failing(parallel::worth_it(x.len()), x.len(), clean, bad) {
             None => Ok(()),
             Some(i) => Err(Error::unstable(format!(
                 "{} with dt = {dt} s is unstable at step {}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s); state left unchanged, retry with a smaller dt",

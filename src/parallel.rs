@@ -89,12 +89,22 @@ where
 }
 
 /// The smallest index in `0..n` for which `bad` holds, searched in parallel chunks when
-/// `parallel`; the answer does not depend on the split.
-pub fn first_failing<F>(parallel: bool, n: usize, bad: F) -> Option<usize>
+/// `parallel`; the answer does not depend on the split. `clean(range)` is a fast test that
+/// must be true only when `bad` holds for no index of `range` (e.g. a branch-free pass that
+/// vectorises); chunks it passes are not searched.
+pub fn first_failing<F, C>(parallel: bool, n: usize, clean: C, bad: F) -> Option<usize>
 where
     F: Fn(usize) -> bool + Sync + Send,
+    C: Fn(std::ops::Range<usize>) -> bool + Sync + Send,
 {
-    let scan = |k: usize| (k * CHUNK..((k + 1) * CHUNK).min(n)).find(|&i| bad(i));
+    let scan = |k: usize| {
+        let range = k * CHUNK..((k + 1) * CHUNK).min(n);
+        if clean(range.clone()) {
+            None
+        } else {
+            range.into_iter().find(|&i| bad(i))
+        }
+    };
     let chunks = n.div_ceil(CHUNK);
     if parallel {
         (0..chunks).into_par_iter().filter_map(scan).min()
@@ -132,12 +142,19 @@ mod tests {
     fn first_failing_finds_the_smallest_index() {
         let n = 5 * CHUNK + 17;
         for parallel in [false, true] {
+            let none = |_| false;
             assert_eq!(
-                first_failing(parallel, n, |i| i % 3000 == 2999 && i > 9000),
+                first_failing(parallel, n, none, |i| i % 3000 == 2999 && i > 9000),
                 Some(11999)
             );
-            assert_eq!(first_failing(parallel, n, |_| false), None);
-            assert_eq!(first_failing(parallel, n, |i| i == n - 1), Some(n - 1));
+            assert_eq!(first_failing(parallel, n, none, |_| false), None);
+            assert_eq!(first_failing(parallel, n, none, |i| i == n - 1), Some(n - 1));
+            // Chunks the clean test passes are not searched: 2999 and 5999 are skipped.
+            let clean = |r: std::ops::Range<usize>| r.end <= 2 * CHUNK;
+            assert_eq!(
+                first_failing(parallel, n, clean, |i| i % 3000 == 2999),
+                Some(8999)
+            );
         }
     }
 }

@@ -3,8 +3,12 @@
 use crate::model::Model;
 use crate::Vec3;
 
-/// Net weight in water of a particle of mass `m` (N).
+/// Net weight in water of a particle of mass `m` (N): `m` times [`body_acceleration`].
 pub fn body_force(model: &Model, m: f64) -> Vec3 {
-    let volume = m / model.cloth_density;
-    (model.cloth_density - model.water_density) * volume * model.gravity
+    m * body_acceleration(model)
+}
+
+/// Net weight in water per kilogram of cloth, `(1 - rho_w / rho_c) g` (m/s^2).
+pub fn body_acceleration(model: &Model) -> Vec3 {
+    ((model.cloth_density - model.water_density) / model.cloth_density) * model.gravity
 }

@@ -13,7 +13,7 @@ mod springs;
 mod tiles;
 
 pub use assemble::add_spring_values;
-pub use body::body_force;
+pub use body::{body_acceleration, body_force};
 pub use contact::{apply_friction, Capsule, Collider, Plane, Sphere};
 pub use jacobian::{linearise, Linearisation};
 pub use normals::vertex_normals;
@@ -86,11 +86,12 @@ pub fn accumulate(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [V
         );
     }
     let normals = &scratch.normals;
+    let gravity = body_acceleration(m);
+    let half = (!input.half_derivative.is_empty()).then_some(input.half_derivative);
     // Everything but the springs, added to their sum `s` for particle p.
     let others = |p: usize, s: [f64; 3]| {
-        let mut total = Vec3::new(s[0], s[1], s[2]);
-        total += body_force(m, t.masses[p]);
-        let d = input.half_derivative.get(p).unwrap_or(&ZERO);
+        let mut total = Vec3::new(s[0], s[1], s[2]) + t.masses[p] * gravity;
+        let d = half.map_or(&ZERO, |h| &h[p]);
         drag::add(m, &input.v[p], d, with_normals.then(|| &normals[p]), &mut total);
         if !input.colliders.is_empty() {
             contact::add(m, input.colliders, &input.x[p], &input.v[p], &mut total);

@@ -291,27 +291,28 @@ fn fold_blocks(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64
 /// every particle as a scalar loop over its modes; laid out so it vectorises across lanes.
 #[inline(always)]
 fn fold_block(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64], out: &mut [Vec3]) {
-    let mut pv = [[0.0; LANES]; 3];
-    let mut vn = [[0.0; LANES]; 3];
+    const W: usize = 3 * LANES;
+    // Component-major, as the modes: entry d * LANES + q is component d of lane q.
+    let mut pv = [0.0; W];
+    let mut vn = [0.0; W];
     for q in 0..prev.len() {
         for d in 0..3 {
-            pv[d][q] = prev[q][d];
-            vn[d][q] = v[q][d];
+            pv[d * LANES + q] = prev[q][d];
+            vn[d * LANES + q] = v[q][d];
         }
     }
-    let mut acc = [[0.0; LANES]; 3];
-    for (l, mode) in modes.chunks_exact_mut(3 * LANES).enumerate() {
+    let mut acc = [0.0; W];
+    for (l, mode) in modes.chunks_exact_mut(W).enumerate() {
         let (decay, a, b, next) = (c.decay[l], c.a[l], c.b[l], c.next[l]);
-        for d in 0..3 {
-            let m = &mut mode[d * LANES..(d + 1) * LANES];
-            for q in 0..LANES {
-                m[q] = decay * m[q] + a * pv[d][q] + b * vn[d][q];
-                acc[d][q] += next * m[q];
-            }
+        for k in 0..W {
+            // Fused multiply-adds: one rounding each, same bits on every CPU (crate::simd).
+            let m = decay.mul_add(mode[k], a.mul_add(pv[k], b * vn[k]));
+            mode[k] = m;
+            acc[k] = next.mul_add(m, acc[k]);
         }
     }
     for (q, o) in out.iter_mut().enumerate().take(prev.len()) {
-        *o = Vec3::new(acc[0][q], acc[1][q], acc[2][q]);
+        *o = Vec3::new(acc[q], acc[LANES + q], acc[2 * LANES + q]);
     }
 }
 
