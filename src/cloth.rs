@@ -540,39 +540,71 @@ impl Cloth {
             buf.resize(n, Vec3::zeros());
         }
         // Pins move in a straight line to their goals over the step; that is their velocity.
-        s.v_step.copy_from_slice(&self.v);
         for (k, &i) in self.pin_list.iter().enumerate() {
             let i = i as usize;
             s.goal[i] = match fraction {
                 Some(f) => s.pin_start[k] + f * (self.pin_target[i] - s.pin_start[k]),
                 None => self.pin_target[i],
             };
-            if self.pinned[i] {
-                s.v_step[i] = (s.goal[i] - self.x[i]) / h;
-            }
         }
-        // D^{1/2}x_n = w0 v_n + H_n, of the velocity relative to the water.
+        // One pass over the particles: the step's velocities (pins' from their goals), the
+        // velocity relative to the water, D^{1/2}x_n = w0 v_n + H_n of it, and the component
+        // arrays the spring pass reads (positions and damping rate).
         let par = parallel::worth_it(n);
+        let with_history = !self.history.is_off();
         let mut w0 = 0.0;
-        if !self.history.is_off() {
+        if with_history {
             self.history.prepare();
             w0 = self.history.current_weight();
-            let current = self.config.model.current;
-            let (history, v_step) = (&self.history, &s.v_step);
-            parallel::chunks2(
-                par,
-                (&mut s.v_rel, 1),
-                (&mut s.half, 1),
-                parallel::CHUNK,
-                |first, rel, half| {
-                    history.past_range(first, half);
-                    for ((r, d), v) in rel.iter_mut().zip(half.iter_mut()).zip(&v_step[first..]) {
-                        *r = v - current;
-                        *d += w0 * *r;
-                    }
-                },
-            );
         }
+        let rate = forces::spring_rate(&self.config.model);
+        let current = self.config.model.current;
+        let (sx, sq) = s.forces.spring_arrays(n);
+        let (history, x, v, pinned, goal) = (&self.history, &self.x, &self.v, &self.pinned, &s.goal);
+        let (v_step, v_rel, half) = (
+            parallel::Disjoint::new(&mut s.v_step),
+            parallel::Disjoint::new(&mut s.v_rel),
+            parallel::Disjoint::new(&mut s.half),
+        );
+        let [sx, sy, sz] = sx.slices_mut().map(parallel::Disjoint::new);
+        let [qx, qy, qz] = sq.slices_mut().map(parallel::Disjoint::new);
+        parallel::for_chunks(par, n, parallel::CHUNK, |first, len| {
+            let r = first..first + len;
+            // SAFETY: every task borrows only its own chunk `r` of each array.
+            let (v_step, v_rel, half, sx, sy, sz, qx, qy, qz) = unsafe {
+                (
+                    v_step.range(r.clone()),
+                    v_rel.range(r.clone()),
+                    half.range(r.clone()),
+                    sx.range(r.clone()),
+                    sy.range(r.clone()),
+                    sz.range(r.clone()),
+                    qx.range(r.clone()),
+                    qy.range(r.clone()),
+                    qz.range(r.clone()),
+                )
+            };
+            if with_history {
+                history.past_range(first, half);
+            }
+            for k in 0..len {
+                let p = first + k;
+                let vs = if pinned[p] { (goal[p] - x[p]) / h } else { v[p] };
+                v_step[k] = vs;
+                let rel = vs - current;
+                v_rel[k] = rel;
+                if with_history {
+                    half[k] += w0 * rel;
+                }
+                (sx[k], sy[k], sz[k]) = (x[p].x, x[p].y, x[p].z);
+                let q = match rate {
+                    forces::SpringRate::HalfDerivative => half[k],
+                    forces::SpringRate::Velocity => vs,
+                    forces::SpringRate::None => continue,
+                };
+                (qx[k], qy[k], qz[k]) = (q.x, q.y, q.z);
+            }
+        });
         let input = ForceInput {
             model: &self.config.model,
             topology: &self.topology,
@@ -581,7 +613,7 @@ impl Cloth {
             half_derivative: &s.half,
             colliders: &self.colliders,
         };
-        forces::accumulate(&input, &mut s.forces, &mut s.force);
+        forces::accumulate_filled(&input, &mut s.forces, &mut s.force);
         let masses = &self.topology.masses;
         match self.config.integrator {
             Integrator::ExplicitEuler | Integrator::SymplecticEuler => {

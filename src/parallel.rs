@@ -88,6 +88,63 @@ where
     }
 }
 
+/// Calls `f(first, len)` for consecutive chunks `first .. first + len` of `0 .. n`, `chunk`
+/// long (the last may be shorter), in parallel when `parallel`. For passes that write several
+/// arrays at once through [`Disjoint`].
+pub fn for_chunks<F>(parallel: bool, n: usize, chunk: usize, f: F)
+where
+    F: Fn(usize, usize) + Sync + Send,
+{
+    let count = n.div_ceil(chunk);
+    let run = |k: usize| {
+        let first = k * chunk;
+        f(first, chunk.min(n - first))
+    };
+    if parallel {
+        (0..count).into_par_iter().for_each(run);
+    } else {
+        (0..count).for_each(run);
+    }
+}
+
+/// A mutable slice that the tasks of one [`for_chunks`] call write in disjoint ranges (what
+/// `split_at_mut` does for two parts, for as many parts as there are chunks, without allocating).
+pub struct Disjoint<'a, T> {
+    ptr: *mut T,
+    len: usize,
+    _borrow: std::marker::PhantomData<&'a mut [T]>,
+}
+
+// SAFETY: a `Disjoint` is a `&mut [T]` whose parts are handed out by `range`, whose contract
+// forbids overlapping parts; sending parts of it to other threads is then like sending the
+// halves of `split_at_mut`.
+unsafe impl<T: Send> Send for Disjoint<'_, T> {}
+// SAFETY: as above; `range` is the only access and its contract forbids overlapping borrows.
+unsafe impl<T: Send> Sync for Disjoint<'_, T> {}
+
+impl<'a, T> Disjoint<'a, T> {
+    pub fn new(s: &'a mut [T]) -> Self {
+        Self {
+            ptr: s.as_mut_ptr(),
+            len: s.len(),
+            _borrow: std::marker::PhantomData,
+        }
+    }
+
+    /// The elements `r`. Panics when `r` is out of bounds.
+    ///
+    /// # Safety
+    /// No two ranges borrowed from the same `Disjoint` at the same time may overlap (e.g. each
+    /// task of a [`for_chunks`] call takes only its own chunk).
+    #[allow(clippy::mut_from_ref)]
+    pub unsafe fn range(&self, r: std::ops::Range<usize>) -> &'a mut [T] {
+        assert!(r.start <= r.end && r.end <= self.len, "range out of bounds");
+        // SAFETY: in bounds (checked above) of a live `&'a mut [T]`; not aliased by any other
+        // borrow (the caller's contract).
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(r.start), r.end - r.start) }
+    }
+}
+
 /// The smallest index in `0..n` for which `bad` holds, searched in parallel chunks when
 /// `parallel`; the answer does not depend on the split. `clean(range)` is a fast test that
 /// must be true only when `bad` holds for no index of `range` (e.g. a branch-free pass that
@@ -135,6 +192,30 @@ mod tests {
                 }
             });
             assert!((0..a.len()).all(|i| b[2 * i] == i));
+        }
+    }
+
+    #[test]
+    fn for_chunks_with_disjoint_writes_every_element_once() {
+        for parallel in [false, true] {
+            let n = 3 * CHUNK + 5;
+            let (mut a, mut b) = (vec![0usize; n], vec![0usize; 2 * n]);
+            let (da, db) = (Disjoint::new(&mut a), Disjoint::new(&mut b));
+            for_chunks(parallel, n, CHUNK, |first, len| {
+                // SAFETY: each chunk borrows only its own range.
+                let (ca, cb) = unsafe {
+                    (
+                        da.range(first..first + len),
+                        db.range(2 * first..2 * (first + len)),
+                    )
+                };
+                for k in 0..len {
+                    ca[k] += first + k + 1;
+                    cb[2 * k + 1] += first + k;
+                }
+            });
+            assert!(a.iter().enumerate().all(|(i, &x)| x == i + 1));
+            assert!((0..n).all(|i| b[2 * i + 1] == i && b[2 * i] == 0));
         }
     }
 

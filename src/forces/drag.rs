@@ -1,31 +1,45 @@
-//! External drags on one particle, acting on its velocity relative to the water.
+//! External drags, acting on the velocity relative to the water.
 //!
 //! - viscous drag, Eq. 3: `-k_vd v`;
 //! - history (Basset) drag, Eq. 4: `-k_hd (D^{1/2}x . v_hat) v_hat`, zero when v = 0;
 //! - normal drag (regular models of Fig. 7): `-k_nd (v . n_hat) n_hat`.
 //!
-//! A term whose coefficient is zero is skipped.
+//! A term whose coefficient is zero is skipped. The drags are added tile by tile (a few hundred
+//! particles), in a loop over the tile that the compiler vectorises.
 
 use crate::model::Model;
 use crate::Vec3;
 
-/// Adds the drags on a particle with velocity `v`, half-derivative `d` and unit normal `n`
-/// (read only when normal drag is on) to `f`.
-#[inline]
-pub(super) fn add(m: &Model, v: &Vec3, d: &Vec3, n: Option<&Vec3>, f: &mut Vec3) {
-    let c = m.current;
+crate::simd_dispatch! { pub(super) fn add_tile(m: &Model, v: &[Vec3], d: Option<&[Vec3]>, n: Option<&[Vec3]>, f: &mut [Vec3]) => add_tile_kernel }
+
+/// Adds the drags on particles `0 .. f.len()` of a tile to `f`: velocities `v`,
+/// half-derivatives `d` (read when history drag is on) and unit normals `n` (read when normal
+/// drag is on), all of the same length.
+#[inline(always)]
+fn add_tile_kernel(m: &Model, v: &[Vec3], d: Option<&[Vec3]>, n: Option<&[Vec3]>, f: &mut [Vec3]) {
+    let len = f.len();
+    let (v, c) = (&v[..len], m.current);
     if m.viscous_drag != 0.0 {
-        *f -= m.viscous_drag * (v - c);
-    }
-    if m.history_drag != 0.0 {
-        let rel = v - c;
-        let speed2 = rel.norm_squared();
-        if speed2 > 0.0 {
-            // (d . v_hat) v_hat = (d . rel) rel / |rel|^2
-            *f -= m.history_drag * (d.dot(&rel) / speed2) * rel;
+        let k = m.viscous_drag;
+        for (fi, vi) in f.iter_mut().zip(v) {
+            *fi -= k * (vi - c);
         }
     }
-    if let Some(n) = n {
-        *f -= m.normal_drag * (v - c).dot(n) * n;
+    if let (Some(d), true) = (d, m.history_drag != 0.0) {
+        let (d, k) = (&d[..len], m.history_drag);
+        for t in 0..len {
+            let (rx, ry, rz) = (v[t].x - c.x, v[t].y - c.y, v[t].z - c.z);
+            let speed2 = rx * rx + ry * ry + rz * rz;
+            let dr = d[t].x * rx + d[t].y * ry + d[t].z * rz;
+            // (d . v_hat) v_hat = (d . rel) rel / |rel|^2; no direction (and no drag) at rest.
+            let s = if speed2 > 0.0 { k * dr / speed2 } else { 0.0 };
+            f[t] -= Vec3::new(s * rx, s * ry, s * rz);
+        }
+    }
+    if let (Some(n), true) = (n, m.normal_drag != 0.0) {
+        let (n, k) = (&n[..len], m.normal_drag);
+        for t in 0..len {
+            f[t] -= k * (v[t] - c).dot(&n[t]) * n[t];
+        }
     }
 }

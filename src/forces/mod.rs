@@ -17,6 +17,7 @@ pub use body::{body_acceleration, body_force};
 pub use contact::{apply_friction, Capsule, Collider, Plane, Sphere};
 pub use jacobian::{linearise, Linearisation};
 pub use normals::vertex_normals;
+pub use springs::{spring_rate, SpringRate};
 
 use crate::model::Model;
 use crate::parallel;
@@ -24,9 +25,6 @@ use crate::soa::Soa3;
 use crate::topology::Topology;
 use crate::Vec3;
 use assemble::TILE;
-
-/// Stands in for D^{1/2}x when a cloth keeps no history (no term reads it then).
-static ZERO: Vec3 = Vec3::new(0.0, 0.0, 0.0);
 
 /// Everything the forces read at one instant.
 pub struct ForceInput<'a> {
@@ -54,6 +52,16 @@ pub struct ForceScratch {
 }
 
 impl ForceScratch {
+    /// The component arrays the spring pass reads, positions and damping rate (see
+    /// [`spring_rate`]), sized for `n` particles: for a caller that fills them in a pass of
+    /// its own and then calls [`accumulate_filled`].
+    pub fn spring_arrays(&mut self, n: usize) -> (&mut Soa3, &mut Soa3) {
+        let s = &mut self.spring_inputs;
+        s.x.resize(n);
+        s.q.resize(n);
+        (&mut s.x, &mut s.q)
+    }
+
     /// Vertex normals of the last evaluation (empty when no term needed them).
     pub fn normals(&self) -> &[Vec3] {
         &self.normals
@@ -68,6 +76,17 @@ impl ForceScratch {
 /// particles run on rayon's pool when the cloth is large ([`parallel::worth_it`]) and the
 /// result does not depend on the thread count.
 pub fn accumulate(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [Vec3]) {
+    accumulate_with(input, scratch, f, false)
+}
+
+/// As [`accumulate`], with the spring pass's component arrays already filled by the caller
+/// ([`ForceScratch::spring_arrays`]: positions `input.x`, and the damping rate `input.v` or
+/// `input.half_derivative` as [`spring_rate`] says).
+pub fn accumulate_filled(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [Vec3]) {
+    accumulate_with(input, scratch, f, true)
+}
+
+fn accumulate_with(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [Vec3], filled: bool) {
     let m = input.model;
     let t = input.topology;
     let n = input.x.len();
@@ -85,20 +104,35 @@ pub fn accumulate(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [V
             &mut scratch.normals,
         );
     }
-    let normals = &scratch.normals;
+    let normals = with_normals.then_some(&scratch.normals[..]);
     let gravity = body_acceleration(m);
     let half = (!input.half_derivative.is_empty()).then_some(input.half_derivative);
-    // Everything but the springs, added to their sum `s` for particle p.
-    let others = |p: usize, s: [f64; 3]| {
-        let mut total = Vec3::new(s[0], s[1], s[2]) + t.masses[p] * gravity;
-        let d = half.map_or(&ZERO, |h| &h[p]);
-        drag::add(m, &input.v[p], d, with_normals.then(|| &normals[p]), &mut total);
-        if !input.colliders.is_empty() {
-            contact::add(m, input.colliders, &input.x[p], &input.v[p], &mut total);
+    // Everything but the springs, added to the springs' sums `s` of the tile starting at p0.
+    let others = |p0: usize, s: [&[f64]; 3], out: &mut [Vec3]| {
+        let len = out.len();
+        let (s, masses) = (
+            [&s[0][..len], &s[1][..len], &s[2][..len]],
+            &t.masses[p0..p0 + len],
+        );
+        for k in 0..len {
+            out[k] = Vec3::new(s[0][k], s[1][k], s[2][k]) + masses[k] * gravity;
         }
-        total
+        let range = p0..p0 + len;
+        drag::add_tile(
+            m,
+            &input.v[range.clone()],
+            half.map(|h| &h[range.clone()]),
+            normals.map(|nr| &nr[range.clone()]),
+            out,
+        );
+        if !input.colliders.is_empty() {
+            for (k, fi) in out.iter_mut().enumerate() {
+                let p = p0 + k;
+                contact::add(m, input.colliders, &input.x[p], &input.v[p], fi);
+            }
+        }
     };
-    let params = springs::params(input, par, &mut scratch.spring_inputs);
+    let params = springs::params(input, par, &mut scratch.spring_inputs, filled);
     if let Some(w) = tiles::window(t) {
         scratch.windows.resize(3 * w * n.div_ceil(parallel::CHUNK), 0.0);
         parallel::chunks2(
@@ -108,10 +142,8 @@ pub fn accumulate(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [V
             1,
             |chunk, window, out| {
                 let c0 = chunk * parallel::CHUNK;
-                tiles::spring_forces(&params, t, c0, out.len(), window, |p0, [x, y, z]| {
-                    for (k, fi) in out[p0 - c0..p0 - c0 + x.len()].iter_mut().enumerate() {
-                        *fi = others(p0 + k, [x[k], y[k], z[k]]);
-                    }
+                tiles::spring_forces(&params, t, c0, out.len(), window, |p0, sums| {
+                    others(p0, sums, &mut out[p0 - c0..p0 - c0 + sums[0].len()]);
                 });
             },
         );
@@ -123,9 +155,7 @@ pub fn accumulate(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [V
             for (tile, out) in chunk.chunks_mut(TILE).enumerate() {
                 let p0 = first + tile * TILE;
                 assemble::add_spring_forces(t, p0, out.len(), spring_force, &mut acc);
-                for (k, fi) in out.iter_mut().enumerate() {
-                    *fi = others(p0 + k, [acc[0][k], acc[1][k], acc[2][k]]);
-                }
+                others(p0, [&acc[0], &acc[1], &acc[2]], out);
             }
         });
     }

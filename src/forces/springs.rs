@@ -41,27 +41,51 @@ pub(super) struct Params<'a> {
 /// Copies of the positions and of the damping rate in component arrays, reused between steps.
 #[derive(Clone, Debug, Default)]
 pub(super) struct SpringScratch {
-    x: Soa3,
-    q: Soa3,
+    pub x: Soa3,
+    pub q: Soa3,
 }
 
-/// Copies what the spring pass reads into `scratch` (component arrays) and returns it.
+/// What the spring damping acts on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpringRate {
+    /// Undamped springs.
+    None,
+    /// The velocity.
+    Velocity,
+    /// D^{1/2}x (fractional springs, Eq. 5).
+    HalfDerivative,
+}
+
+/// What the spring damping of `m` acts on.
+pub fn spring_rate(m: &crate::model::Model) -> SpringRate {
+    match m.spring_damping_mode {
+        _ if m.spring_damping == 0.0 => SpringRate::None,
+        SpringDamping::None => SpringRate::None,
+        SpringDamping::Velocity => SpringRate::Velocity,
+        SpringDamping::Fractional => SpringRate::HalfDerivative,
+    }
+}
+
+/// What the spring pass reads; copies the positions and the damping rate into `scratch`
+/// (component arrays) unless `filled` says the caller already did.
 pub(super) fn params<'a>(
     input: &ForceInput<'a>,
     parallel: bool,
     scratch: &'a mut SpringScratch,
+    filled: bool,
 ) -> Params<'a> {
     let m = input.model;
-    let rate: Option<&[crate::Vec3]> = match m.spring_damping_mode {
-        _ if m.spring_damping == 0.0 => None,
-        SpringDamping::None => None,
-        SpringDamping::Velocity => Some(input.v),
-        SpringDamping::Fractional => Some(input.half_derivative),
+    let rate: Option<&[crate::Vec3]> = match spring_rate(m) {
+        SpringRate::None => None,
+        SpringRate::Velocity => Some(input.v),
+        SpringRate::HalfDerivative => Some(input.half_derivative),
     };
     let t = input.topology;
-    scratch.x.fill_from(parallel, input.x);
-    if let Some(q) = rate {
-        scratch.q.fill_from(parallel, q);
+    if !filled {
+        scratch.x.fill_from(parallel, input.x);
+        if let Some(q) = rate {
+            scratch.q.fill_from(parallel, q);
+        }
     }
     Params {
         stiffness: [
