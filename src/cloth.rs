@@ -561,6 +561,7 @@ impl Cloth {
         let current = self.config.model.current;
         let (sx, sq) = s.forces.spring_arrays(n);
         let (history, x, v, pinned, goal) = (&self.history, &self.x, &self.v, &self.pinned, &s.goal);
+        let pin_list = &self.pin_list;
         let (v_step, v_rel, half) = (
             parallel::Disjoint::new(&mut s.v_step),
             parallel::Disjoint::new(&mut s.v_rel),
@@ -587,22 +588,38 @@ impl Cloth {
             if with_history {
                 history.past_range(first, half);
             }
+            let (x, v) = (&x[r.clone()], &v[r.clone()]);
             for k in 0..len {
-                let p = first + k;
-                let vs = if pinned[p] { (goal[p] - x[p]) / h } else { v[p] };
-                v_step[k] = vs;
-                let rel = vs - current;
-                v_rel[k] = rel;
-                if with_history {
-                    half[k] += w0 * rel;
+                v_step[k] = v[k];
+                v_rel[k] = v[k] - current;
+                (sx[k], sy[k], sz[k]) = (x[k].x, x[k].y, x[k].z);
+            }
+            if with_history {
+                for k in 0..len {
+                    half[k] += w0 * v_rel[k];
                 }
-                (sx[k], sy[k], sz[k]) = (x[p].x, x[p].y, x[p].z);
-                let q = match rate {
-                    forces::SpringRate::HalfDerivative => half[k],
-                    forces::SpringRate::Velocity => vs,
-                    forces::SpringRate::None => continue,
-                };
-                (qx[k], qy[k], qz[k]) = (q.x, q.y, q.z);
+            }
+            // Fully pinned particles move to their goals: their velocity, and what follows from it.
+            for &i in pin_list {
+                let p = i as usize;
+                if !(r.contains(&p) && pinned[p]) {
+                    continue;
+                }
+                let k = p - first;
+                v_step[k] = (goal[p] - x[k]) / h;
+                v_rel[k] = v_step[k] - current;
+                if with_history {
+                    history.past_range(p, &mut half[k..k + 1]);
+                    half[k] += w0 * v_rel[k];
+                }
+            }
+            let q: &[Vec3] = match rate {
+                forces::SpringRate::HalfDerivative => half,
+                forces::SpringRate::Velocity => v_step,
+                forces::SpringRate::None => return,
+            };
+            for k in 0..len {
+                (qx[k], qy[k], qz[k]) = (q[k].x, q[k].y, q[k].z);
             }
         });
         let input = ForceInput {
