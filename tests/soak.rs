@@ -90,5 +90,5 @@ fn a_million_steps_with_soe_history() {
     }
     assert_eq!(c.step_count(), 1_000_000);
     assert!((c.time() - 500.0).abs() < 1e-6, "{}", c.time());
-    assert_eq!(c.history().mode_count(), 20);
+    assert_eq!(c.history().mode_count(), 16);
 }

@@ -52,7 +52,7 @@ impl Scheme {
     /// The paper's configuration (u = 3).
     pub const PAPER: Scheme = Scheme::Truncated { u: 3 };
     /// The default: SOE with 1e-3 relative kernel error (well below what the eye sees in
-    /// cloth motion, see `docs/accuracy.md`) for steps down to 0.1 ms and shots up to 1 h (20 modes).
+    /// cloth motion, see `docs/accuracy.md`) for steps down to 0.1 ms and shots up to 1 h (16 modes).
     pub const DEFAULT: Scheme = Scheme::SumOfExponentials {
         tolerance: DEFAULT_SOE_TOLERANCE,
         horizon: DEFAULT_SOE_HORIZON,

@@ -134,8 +134,8 @@ impl Clone for SumOfExponentials {
 impl SumOfExponentials {
     /// Modes that matter over a gap `g`: those with `s_l g <= cut-off`, the cut-off being where
     /// a mode's factor `e^{-s_l g}` falls below 1/1000 of the sum's own measured error (about
-    /// 13.9 at the default tolerance). A mode past it adds less than that to D^{1/2}x, so it is
-    /// neither summed nor folded; at 0.5 ms steps that leaves out the two fastest of 20.
+    /// 14.1 at the default tolerance). A mode past it adds less than that to D^{1/2}x, so it is
+    /// neither summed nor folded; at 1/24 s steps that leaves out the four fastest of 16.
     fn active_modes(&self, g: f64) -> usize {
         self.kernel.rates.partition_point(|&s| s * g <= self.cut)
     }
@@ -381,9 +381,9 @@ mod tests {
     fn leaving_out_negligible_modes_changes_d_by_less_than_the_cut_off_promises() {
         let kernel = SoeKernel::build(1e-3, 1e-4, 3600.0).unwrap();
         let skipping = SumOfExponentials::new(kernel.clone(), 1);
-        // At 1/24 s six modes are negligible; at 0.5 ms two.
-        assert_eq!(skipping.active_modes(1.0 / 24.0), kernel.len() - 6);
-        assert_eq!(skipping.active_modes(5e-4), kernel.len() - 2);
+        // At 1/24 s four of the 16 modes are negligible; at 0.5 ms none.
+        assert_eq!(skipping.active_modes(1.0 / 24.0), kernel.len() - 4);
+        assert_eq!(skipping.active_modes(5e-4), kernel.len());
         let mut keeping = skipping.clone();
         keeping.cut = f64::INFINITY;
         // Fine steps, coarse ones (modes left out, their state goes stale), fine again (they
