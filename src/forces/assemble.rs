@@ -57,18 +57,9 @@ where
 {
     for (k, o) in out.iter_mut().enumerate() {
         let row = t.vertex_springs.row(first + k);
-        let term = |e: u32| values[(e >> 1) as usize] * if e & 1 == 0 { 1.0 } else { j_sign };
-        let (mut even, mut odd) = (T::zeroed(), T::zeroed());
-        let mut pairs = row.chunks_exact(2);
-        for pair in &mut pairs {
-            even += term(pair[0]);
-            odd += term(pair[1]);
-        }
-        if let [last] = pairs.remainder() {
-            even += term(*last);
-        }
-        even += odd;
-        *o += even;
+        *o += row_sum(row, |e| {
+            values[(e >> 1) as usize] * if e & 1 == 0 { 1.0 } else { j_sign }
+        });
     }
 }
 
@@ -112,26 +103,33 @@ pub(super) fn add_spring_forces(
             let row = t.vertex_springs.row(p0 + k);
             for c in 0..3 {
                 let fc = f[c];
-                let term = |e: u32| {
+                acc[c][k] = row_sum(row, |e| {
                     if e & 1 == 0 {
                         fc[(e >> 1) as usize]
                     } else {
                         -fc[(e >> 1) as usize]
                     }
-                };
-                let (mut even, mut odd) = (0.0, 0.0);
-                let mut pairs = row.chunks_exact(2);
-                for pair in &mut pairs {
-                    even += term(pair[0]);
-                    odd += term(pair[1]);
-                }
-                if let [last] = pairs.remainder() {
-                    even += term(*last);
-                }
-                acc[c][k] = even + odd;
+                });
             }
         }
     }
+}
+
+/// `sum term(e)` over the adjacency row, in two interleaved partial sums (so additions do not
+/// wait on each other), even entries then odd, combined at the end: a fixed order.
+#[inline]
+fn row_sum<T: Pod + AddAssign>(row: &[u32], term: impl Fn(u32) -> T) -> T {
+    let (mut even, mut odd) = (T::zeroed(), T::zeroed());
+    let mut pairs = row.chunks_exact(2);
+    for pair in &mut pairs {
+        even += term(pair[0]);
+        odd += term(pair[1]);
+    }
+    if let [last] = pairs.remainder() {
+        even += term(*last);
+    }
+    even += odd;
+    even
 }
 
 crate::simd_dispatch! { pub(super) fn add_scaled_widest(sign: f64, src: &[f64], dst: &mut [f64]) => add_scaled }

@@ -107,18 +107,22 @@ impl TileRuns {
 
 #[cfg(test)]
 mod tests {
-    use crate::topology::GridSpec;
+    use crate::topology::{GridSpec, Topology};
 
-    #[test]
-    fn runs_describe_every_spring_exactly() {
-        let t = GridSpec {
+    fn grid_7x5() -> Topology {
+        GridSpec {
             width: 7,
             height: 5,
             spacing: 0.1,
             total_mass: 1.0,
         }
         .build()
-        .unwrap();
+        .unwrap()
+    }
+
+    #[test]
+    fn runs_describe_every_spring_exactly() {
+        let t = grid_7x5();
         let mut covered = 0;
         for r in &t.spring_runs {
             for k in 0..r.len {
@@ -137,14 +141,7 @@ mod tests {
 
     #[test]
     fn padded_runs_hold_every_spring_once_and_pad_only_gaps() {
-        let t = GridSpec {
-            width: 7,
-            height: 5,
-            spacing: 0.1,
-            total_mass: 1.0,
-        }
-        .build()
-        .unwrap();
+        let t = grid_7x5();
         let p = &t.tile_runs;
         // A grid's eight families (stretch and bend along rows and columns, the two shear
         // diagonals, the two skip-one bend diagonals) become eight runs.
