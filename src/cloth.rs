@@ -37,6 +37,9 @@ pub struct ClothConfig {
     pub solver: SolverSettings,
 }
 
+/// Particles per tile of the pass before the forces (its arrays for a tile fit in L1).
+const PASS_TILE: usize = 256;
+
 /// Most substeps one call may take.
 pub const MAX_SUBSTEPS: u32 = 1_000_000;
 
@@ -83,6 +86,7 @@ struct Scratch {
     v_new: Vec<Vec3>,
     goal: Vec<Vec3>,
     pin_start: Vec<Vec3>,
+    hard_pins: Vec<u32>,
     forces: ForceScratch,
     implicit: ImplicitScratch,
 }
@@ -557,11 +561,16 @@ impl Cloth {
             self.history.prepare();
             w0 = self.history.current_weight();
         }
+        // Fully pinned particles, ascending, to find those of a tile by bisection.
+        s.hard_pins.clear();
+        s.hard_pins
+            .extend(self.pin_list.iter().filter(|&&i| self.pinned[i as usize]));
+        s.hard_pins.sort_unstable();
+        let hard_pins = &s.hard_pins;
         let rate = forces::spring_rate(&self.config.model);
         let current = self.config.model.current;
         let (sx, sq) = s.forces.spring_arrays(n);
-        let (history, x, v, pinned, goal) = (&self.history, &self.x, &self.v, &self.pinned, &s.goal);
-        let pin_list = &self.pin_list;
+        let (history, x, v, goal) = (&self.history, &self.x, &self.v, &s.goal);
         let (v_step, v_rel, half) = (
             parallel::Disjoint::new(&mut s.v_step),
             parallel::Disjoint::new(&mut s.v_rel),
@@ -585,41 +594,37 @@ impl Cloth {
                     qz.range(r.clone()),
                 )
             };
-            if with_history {
-                history.past_range(first, half);
-            }
             let (x, v) = (&x[r.clone()], &v[r.clone()]);
-            for k in 0..len {
-                v_step[k] = v[k];
-                v_rel[k] = v[k] - current;
-                (sx[k], sy[k], sz[k]) = (x[k].x, x[k].y, x[k].z);
-            }
-            if with_history {
-                for k in 0..len {
-                    half[k] += w0 * v_rel[k];
+            // Tile by tile, so that the loops below find the tile's numbers in L1.
+            for t0 in (0..len).step_by(PASS_TILE) {
+                let t = t0..(t0 + PASS_TILE).min(len);
+                for k in t.clone() {
+                    v_step[k] = v[k];
+                    v_rel[k] = v[k] - current;
+                    (sx[k], sy[k], sz[k]) = (x[k].x, x[k].y, x[k].z);
                 }
-            }
-            // Fully pinned particles move to their goals: their velocity, and what follows from it.
-            for &i in pin_list {
-                let p = i as usize;
-                if !(r.contains(&p) && pinned[p]) {
-                    continue;
+                // Fully pinned particles move to their goals: that is their velocity.
+                let (lo, hi) = (first + t.start, first + t.end);
+                let pins = &hard_pins[hard_pins.partition_point(|&i| (i as usize) < lo)..];
+                for &i in pins.iter().take_while(|&&i| (i as usize) < hi) {
+                    let (p, k) = (i as usize, i as usize - first);
+                    v_step[k] = (goal[p] - x[k]) / h;
+                    v_rel[k] = v_step[k] - current;
                 }
-                let k = p - first;
-                v_step[k] = (goal[p] - x[k]) / h;
-                v_rel[k] = v_step[k] - current;
                 if with_history {
-                    history.past_range(p, &mut half[k..k + 1]);
-                    half[k] += w0 * v_rel[k];
+                    history.past_range(lo, &mut half[t.clone()]);
+                    for k in t.clone() {
+                        half[k] += w0 * v_rel[k];
+                    }
                 }
-            }
-            let q: &[Vec3] = match rate {
-                forces::SpringRate::HalfDerivative => half,
-                forces::SpringRate::Velocity => v_step,
-                forces::SpringRate::None => return,
-            };
-            for k in 0..len {
-                (qx[k], qy[k], qz[k]) = (q[k].x, q[k].y, q[k].z);
+                let q: &[Vec3] = match rate {
+                    forces::SpringRate::HalfDerivative => half,
+                    forces::SpringRate::Velocity => v_step,
+                    forces::SpringRate::None => continue,
+                };
+                for k in t {
+                    (qx[k], qy[k], qz[k]) = (q[k].x, q[k].y, q[k].z);
+                }
             }
         });
         let input = ForceInput {
