@@ -17,15 +17,37 @@ use super::{Collider, ForceInput};
 use crate::model::SpringDamping;
 use crate::Vec3;
 
+/// A spring's 3x3 block in the form every spring block has: `along dir dir^T + across I`
+/// (40 bytes instead of a matrix's 72; applying it is two dot-product-sized operations).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SpringBlock {
+    /// Unit direction of the spring (zero for a collapsed spring).
+    pub dir: Vec3,
+    pub along: f64,
+    pub across: f64,
+}
+
+impl SpringBlock {
+    /// The block times `u`.
+    #[inline]
+    pub fn apply(&self, u: &Vec3) -> Vec3 {
+        (self.along * self.dir.dot(u)) * self.dir + self.across * u
+    }
+
+    /// The block as a matrix.
+    pub fn matrix(&self) -> Matrix3<f64> {
+        self.along * outer(&self.dir) + self.across * Matrix3::identity()
+    }
+}
+
 /// Per-spring and per-particle blocks of `-df/dx` and `-df/dv`.
 #[derive(Clone, Debug, Default)]
 pub struct Linearisation {
     /// `-df_i/dx_i` of each spring (acts on x_i - x_j).
-    pub spring_stiffness: Vec<Matrix3<f64>>,
-    /// Damping coefficient c_s of each spring (block `c_s dir dir^T`).
+    pub spring_stiffness: Vec<SpringBlock>,
+    /// Damping coefficient c_s of each spring (block `c_s dir dir^T`, dir as in
+    /// `spring_stiffness`).
     pub spring_damping: Vec<f64>,
-    /// Unit direction of each spring.
-    pub spring_dir: Vec<Vec3>,
     /// Per-particle `-df/dv`.
     pub damping: Vec<Matrix3<f64>>,
     /// Per-particle `-df/dx`.
@@ -42,9 +64,8 @@ pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Li
     let m = input.model;
     let ns = input.topology.springs.len();
     let n = input.x.len();
-    out.spring_stiffness.resize(ns, Matrix3::zeros());
+    out.spring_stiffness.resize(ns, SpringBlock::default());
     out.spring_damping.resize(ns, 0.0);
-    out.spring_dir.resize(ns, Vec3::zeros());
     out.damping.resize(n, Matrix3::zeros());
     out.stiffness.resize(n, Matrix3::zeros());
     let cd = match m.spring_damping_mode {
@@ -57,17 +78,18 @@ pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Li
         let l = input.x[s.i as usize] - input.x[s.j as usize];
         let len = l.norm();
         if len == 0.0 {
-            out.spring_stiffness[k] = Matrix3::zeros();
+            out.spring_stiffness[k] = SpringBlock::default();
             out.spring_damping[k] = 0.0;
-            out.spring_dir[k] = Vec3::zeros();
             continue;
         }
-        let dir = l / len;
-        let ll = outer(&dir);
+        // k_s [l l^T + t (I - l l^T)] = k_s (1 - t) l l^T + k_s t I.
         let transverse = (1.0 - s.rest / len).max(0.0);
-        out.spring_stiffness[k] = ks * (ll + transverse * (Matrix3::identity() - ll));
+        out.spring_stiffness[k] = SpringBlock {
+            dir: l / len,
+            along: ks * (1.0 - transverse),
+            across: ks * transverse,
+        };
         out.spring_damping[k] = cd;
-        out.spring_dir[k] = dir;
     }
     let c = m.current;
     for i in 0..n {

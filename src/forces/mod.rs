@@ -15,7 +15,7 @@ mod tiles;
 pub use assemble::add_spring_values;
 pub use body::{body_acceleration, body_force};
 pub use contact::{apply_friction, Capsule, Collider, Plane, Sphere};
-pub use jacobian::{linearise, Linearisation};
+pub use jacobian::{linearise, Linearisation, SpringBlock};
 pub use normals::vertex_normals;
 pub use springs::{spring_rate, SpringRate};
 

@@ -14,7 +14,7 @@ use nalgebra::Matrix3;
 
 use super::cg::{self, CgScratch, SolverSettings, SolverStats};
 use crate::forces::add_spring_values;
-use crate::forces::Linearisation;
+use crate::forces::{Linearisation, SpringBlock};
 use crate::parallel;
 use crate::topology::Topology;
 use crate::Vec3;
@@ -26,8 +26,10 @@ pub struct ImplicitScratch {
     rhs: Vec<Vec3>,
     dv: Vec<Vec3>,
     precond: Vec<Matrix3<f64>>,
-    /// Per-spring blocks of the system and per-spring vectors of the product.
-    spring_blocks: Vec<Matrix3<f64>>,
+    /// Per-spring blocks of the system, the same as matrices (for the preconditioner), and
+    /// per-spring vectors of the product.
+    spring_blocks: Vec<SpringBlock>,
+    spring_matrices: Vec<Matrix3<f64>>,
     spring_values: Vec<Vec3>,
     cg: CgScratch,
 }
@@ -45,11 +47,26 @@ pub struct ImplicitInput<'a> {
 }
 
 /// Writes `out[k] = blocks[k] (p_i - p_j)` for every spring k.
-fn spring_products(par: bool, t: &Topology, blocks: &[Matrix3<f64>], p: &[Vec3], out: &mut [Vec3]) {
+fn spring_products(par: bool, t: &Topology, blocks: &[SpringBlock], p: &[Vec3], out: &mut [Vec3]) {
+    // Run by run: a run's end points are contiguous slices of `p` (no index loads).
+    let runs = &t.spring_runs;
     parallel::chunks(par, out, parallel::CHUNK, |first, chunk| {
-        for (k, o) in chunk.iter_mut().enumerate() {
-            let s = &t.springs[first + k];
-            *o = blocks[first + k] * (p[s.i as usize] - p[s.j as usize]);
+        let end = first + chunk.len();
+        let mut r = runs.partition_point(|r| (r.first_spring + r.len) as usize <= first);
+        while let Some(run) = runs.get(r) {
+            let (a, b) = (run.first_spring as usize, (run.first_spring + run.len) as usize);
+            if a >= end {
+                break;
+            }
+            let (lo, hi) = (a.max(first), b.min(end));
+            let n = hi - lo;
+            let i0 = run.first_vertex as usize + (lo - a);
+            let j0 = i0 + run.offset as usize;
+            let (pi, pj, bl) = (&p[i0..i0 + n], &p[j0..j0 + n], &blocks[lo..hi]);
+            for (k, o) in chunk[lo - first..hi - first].iter_mut().enumerate() {
+                *o = bl[k].apply(&(pi[k] - pj[k]));
+            }
+            r += 1;
         }
     });
 }
@@ -59,7 +76,7 @@ fn spring_products(par: bool, t: &Topology, blocks: &[Matrix3<f64>], p: &[Vec3],
 fn apply_system(
     inp: &ImplicitInput<'_>,
     lin: &Linearisation,
-    blocks: &[Matrix3<f64>],
+    blocks: &[SpringBlock],
     values: &mut [Vec3],
     p: &[Vec3],
     out: &mut [Vec3],
@@ -93,27 +110,34 @@ pub fn implicit_euler(
         dv,
         precond,
         spring_blocks,
+        spring_matrices,
         spring_values,
         cg,
     } = scratch;
     rhs.resize(n, Vec3::zeros());
     dv.resize(n, Vec3::zeros());
     precond.resize(n, Matrix3::identity());
-    spring_blocks.resize(t.springs.len(), Matrix3::zeros());
+    spring_blocks.resize(t.springs.len(), SpringBlock::default());
+    spring_matrices.resize(t.springs.len(), Matrix3::zeros());
     spring_values.resize(t.springs.len(), Vec3::zeros());
     // Each spring's block of the system: h c_s dir dir^T + h^2 K_s.
     parallel::chunks(par, spring_blocks, parallel::CHUNK, |first, chunk| {
         for (k, b) in chunk.iter_mut().enumerate() {
-            let dir = lin.spring_dir[first + k];
-            *b = h * lin.spring_damping[first + k] * dir * dir.transpose()
-                + h * h * lin.spring_stiffness[first + k];
+            // h c_s dir dir^T + h^2 K_s, K_s = along dir dir^T + across I.
+            let ks = &lin.spring_stiffness[first + k];
+            *b = SpringBlock {
+                dir: ks.dir,
+                along: h * lin.spring_damping[first + k] + h * h * ks.along,
+                across: h * h * ks.across,
+            };
         }
     });
     // rhs = h f_n - h^2 K v_n (the springs' K acting on v_i - v_j).
     parallel::chunks(par, spring_values, parallel::CHUNK, |first, chunk| {
         for (k, o) in chunk.iter_mut().enumerate() {
             let s = &t.springs[first + k];
-            *o = -(h * h) * (lin.spring_stiffness[first + k] * (inp.v[s.i as usize] - inp.v[s.j as usize]));
+            *o = -(h * h)
+                * lin.spring_stiffness[first + k].apply(&(inp.v[s.i as usize] - inp.v[s.j as usize]));
         }
     });
     let values = &*spring_values;
@@ -126,12 +150,18 @@ pub fn implicit_euler(
     });
     // Block-Jacobi preconditioner: inverse of each 3x3 diagonal block of the system.
     let blocks = &*spring_blocks;
+    parallel::chunks(par, spring_matrices, parallel::CHUNK, |first, chunk| {
+        for (k, m) in chunk.iter_mut().enumerate() {
+            *m = blocks[first + k].matrix();
+        }
+    });
+    let matrices = &*spring_matrices;
     parallel::chunks(par, precond, parallel::CHUNK, |first, chunk| {
         for (k, m) in chunk.iter_mut().enumerate() {
             let i = first + k;
             *m = inp.masses[i] * Matrix3::identity() + h * lin.damping[i] + h * h * lin.stiffness[i];
         }
-        add_spring_values(t, first, blocks, 1.0, chunk);
+        add_spring_values(t, first, matrices, 1.0, chunk);
         for (k, m) in chunk.iter_mut().enumerate() {
             *m = m
                 .try_inverse()
