@@ -17,7 +17,7 @@ pub const CHUNK: usize = 4096;
 
 /// Fewest particles for which a step uses more than one thread (measured with
 /// `cargo run --release --example throughput`; see docs/benchmarks.md).
-pub const MIN_PARALLEL: usize = 10_000;
+pub const MIN_PARALLEL: usize = 16_000;
 
 /// Whether a cloth of `n` particles should spread its passes over the pool.
 pub fn worth_it(n: usize) -> bool {
