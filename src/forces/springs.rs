@@ -19,7 +19,7 @@ use super::ForceInput;
 use crate::model::SpringDamping;
 use crate::parallel;
 use crate::soa::Soa3;
-use crate::topology::{SpringKind, SpringRun};
+use crate::topology::{for_each_piece, SpringKind, SpringRun};
 
 /// What the spring pass reads besides the springs.
 #[derive(Clone, Copy)]
@@ -112,13 +112,7 @@ pub(super) fn compute(p: &Params<'_>, runs: &[SpringRun], parallel: bool, out: &
     out.resize(p.rest.len());
     parallel::chunks3(parallel, out.slices_mut(), parallel::CHUNK, |first, mut chunk| {
         let end = first + chunk[0].len();
-        let mut r = runs.partition_point(|r| (r.first_spring + r.len) as usize <= first);
-        while let Some(run) = runs.get(r) {
-            let (a, b) = (run.first_spring as usize, (run.first_spring + run.len) as usize);
-            if a >= end {
-                break;
-            }
-            let (lo, hi) = (a.max(first), b.min(end));
+        for_each_piece(runs, first, end, |run, lo, hi| {
             let [ox, oy, oz] = &mut chunk;
             let piece = [
                 &mut ox[lo - first..hi - first],
@@ -126,8 +120,7 @@ pub(super) fn compute(p: &Params<'_>, runs: &[SpringRun], parallel: bool, out: &
                 &mut oz[lo - first..hi - first],
             ];
             run_widest(p, run, lo, piece);
-            r += 1;
-        }
+        });
     });
 }
 

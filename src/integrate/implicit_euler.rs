@@ -16,7 +16,7 @@ use super::cg::{self, CgScratch, SolverSettings, SolverStats};
 use crate::forces::add_spring_values;
 use crate::forces::{Linearisation, SpringBlock};
 use crate::parallel;
-use crate::topology::Topology;
+use crate::topology::{for_each_piece, Topology};
 use crate::Vec3;
 
 /// Work memory of the implicit step.
@@ -49,25 +49,16 @@ pub struct ImplicitInput<'a> {
 /// Writes `out[k] = blocks[k] (p_i - p_j)` for every spring k.
 fn spring_products(par: bool, t: &Topology, blocks: &[SpringBlock], p: &[Vec3], out: &mut [Vec3]) {
     // Run by run: a run's end points are contiguous slices of `p` (no index loads).
-    let runs = &t.spring_runs;
     parallel::chunks(par, out, parallel::CHUNK, |first, chunk| {
-        let end = first + chunk.len();
-        let mut r = runs.partition_point(|r| (r.first_spring + r.len) as usize <= first);
-        while let Some(run) = runs.get(r) {
-            let (a, b) = (run.first_spring as usize, (run.first_spring + run.len) as usize);
-            if a >= end {
-                break;
-            }
-            let (lo, hi) = (a.max(first), b.min(end));
+        for_each_piece(&t.spring_runs, first, first + chunk.len(), |run, lo, hi| {
             let n = hi - lo;
-            let i0 = run.first_vertex as usize + (lo - a);
+            let i0 = run.first_vertex as usize + (lo - run.first_spring as usize);
             let j0 = i0 + run.offset as usize;
             let (pi, pj, bl) = (&p[i0..i0 + n], &p[j0..j0 + n], &blocks[lo..hi]);
             for (k, o) in chunk[lo - first..hi - first].iter_mut().enumerate() {
                 *o = bl[k].apply(&(pi[k] - pj[k]));
             }
-            r += 1;
-        }
+        });
     });
 }
 

@@ -13,7 +13,7 @@ mod spring;
 pub use adjacency::Adjacency;
 pub use grid::{grid_index, GridSpec};
 pub use mesh::{MeshMass, MeshSpec, MAX_MESH_VERTICES};
-pub use runs::{SpringRun, TileRuns};
+pub use runs::{for_each_piece, SpringRun, TileRuns};
 pub use spring::{Spring, SpringKind};
 
 use crate::Vec3;

@@ -19,6 +19,24 @@ pub struct SpringRun {
     pub len: u32,
 }
 
+/// Calls `f(run, lo, hi)` for every run overlapping the springs `first .. end`, in order, with
+/// `lo .. hi` the overlap (spring indices). `runs` must be in spring order, as built here.
+pub fn for_each_piece(
+    runs: &[SpringRun],
+    first: usize,
+    end: usize,
+    mut f: impl FnMut(&SpringRun, usize, usize),
+) {
+    let start = runs.partition_point(|r| (r.first_spring + r.len) as usize <= first);
+    for run in &runs[start..] {
+        let (a, b) = (run.first_spring as usize, (run.first_spring + run.len) as usize);
+        if a >= end {
+            break;
+        }
+        f(run, a.max(first), b.min(end));
+    }
+}
+
 /// Sorts `springs` (each with i < j) by (kind, j - i, i) and returns the runs.
 pub fn order_into_runs(springs: &mut [Spring]) -> Vec<SpringRun> {
     springs.sort_by_key(|s| (s.kind as u8, s.j - s.i, s.i));
