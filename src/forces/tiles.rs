@@ -31,7 +31,8 @@ const MAX_OFFSET: usize = 1024;
 pub(super) fn window(t: &Topology) -> Option<usize> {
     let tr = &t.tile_runs;
     let long = tr.rest.len() >= 8 * tr.runs.len();
-    (long && tr.max_offset <= MAX_OFFSET).then_some(TILE + tr.max_offset)
+    // Lazily: the sum is formed only when the offset is known to be small.
+    (long && tr.max_offset <= MAX_OFFSET).then(|| TILE + tr.max_offset)
 }
 
 /// Sums the spring forces of particles `c0 .. c0 + len` (one chunk) tile by tile and calls
