@@ -30,6 +30,7 @@ where
     }
 }
 
+/// Run by run, for particles `first .. first + out.len()`, a range inside one chunk.
 fn by_runs<T: Pod>(t: &Topology, first: usize, values: &[T], j_sign: f64, out: &mut [T]) {
     let end = first + out.len();
     let width = std::mem::size_of::<T>() / std::mem::size_of::<f64>();
@@ -81,22 +82,10 @@ pub(super) fn add_spring_forces(
     for a in acc.iter_mut() {
         a[..len].fill(0.0);
     }
-    let end = p0 + len;
     if t.long_runs() {
-        for &r in t.chunk_runs.row(p0 / crate::parallel::CHUNK) {
-            let run = &t.spring_runs[r as usize];
-            let s0 = run.first_spring as usize;
-            let n = run.len as usize;
-            let i0 = run.first_vertex as usize;
-            for (start, sign) in [(i0, 1.0), (i0 + run.offset as usize, -1.0)] {
-                let (lo, hi) = (start.max(p0), (start + n).min(end));
-                if lo < hi {
-                    let src = (s0 + lo - start)..(s0 + hi - start);
-                    for c in 0..3 {
-                        add_scaled_widest(sign, &f[c][src.clone()], &mut acc[c][lo - p0..hi - p0]);
-                    }
-                }
-            }
+        // Component by component: each particle receives its springs in the same order.
+        for c in 0..3 {
+            by_runs(t, p0, f[c], -1.0, &mut acc[c][..len]);
         }
     } else {
         for k in 0..len {
