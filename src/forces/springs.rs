@@ -34,8 +34,6 @@ pub(super) struct Params<'a> {
     /// Rest length and family of each spring (or slot of a padded run).
     pub rest: &'a [f64],
     pub kinds: &'a [u8],
-    /// 1 for a real spring, 0 for a padding slot (read only by [`run_padded_widest`]).
-    pub live: &'a [f64],
 }
 
 /// Copies of the positions and of the damping rate in component arrays, reused between steps.
@@ -102,7 +100,6 @@ pub(super) fn params<'a>(
         },
         rest: &t.spring_rest,
         kinds: &t.spring_kinds,
-        live: &[],
     }
 }
 
@@ -124,27 +121,27 @@ pub(super) fn compute(p: &Params<'_>, runs: &[SpringRun], parallel: bool, out: &
     });
 }
 
-crate::simd_dispatch! { pub(super) fn run_widest(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) => run_kernel_plain }
-crate::simd_dispatch! { pub(super) fn run_padded_widest(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) => run_kernel_padded }
+crate::simd_dispatch! { pub(super) fn run_widest(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) => run_kernel_each }
+crate::simd_dispatch! { pub(super) fn run_uniform_widest(p: &Params<'_>, run: &SpringRun, first_spring: usize, rest: f64, out: [&mut [f64]; 3]) => run_kernel_uniform }
 
 #[inline(always)]
-fn run_kernel_plain(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) {
-    run_kernel::<false>(p, run, first_spring, out)
+fn run_kernel_each(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) {
+    run_kernel::<false>(p, run, first_spring, 0.0, out)
 }
 
 #[inline(always)]
-fn run_kernel_padded(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) {
-    run_kernel::<true>(p, run, first_spring, out)
+fn run_kernel_uniform(p: &Params<'_>, run: &SpringRun, first_spring: usize, rest: f64, out: [&mut [f64]; 3]) {
+    run_kernel::<true>(p, run, first_spring, rest, out)
 }
 
-/// Springs `first_spring ..` of `run`, as many as `out` holds. With `PADDED`, `run` is a
-/// padded run ([`crate::topology::TileRuns`]) and each force is multiplied by its slot's `live`
-/// (0 for padding).
+/// Springs `first_spring ..` of `run`, as many as `out` holds. With `UNIFORM`, every spring
+/// has the rest length `uniform_rest` and `p.rest` is not read (same arithmetic either way).
 #[inline(always)]
-fn run_kernel<'a, const PADDED: bool>(
+fn run_kernel<'a, const UNIFORM: bool>(
     p: &Params<'a>,
     run: &SpringRun,
     first_spring: usize,
+    uniform_rest: f64,
     out: [&mut [f64]; 3],
 ) {
     let [fx, fy, fz] = out;
@@ -156,12 +153,12 @@ fn run_kernel<'a, const PADDED: bool>(
     let ends = |a: [&'a [f64]; 3], s: usize| [&a[0][s..s + n], &a[1][s..s + n], &a[2][s..s + n]];
     let ([xi, yi, zi], [xj, yj, zj]) = (ends(p.x, i0), ends(p.x, j0));
     let ([qxi, qyi, qzi], [qxj, qyj, qzj]) = (ends(p.q, i0), ends(p.q, j0));
-    let rest = &p.rest[first_spring..first_spring + n];
-    let live = if PADDED {
-        &p.live[first_spring..first_spring + n]
-    } else {
+    let rest: &[f64] = if UNIFORM {
         &[]
+    } else {
+        &p.rest[first_spring..first_spring + n]
     };
+    let rest_at = |t: usize| if UNIFORM { uniform_rest } else { rest[t] };
     let kd = p.kd;
     // Out-of-range squared lengths (see `inverse_length`) fall back to the exact kernel.
     // A squared length outside `[SEED_MIN, SEED_MAX]` (see `inverse_length`), or NaN: the slice
@@ -177,19 +174,18 @@ fn run_kernel<'a, const PADDED: bool>(
         let len = l2 * inv;
         // F = (mag / |l|) l with mag = -k_s (|l| - r) - k_d (dq . l) / |l|.
         let mag = if kd == 0.0 {
-            -ks * (len - rest[t])
+            -ks * (len - rest_at(t))
         } else {
             let (dx, dy, dz) = (qxi[t] - qxj[t], qyi[t] - qyj[t], qzi[t] - qzj[t]);
             let dql = dx.mul_add(lx, dy.mul_add(ly, dz * lz));
-            (-ks).mul_add(len - rest[t], -(kd * inv) * dql)
+            (-ks).mul_add(len - rest_at(t), -(kd * inv) * dql)
         };
-        let s = if PADDED { mag * inv * live[t] } else { mag * inv };
+        let s = mag * inv;
         fx[t] = s * lx;
         fy[t] = s * ly;
         fz[t] = s * lz;
     }
     if outside {
-        let live = PADDED.then_some(live);
         exact_kernel(
             ks,
             kd,
@@ -197,8 +193,7 @@ fn run_kernel<'a, const PADDED: bool>(
             [xj, yj, zj],
             [qxi, qyi, qzi],
             [qxj, qyj, qzj],
-            rest,
-            live,
+            rest_at,
             [fx, fy, fz],
         );
     }
@@ -222,7 +217,7 @@ fn inverse_length(l2: f64) -> f64 {
 
 /// The spring pass with f64 square root and division, for slices with a squared length outside
 /// `[SEED_MIN, SEED_MAX]` (collapsed or absurdly long springs). A zero-length spring has no
-/// direction: no force rather than NaN. `live` multiplies each force (padded runs).
+/// direction: no force rather than NaN. `rest(t)`: the rest length of spring t.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn exact_kernel(
@@ -232,27 +227,22 @@ fn exact_kernel(
     xj: [&[f64]; 3],
     qi: [&[f64]; 3],
     qj: [&[f64]; 3],
-    rest: &[f64],
-    live: Option<&[f64]>,
+    rest: impl Fn(usize) -> f64,
     out: [&mut [f64]; 3],
 ) {
     let [fx, fy, fz] = out;
-    for t in 0..rest.len() {
+    for t in 0..fx.len() {
         let l = [xi[0][t] - xj[0][t], xi[1][t] - xj[1][t], xi[2][t] - xj[2][t]];
         let dq = [qi[0][t] - qj[0][t], qi[1][t] - qj[1][t], qi[2][t] - qj[2][t]];
         let len = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
         let dql = dq[0] * l[0] + dq[1] * l[1] + dq[2] * l[2];
         let inv = 1.0 / len;
         let mag = if kd == 0.0 {
-            -ks * (len - rest[t])
+            -ks * (len - rest(t))
         } else {
-            -ks * (len - rest[t]) - kd * dql * inv
+            -ks * (len - rest(t)) - kd * dql * inv
         };
-        let s = if len > 0.0 {
-            mag * inv * live.map_or(1.0, |m| m[t])
-        } else {
-            0.0
-        };
+        let s = if len > 0.0 { mag * inv } else { 0.0 };
         fx[t] = s * l[0];
         fy[t] = s * l[1];
         fz[t] = s * l[2];

@@ -17,7 +17,7 @@
 //! the sums do not depend on the thread count.
 
 use super::assemble::add_scaled_widest;
-use super::springs::{run_padded_widest, Params};
+use super::springs::{run_uniform_widest, run_widest, Params};
 use crate::topology::Topology;
 
 /// Particles per tile.
@@ -54,7 +54,6 @@ pub(super) fn spring_forces<F>(
     let p = &Params {
         rest: &t.tile_runs.rest,
         kinds: &t.tile_runs.kinds,
-        live: &t.tile_runs.live,
         ..*p
     };
     window.fill(0.0);
@@ -98,8 +97,10 @@ fn add_range(
     window: &mut [f64],
     temp: &mut [[f64; TILE]; 3],
 ) {
+    let tr = &t.tile_runs;
     for &r in runs {
-        let run = &t.tile_runs.runs[r as usize];
+        let run = &tr.runs[r as usize];
+        let uniform = tr.uniform_rest[r as usize];
         let i0 = run.first_vertex as usize;
         let off = run.offset as usize;
         let i_end = i0 + run.len as usize;
@@ -114,7 +115,15 @@ fn add_range(
             let m = (hi - lo).min(TILE);
             let s = run.first_spring as usize + (lo - i0);
             let [tx, ty, tz] = temp;
-            run_padded_widest(p, run, s, [&mut tx[..m], &mut ty[..m], &mut tz[..m]]);
+            let out = [&mut tx[..m], &mut ty[..m], &mut tz[..m]];
+            match uniform {
+                Some(rest) => run_uniform_widest(p, run, s, rest, out),
+                None => run_widest(p, run, s, out),
+            }
+            // Padding slots were evaluated like springs: no force.
+            for q in tr.pads_in(s..s + m) {
+                (tx[q - s], ty[q - s], tz[q - s]) = (0.0, 0.0, 0.0);
+            }
             // +f at the i ends inside the chunk.
             let (a, b) = (lo.max(c0), (lo + m).min(c1));
             if a < b {

@@ -80,7 +80,10 @@ impl GridSpec {
                         }
                         let a = (j * i64::from(w) + i) as u32;
                         let b = (nj * i64::from(w) + ni) as u32;
-                        let rest = (rest_positions[b as usize] - rest_positions[a as usize]).norm();
+                        // The nominal length, the same bits for every spring of a family (the
+                        // difference of the rest positions can differ from it by an ulp), so
+                        // the force pass can treat a family's rest length as one number.
+                        let rest = s * ((di * di + dj * dj) as f64).sqrt();
                         springs.push(Spring {
                             i: a.min(b),
                             j: a.max(b),

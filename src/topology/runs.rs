@@ -65,10 +65,11 @@ const MAX_GAP: u32 = 4;
 
 /// The runs again, with runs of the same family and offset that are separated by a few missing
 /// springs joined into one by padding slots (a grid's rows break every horizontal, shear and
-/// bend run at the row end: padding makes each family one run). A slot is a real spring
-/// (`live` = 1) or padding (`live` = 0, rest 0: its force is multiplied by 0).
-/// `SpringRun::first_spring` indexes slots here. Used by the tiled force pass, where fewer, longer runs mean fewer,
-/// longer vector loops.
+/// bend run at the row end: padding makes each family one run). A slot is a real spring or
+/// padding (listed in `pads`, rest 0): the force pass evaluates padding like a spring and then
+/// sets its force to zero, so it reads nothing per slot to tell them apart.
+/// `SpringRun::first_spring` indexes slots here. Used by the tiled force pass, where fewer,
+/// longer runs mean fewer, longer vector loops.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TileRuns {
     pub runs: Vec<SpringRun>,
@@ -76,8 +77,11 @@ pub struct TileRuns {
     pub rest: Vec<f64>,
     /// Family of each slot (`SpringKind as u8`).
     pub kinds: Vec<u8>,
-    /// 1 for a spring, 0 for padding.
-    pub live: Vec<f64>,
+    /// The padding slots, ascending.
+    pub pads: Vec<u32>,
+    /// Per run: the rest length every spring of it has, when they all have the same one (a
+    /// regular grid's families), so the force pass need not read `rest` for it.
+    pub uniform_rest: Vec<Option<f64>>,
     /// Runs touching each chunk of vertices.
     pub chunk_runs: super::Adjacency,
     /// Largest offset of any run.
@@ -99,9 +103,9 @@ impl TileRuns {
             match (gap, t.runs.last_mut()) {
                 (Some(gap), Some(last)) => {
                     for _ in 0..gap {
+                        t.pads.push(t.rest.len() as u32);
                         t.rest.push(0.0);
                         t.kinds.push(kind);
-                        t.live.push(0.0);
                     }
                     last.len += gap + r.len;
                 }
@@ -114,12 +118,41 @@ impl TileRuns {
             for s in &springs[r.first_spring as usize..(r.first_spring + r.len) as usize] {
                 t.rest.push(s.rest);
                 t.kinds.push(kind);
-                t.live.push(1.0);
             }
         }
+        t.uniform_rest = t.runs.iter().map(|r| t.uniform(r)).collect();
         t.chunk_runs = super::Adjacency::chunk_runs(n, &t.runs);
         t.max_offset = t.runs.iter().map(|r| r.offset as usize).max().unwrap_or(0);
         t
+    }
+
+    /// The rest length shared by every spring (not padding) of `run`, if there is one.
+    fn uniform(&self, run: &SpringRun) -> Option<f64> {
+        let slots = run.first_spring as usize..(run.first_spring + run.len) as usize;
+        let first_pad = self.pads.partition_point(|&q| (q as usize) < slots.start);
+        let mut pads = self.pads[first_pad..].iter().map(|&q| q as usize).peekable();
+        let mut shared: Option<f64> = None;
+        for slot in slots {
+            if pads.next_if_eq(&slot).is_some() {
+                continue;
+            }
+            let r = self.rest[slot];
+            match shared {
+                None => shared = Some(r),
+                Some(s) if s.to_bits() == r.to_bits() => {}
+                Some(_) => return None,
+            }
+        }
+        shared
+    }
+
+    /// The padding slots among `slots`.
+    pub fn pads_in(&self, slots: std::ops::Range<usize>) -> impl Iterator<Item = usize> + '_ {
+        let first = self.pads.partition_point(|&q| (q as usize) < slots.start);
+        self.pads[first..]
+            .iter()
+            .map(|&q| q as usize)
+            .take_while(move |&q| q < slots.end)
     }
 }
 
@@ -166,22 +199,41 @@ mod tests {
         assert_eq!(p.runs.len(), 8);
         let mut seen = vec![0; t.springs.len()];
         for r in &p.runs {
-            for k in 0..r.len {
-                let slot = (r.first_spring + k) as usize;
-                let (i, j) = (r.first_vertex + k, r.first_vertex + k + r.offset);
+            let slots = r.first_spring as usize..(r.first_spring + r.len) as usize;
+            let pads: Vec<usize> = p.pads_in(slots.clone()).collect();
+            for (k, slot) in slots.enumerate() {
+                let (i, j) = (r.first_vertex + k as u32, r.first_vertex + k as u32 + r.offset);
                 let found = t.springs.iter().position(|s| s.i == i && s.j == j);
                 match found {
                     Some(s) => {
-                        assert_eq!(p.live[slot], 1.0);
+                        assert!(!pads.contains(&slot));
                         assert_eq!(p.rest[slot], t.springs[s].rest);
                         assert_eq!(p.kinds[slot], t.springs[s].kind as u8);
                         seen[s] += 1;
                     }
-                    None => assert_eq!((p.live[slot], p.rest[slot]), (0.0, 0.0)),
+                    None => assert!(pads.contains(&slot) && p.rest[slot] == 0.0),
                 }
             }
         }
         assert!(seen.iter().all(|&c| c == 1));
         assert_eq!(p.max_offset, 16);
+        // A regular grid: each family has one rest length.
+        assert!(p.uniform_rest.iter().all(|r| r.is_some()));
+    }
+
+    #[test]
+    fn a_run_with_two_rest_lengths_has_no_uniform_one() {
+        let mut t = grid_7x5();
+        // Stretch one spring of the first family: the topology is rebuilt from the springs.
+        t.springs[0].rest *= 1.5;
+        let p = super::TileRuns::new(t.vertex_count(), &t.springs, &t.spring_runs);
+        let kind = t.springs[0].kind as u8;
+        let (with, without): (Vec<_>, Vec<_>) = p
+            .runs
+            .iter()
+            .zip(&p.uniform_rest)
+            .partition(|(r, _)| p.kinds[r.first_spring as usize] == kind && r.first_vertex == 0);
+        assert!(with.iter().any(|(_, u)| u.is_none()));
+        assert!(without.iter().all(|(_, u)| u.is_some()));
     }
 }
