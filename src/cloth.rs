@@ -14,13 +14,14 @@ use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
 use crate::forces::{self, Collider, ForceInput, ForceScratch, Plane, Sphere};
 use crate::history::{HalfDerivative, History, Scheme};
 use crate::integrate::{
-    explicit_euler, implicit_euler, symplectic_euler, ImplicitInput, ImplicitScratch, Integrator,
-    SolverSettings, SolverStats,
+    self, explicit_euler, explicit_euler_range, implicit_euler, symplectic_euler, symplectic_euler_range,
+    ImplicitInput, ImplicitScratch, Integrator, SolverSettings, SolverStats,
 };
 use crate::model::Model;
 use crate::parallel;
 use crate::topology::Topology;
 use crate::Vec3;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Everything that configures a cloth besides its topology.
 #[derive(Clone, Debug, PartialEq)]
@@ -635,16 +636,41 @@ impl Cloth {
             half_derivative: &s.half,
             colliders: &self.colliders,
         };
-        forces::accumulate_filled(&input, &mut s.forces, &mut s.force);
         let masses = &self.topology.masses;
-        match self.config.integrator {
-            Integrator::ExplicitEuler | Integrator::SymplecticEuler => {
-                let step = if self.config.integrator == Integrator::ExplicitEuler {
-                    explicit_euler
-                } else {
-                    symplectic_euler
-                };
-                step(
+        let explicit = self.config.integrator != Integrator::ImplicitEuler;
+        let friction = forces::friction_active(&self.colliders, &self.friction);
+        // Whether every particle the integrator wrote (before pins) was sound; None when the
+        // check is left to `check_sound`.
+        let mut integrated_sound = None;
+        if explicit && !friction {
+            // Integrate each tile as soon as its forces are known, and check it there: no
+            // force array is written and read back, no separate pass checks the result.
+            let step = if self.config.integrator == Integrator::ExplicitEuler {
+                explicit_euler_range
+            } else {
+                symplectic_euler_range
+            };
+            let vmax2 = self.config.max_speed * self.config.max_speed;
+            let all_sound = AtomicBool::new(true);
+            let (x_new, v_new) = (
+                parallel::Disjoint::new(&mut s.x_new),
+                parallel::Disjoint::new(&mut s.v_new),
+            );
+            let v_step = &s.v_step;
+            forces::accumulate_tiles(&input, &mut s.forces, |p0, f| {
+                let r = p0..p0 + f.len();
+                // SAFETY: each tile is handed over once and tiles are disjoint.
+                let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
+                step(h, &x[r.clone()], &v_step[r.clone()], f, &masses[r], xn, vn);
+                if !integrate::sound(xn, vn, vmax2) {
+                    all_sound.store(false, Ordering::Relaxed);
+                }
+            });
+            integrated_sound = Some(all_sound.into_inner());
+        } else {
+            forces::accumulate_filled(&input, &mut s.forces, &mut s.force);
+            match self.config.integrator {
+                Integrator::ExplicitEuler => explicit_euler(
                     h,
                     &self.x,
                     &s.v_step,
@@ -652,23 +678,32 @@ impl Cloth {
                     masses,
                     &mut s.x_new,
                     &mut s.v_new,
-                )
-            }
-            Integrator::ImplicitEuler => {
-                forces::linearise(&input, w0, s.forces.normals(), &mut s.implicit.lin);
-                let inp = ImplicitInput {
+                ),
+                Integrator::SymplecticEuler => symplectic_euler(
                     h,
-                    x: &self.x,
-                    v: &s.v_step,
-                    force: &s.force,
+                    &self.x,
+                    &s.v_step,
+                    &s.force,
                     masses,
-                    topology: &self.topology,
-                    pinned: &self.pinned,
-                    settings: self.config.solver,
-                };
-                self.solver_stats = implicit_euler(&inp, &mut s.implicit, &mut s.v_new);
-                for i in 0..n {
-                    s.x_new[i] = self.x[i] + h * s.v_new[i];
+                    &mut s.x_new,
+                    &mut s.v_new,
+                ),
+                Integrator::ImplicitEuler => {
+                    forces::linearise(&input, w0, s.forces.normals(), &mut s.implicit.lin);
+                    let inp = ImplicitInput {
+                        h,
+                        x: &self.x,
+                        v: &s.v_step,
+                        force: &s.force,
+                        masses,
+                        topology: &self.topology,
+                        pinned: &self.pinned,
+                        settings: self.config.solver,
+                    };
+                    self.solver_stats = implicit_euler(&inp, &mut s.implicit, &mut s.v_new);
+                    for i in 0..n {
+                        s.x_new[i] = self.x[i] + h * s.v_new[i];
+                    }
                 }
             }
         }
@@ -696,7 +731,18 @@ impl Cloth {
                 s.v_new[i] = v_free + w * (v_goal - v_free);
             }
         }
-        self.check_sound(h)?;
+        // Only pins changed particles after a sound integration: check just them then.
+        let pins_sound = || {
+            let (x, v) = (&self.scratch.x_new, &self.scratch.v_new);
+            let vmax2 = self.config.max_speed * self.config.max_speed;
+            self.pin_list.iter().all(|&i| {
+                let i = i as usize;
+                integrate::sound(&x[i..=i], &v[i..=i], vmax2)
+            })
+        };
+        if !(integrated_sound == Some(true) && pins_sound()) {
+            self.check_sound(h)?;
+        }
         let s = &mut self.scratch;
         std::mem::swap(&mut self.x, &mut s.x_new);
         std::mem::swap(&mut self.v, &mut s.v_new);
@@ -714,19 +760,7 @@ impl Cloth {
             let finite = x[i].iter().chain(v[i].iter()).all(|c| c.is_finite());
             !finite || v[i].norm_squared() > vmax2
         };
-        // Branch-free over a chunk (so it vectorises): `c * 0` is NaN exactly when c is not
-        // finite, and NaN fails every comparison.
-        let clean = |r: std::ops::Range<usize>| {
-            let (xs, vs) = (&x[r.clone()], &v[r]);
-            let mut nonfinite = 0.0;
-            let mut fastest: f64 = 0.0;
-            for (a, b) in xs.iter().zip(vs) {
-                nonfinite += (a.x * 0.0 + a.y * 0.0) + (a.z * 0.0 + b.x * 0.0) + (b.y * 0.0 + b.z * 0.0);
-                let s = b.x * b.x + b.y * b.y + b.z * b.z;
-                fastest = if s > fastest { s } else { fastest };
-            }
-            nonfinite == 0.0 && fastest <= vmax2
-        };
+        let clean = |r: std::ops::Range<usize>| integrate::sound(&x[r.clone()], &v[r], vmax2);
         match parallel::first_failing(parallel::worth_it(x.len()), x.len(), clean, bad) {
             None => Ok(()),
             Some(i) => Err(Error::unstable(format!(

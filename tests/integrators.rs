@@ -335,3 +335,78 @@ fn substeps_equal_manual_steps_and_restore_everything_on_failure() {
     let d = max_distance(a.cloth.positions(), b.cloth.positions());
     assert!(d < 1e-12, "{d}");
 }
+
+/// The speed check sees every particle the step moves: one pushed hard by a collider is
+/// refused, a pinned one moved too fast is refused, and a pinned one that the collider pushes
+/// is not (its pin overrides the push). The explicit integrators check as they integrate,
+/// tile by tile, then re-check the pins; this pins down that they refuse exactly what the
+/// plain check after the step refuses.
+#[test]
+fn the_speed_check_covers_pins_and_ignores_what_pins_override() {
+    use fraccloth::forces::Sphere;
+    use fraccloth::{ClothConfig, ErrorKind, GridSpec, Vec3};
+    for integrator in Integrator::ALL {
+        let make = |pinned: &[u32], sphere: bool| {
+            let topology = GridSpec {
+                width: 5,
+                height: 5,
+                spacing: 0.1,
+                total_mass: 0.025, // 1 g per particle
+            }
+            .build()
+            .unwrap();
+            let mut config = ClothConfig {
+                integrator,
+                max_speed: 0.1,
+                ..ClothConfig::default()
+            };
+            config.model.gravity = Vec3::zeros();
+            let mut cloth = Cloth::new(topology, config).unwrap();
+            cloth.set_pinned(pinned).unwrap();
+            // A small sphere 1 cm in front of vertex 0 only: ~0.75 N on 1 g, so 0.75 m/s
+            // after 1 ms if vertex 0 is free.
+            let x0 = cloth.positions()[0];
+            if sphere {
+                cloth
+                    .add_sphere(Sphere {
+                        center: x0 + Vec3::new(0.0, 0.0, 0.01),
+                        radius: 0.02,
+                        velocity: Vec3::zeros(),
+                    })
+                    .unwrap();
+            }
+            cloth
+        };
+        let name = integrator.name();
+        // Free: the push is too fast.
+        let mut free = make(&[1, 2, 3, 4], true);
+        let before = free.positions().to_vec();
+        let e = free.step(1e-3).unwrap_err();
+        assert_eq!(e.kind, ErrorKind::Unstable, "{name}: {}", e.message);
+        assert!(e.message.contains("vertex 0"), "{name}: {}", e.message);
+        assert_eq!(free.positions(), &before[..], "{name}");
+        // Pinned: the pin holds it, nothing moves too fast.
+        let mut held = make(&[0, 1, 2, 3, 4], true);
+        held.step(1e-3)
+            .unwrap_or_else(|e| panic!("{name}: {}", e.message));
+        assert_eq!(held.positions()[0], before[0], "{name}");
+        // A pin sent 1 m in 1 ms (1000 m/s) is refused, and nothing changes.
+        let target = before[2] + Vec3::new(1.0, 0.0, 0.0);
+        held.set_pin_targets(&[2], &[target]).unwrap();
+        let now = held.positions().to_vec();
+        let e = held.step(1e-3).unwrap_err();
+        assert_eq!(e.kind, ErrorKind::Unstable, "{name}: {}", e.message);
+        assert!(e.message.contains("vertex 2"), "{name}: {}", e.message);
+        assert_eq!(held.positions(), &now[..], "{name}");
+        // A soft pin (weight 1/2) sent 1 m in 1 ms, nothing else moving: the particle
+        // integrates from rest (sound) and only the pin's pull, applied after, makes it too
+        // fast (500 m/s).
+        let mut soft = make(&[0, 1, 3, 4], false);
+        soft.pin_group(&[2], 0.5).unwrap();
+        soft.set_pin_targets(&[2], &[target]).unwrap();
+        let e = soft.step(1e-3).unwrap_err();
+        assert_eq!(e.kind, ErrorKind::Unstable, "{name}: {}", e.message);
+        assert!(e.message.contains("vertex 2"), "{name}: {}", e.message);
+        assert_eq!(soft.positions(), &before[..], "{name}");
+    }
+}

@@ -99,6 +99,11 @@ pub(super) fn add(m: &Model, colliders: &[Collider], x: &Vec3, v: &Vec3, f: &mut
     }
 }
 
+/// Whether any collider has friction (else [`apply_friction`] changes nothing).
+pub fn friction_active(colliders: &[Collider], friction: &[f64]) -> bool {
+    colliders.iter().zip(friction).any(|(_, &mu)| mu != 0.0)
+}
+
 /// Coulomb friction as a velocity correction after a step of size `h`: for every particle in
 /// contact with a collider of friction coefficient μ > 0 (at the start-of-step position `x`),
 /// the tangential part of `v_new - v_c` shrinks by `min(|v_t|, μ h F_n / m)`, F_n the normal
@@ -114,7 +119,7 @@ pub fn apply_friction(
     pinned: &[bool],
     v_new: &mut [Vec3],
 ) {
-    if friction.iter().all(|&mu| mu == 0.0) {
+    if !friction_active(colliders, friction) {
         return;
     }
     let (k, margin) = (m.collision_stiffness, m.collision_margin);

@@ -14,7 +14,7 @@ mod tiles;
 
 pub use assemble::add_spring_values;
 pub use body::{body_acceleration, body_force};
-pub use contact::{apply_friction, Capsule, Collider, Plane, Sphere};
+pub use contact::{apply_friction, friction_active, Capsule, Collider, Plane, Sphere};
 pub use jacobian::{linearise, Linearisation, SpringBlock};
 pub use normals::vertex_normals;
 pub use springs::{spring_rate, SpringRate};
@@ -87,6 +87,31 @@ pub fn accumulate_filled(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: 
 }
 
 fn accumulate_with(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [Vec3], filled: bool) {
+    let out = parallel::Disjoint::new(f);
+    for_each_tile(input, scratch, filled, |p0, forces| {
+        // SAFETY: tiles are disjoint, each is handed to this closure once.
+        unsafe { out.range(p0..p0 + forces.len()) }.copy_from_slice(forces);
+    });
+}
+
+/// Evaluates the total force on every particle, tile by tile, and calls `sink(p0, forces)`
+/// once per tile with the forces (N) on particles `p0 .. p0 + forces.len()` (at most 256 of
+/// them, all in one [`parallel::CHUNK`]) while they are still in L1 cache: a
+/// caller can use them there (an explicit integrator does) instead of reading a force array
+/// back from memory. The spring pass's component arrays must be filled, as for
+/// [`accumulate_filled`]. Tiles of different chunks may be handed over on different threads,
+/// in any order; the forces do not depend on the thread count.
+pub fn accumulate_tiles<S>(input: &ForceInput<'_>, scratch: &mut ForceScratch, sink: S)
+where
+    S: Fn(usize, &mut [Vec3]) + Sync,
+{
+    for_each_tile(input, scratch, true, sink)
+}
+
+fn for_each_tile<S>(input: &ForceInput<'_>, scratch: &mut ForceScratch, filled: bool, sink: S)
+where
+    S: Fn(usize, &mut [Vec3]) + Sync,
+{
     let m = input.model;
     let t = input.topology;
     let n = input.x.len();
@@ -107,8 +132,9 @@ fn accumulate_with(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [
     let normals = with_normals.then_some(&scratch.normals[..]);
     let gravity = body_acceleration(m);
     let half = (!input.half_derivative.is_empty()).then_some(input.half_derivative);
-    // Everything but the springs, added to the springs' sums `s` of the tile starting at p0.
-    let others = |p0: usize, s: [&[f64]; 3], out: &mut [Vec3]| {
+    // Everything but the springs, added to the springs' sums `s` of the tile starting at p0;
+    // then the tile goes to the sink.
+    let finish = |p0: usize, s: [&[f64]; 3], out: &mut [Vec3]| {
         let len = out.len();
         let (s, masses) = (
             [&s[0][..len], &s[1][..len], &s[2][..len]],
@@ -131,31 +157,28 @@ fn accumulate_with(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [
                 contact::add(m, input.colliders, &input.x[p], &input.v[p], fi);
             }
         }
+        sink(p0, out);
     };
     let params = springs::params(input, par, &mut scratch.spring_inputs, filled);
     if let Some(w) = tiles::window(t) {
         scratch.windows.resize(3 * w * n.div_ceil(parallel::CHUNK), 0.0);
-        parallel::chunks2(
-            par,
-            (&mut scratch.windows, 3 * w),
-            (f, parallel::CHUNK),
-            1,
-            |chunk, window, out| {
-                let c0 = chunk * parallel::CHUNK;
-                tiles::spring_forces(&params, t, c0, out.len(), window, |p0, sums| {
-                    others(p0, sums, &mut out[p0 - c0..p0 - c0 + sums[0].len()]);
-                });
-            },
-        );
+        parallel::chunks(par, &mut scratch.windows, 3 * w, |first, window| {
+            let c0 = first / (3 * w) * parallel::CHUNK;
+            let mut buf = [Vec3::zeros(); TILE];
+            tiles::spring_forces(&params, t, c0, parallel::CHUNK.min(n - c0), window, |p0, sums| {
+                finish(p0, sums, &mut buf[..sums[0].len()]);
+            });
+        });
     } else {
         springs::compute(&params, &t.spring_runs, par, &mut scratch.springs);
         let spring_force = scratch.springs.slices();
-        parallel::chunks(par, f, parallel::CHUNK, |first, chunk| {
+        parallel::for_chunks(par, n, parallel::CHUNK, |first, len| {
             let mut acc = [[0.0; TILE]; 3];
-            for (tile, out) in chunk.chunks_mut(TILE).enumerate() {
-                let p0 = first + tile * TILE;
-                assemble::add_spring_forces(t, p0, out.len(), spring_force, &mut acc);
-                others(p0, [&acc[0], &acc[1], &acc[2]], out);
+            let mut buf = [Vec3::zeros(); TILE];
+            for p0 in (first..first + len).step_by(TILE) {
+                let m = TILE.min(first + len - p0);
+                assemble::add_spring_forces(t, p0, m, spring_force, &mut acc);
+                finish(p0, [&acc[0], &acc[1], &acc[2]], &mut buf[..m]);
             }
         });
     }

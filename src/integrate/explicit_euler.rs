@@ -24,11 +24,36 @@ pub fn explicit_euler(
         (v_new, 1),
         parallel::CHUNK,
         |first, x_new, v_new| {
-            for k in 0..x_new.len() {
-                let i = first + k;
-                x_new[k] = x[i] + h * v[i];
-                v_new[k] = v[i] + (h / masses[i]) * force[i];
-            }
+            let r = first..first + x_new.len();
+            explicit_euler_range(
+                h,
+                &x[r.clone()],
+                &v[r.clone()],
+                &force[r.clone()],
+                &masses[r],
+                x_new,
+                v_new,
+            );
         },
     );
+}
+
+/// The same for particles whose state, forces and masses are the given slices (all of one
+/// length): a tile, for a caller that integrates forces as they are computed.
+#[inline]
+pub fn explicit_euler_range(
+    h: f64,
+    x: &[Vec3],
+    v: &[Vec3],
+    force: &[Vec3],
+    masses: &[f64],
+    x_new: &mut [Vec3],
+    v_new: &mut [Vec3],
+) {
+    let n = x_new.len();
+    let (x, v, force, masses, v_new) = (&x[..n], &v[..n], &force[..n], &masses[..n], &mut v_new[..n]);
+    for k in 0..n {
+        x_new[k] = x[k] + h * v[k];
+        v_new[k] = v[k] + (h / masses[k]) * force[k];
+    }
 }

@@ -9,10 +9,12 @@ mod explicit_euler;
 mod implicit_euler;
 mod symplectic_euler;
 
+use crate::Vec3;
+
 pub use cg::{SolverSettings, SolverStats};
-pub use explicit_euler::explicit_euler;
+pub use explicit_euler::{explicit_euler, explicit_euler_range};
 pub use implicit_euler::{implicit_euler, ImplicitInput, ImplicitScratch};
-pub use symplectic_euler::symplectic_euler;
+pub use symplectic_euler::{symplectic_euler, symplectic_euler_range};
 
 /// Which integrator advances the cloth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -50,4 +52,18 @@ impl Integrator {
             Integrator::ImplicitEuler => "implicit",
         }
     }
+}
+
+/// Whether every position and velocity is finite and no speed exceeds `sqrt(max_speed2)`.
+/// Branch-free, so it vectorises: `c * 0` is NaN exactly when c is not finite, and NaN fails
+/// every comparison.
+pub fn sound(x: &[Vec3], v: &[Vec3], max_speed2: f64) -> bool {
+    let mut nonfinite = 0.0;
+    let mut fastest: f64 = 0.0;
+    for (a, b) in x.iter().zip(v) {
+        nonfinite += (a.x * 0.0 + a.y * 0.0) + (a.z * 0.0 + b.x * 0.0) + (b.y * 0.0 + b.z * 0.0);
+        let s = b.x * b.x + b.y * b.y + b.z * b.z;
+        fastest = if s > fastest { s } else { fastest };
+    }
+    nonfinite == 0.0 && fastest <= max_speed2
 }
