@@ -6,6 +6,7 @@
 //! than [`ClothConfig::max_speed`] (an underwater cloth never moves at 100 m/s; a
 //! state that does has exploded).
 
+mod prepass;
 mod snapshot;
 
 pub use snapshot::SNAPSHOT_VERSION;
@@ -599,11 +600,14 @@ impl Cloth {
             // Tile by tile, so that the loops below find the tile's numbers in L1.
             for t0 in (0..len).step_by(PASS_TILE) {
                 let t = t0..(t0 + PASS_TILE).min(len);
-                for k in t.clone() {
-                    v_step[k] = v[k];
-                    v_rel[k] = v[k] - current;
-                    (sx[k], sy[k], sz[k]) = (x[k].x, x[k].y, x[k].z);
-                }
+                prepass::velocities_and_positions(
+                    &x[t.clone()],
+                    &v[t.clone()],
+                    current,
+                    &mut v_step[t.clone()],
+                    &mut v_rel[t.clone()],
+                    [&mut sx[t.clone()], &mut sy[t.clone()], &mut sz[t.clone()]],
+                );
                 // Fully pinned particles move to their goals: that is their velocity.
                 let (lo, hi) = (first + t.start, first + t.end);
                 let pins = &hard_pins[hard_pins.partition_point(|&i| (i as usize) < lo)..];
@@ -614,18 +618,26 @@ impl Cloth {
                 }
                 if with_history {
                     history.past_range(lo, &mut half[t.clone()]);
-                    for k in t.clone() {
-                        half[k] += w0 * v_rel[k];
+                }
+                // The damping rate's component arrays: none for undamped springs.
+                let (rate, q): (Option<&[Vec3]>, [&mut [f64]; 3]) = match rate {
+                    forces::SpringRate::None if !with_history => continue,
+                    forces::SpringRate::None => (None, [&mut [], &mut [], &mut []]),
+                    forces::SpringRate::HalfDerivative => {
+                        (None, [&mut qx[t.clone()], &mut qy[t.clone()], &mut qz[t.clone()]])
                     }
-                }
-                let q: &[Vec3] = match rate {
-                    forces::SpringRate::HalfDerivative => half,
-                    forces::SpringRate::Velocity => v_step,
-                    forces::SpringRate::None => continue,
+                    forces::SpringRate::Velocity => (
+                        Some(&v_step[t.clone()]),
+                        [&mut qx[t.clone()], &mut qy[t.clone()], &mut qz[t.clone()]],
+                    ),
                 };
-                for k in t {
-                    (qx[k], qy[k], qz[k]) = (q[k].x, q[k].y, q[k].z);
-                }
+                prepass::add_current_and_split(
+                    with_history.then_some(w0),
+                    &v_rel[t.clone()],
+                    &mut half[t.clone()],
+                    rate,
+                    q,
+                );
             }
         });
         let input = ForceInput {
