@@ -31,16 +31,16 @@ pub fn level() -> &'static str {
 #[macro_export]
 #[doc(hidden)]
 macro_rules! simd_dispatch {
-    ($vis:vis fn $name:ident ( $($p:ident : $t:ty),* $(,)? ) => $body:ident) => {
-        $vis fn $name($($p: $t),*) {
+    ($vis:vis fn $name:ident ( $($p:ident : $t:ty),* $(,)? ) $(-> $ret:ty)? => $body:ident) => {
+        $vis fn $name($($p: $t),*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx512f")]
-                unsafe fn wide512($($p: $t),*) {
+                unsafe fn wide512($($p: $t),*) $(-> $ret)? {
                     $body($($p),*)
                 }
                 #[target_feature(enable = "avx2,fma")]
-                unsafe fn wide256($($p: $t),*) {
+                unsafe fn wide256($($p: $t),*) $(-> $ret)? {
                     $body($($p),*)
                 }
                 if std::is_x86_feature_detected!("avx512f") {

@@ -136,13 +136,7 @@ where
     // then the tile goes to the sink.
     let finish = |p0: usize, s: [&[f64]; 3], out: &mut [Vec3]| {
         let len = out.len();
-        let (s, masses) = (
-            [&s[0][..len], &s[1][..len], &s[2][..len]],
-            &t.masses[p0..p0 + len],
-        );
-        for k in 0..len {
-            out[k] = Vec3::new(s[0][k], s[1][k], s[2][k]) + masses[k] * gravity;
-        }
+        body::add_weight_to_springs_widest(s, &t.masses[p0..p0 + len], gravity, out);
         let range = p0..p0 + len;
         drag::add_tile(
             m,

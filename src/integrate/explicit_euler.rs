@@ -38,10 +38,12 @@ pub fn explicit_euler(
     );
 }
 
+crate::simd_dispatch! { pub fn explicit_euler_range(h: f64, x: &[Vec3], v: &[Vec3], force: &[Vec3], masses: &[f64], x_new: &mut [Vec3], v_new: &mut [Vec3]) => explicit_euler_kernel }
+
 /// The same for particles whose state, forces and masses are the given slices (all of one
 /// length): a tile, for a caller that integrates forces as they are computed.
-#[inline]
-pub fn explicit_euler_range(
+#[inline(always)]
+fn explicit_euler_kernel(
     h: f64,
     x: &[Vec3],
     v: &[Vec3],

@@ -54,10 +54,13 @@ impl Integrator {
     }
 }
 
+crate::simd_dispatch! { pub fn sound(x: &[Vec3], v: &[Vec3], max_speed2: f64) -> bool => sound_kernel }
+
 /// Whether every position and velocity is finite and no speed exceeds `sqrt(max_speed2)`.
 /// Branch-free, so it vectorises: `c * 0` is NaN exactly when c is not finite, and NaN fails
 /// every comparison.
-pub fn sound(x: &[Vec3], v: &[Vec3], max_speed2: f64) -> bool {
+#[inline(always)]
+fn sound_kernel(x: &[Vec3], v: &[Vec3], max_speed2: f64) -> bool {
     let mut nonfinite = 0.0;
     let mut fastest: f64 = 0.0;
     for (a, b) in x.iter().zip(v) {
