@@ -57,16 +57,46 @@ impl Integrator {
 crate::simd_dispatch! { pub fn sound(x: &[Vec3], v: &[Vec3], max_speed2: f64) -> bool => sound_kernel }
 
 /// Whether every position and velocity is finite and no speed exceeds `sqrt(max_speed2)`.
-/// Branch-free, so it vectorises: `c * 0` is NaN exactly when c is not finite, and NaN fails
-/// every comparison.
+/// Branch-free and with no floating-point sum across particles, so it vectorises: `c * 0` is
+/// NaN exactly when c is not finite, NaN and infinity propagate into the squared speed, and
+/// NaN fails every comparison.
 #[inline(always)]
 fn sound_kernel(x: &[Vec3], v: &[Vec3], max_speed2: f64) -> bool {
-    let mut nonfinite = 0.0;
-    let mut fastest: f64 = 0.0;
+    let mut ok = true;
     for (a, b) in x.iter().zip(v) {
-        nonfinite += (a.x * 0.0 + a.y * 0.0) + (a.z * 0.0 + b.x * 0.0) + (b.y * 0.0 + b.z * 0.0);
-        let s = b.x * b.x + b.y * b.y + b.z * b.z;
-        fastest = if s > fastest { s } else { fastest };
+        let position = (a.x * 0.0 + a.y * 0.0) + a.z * 0.0;
+        let s = (b.x * b.x + b.y * b.y + b.z * b.z) + position;
+        ok &= s <= max_speed2;
     }
-    nonfinite == 0.0 && fastest <= max_speed2
+    ok
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sound_refuses_every_non_finite_number_and_excess_speed() {
+        let ok = vec![Vec3::new(1e300, -2.0, 3.0); 37];
+        let slow = vec![Vec3::new(0.5, -0.5, 0.5); 37];
+        assert!(sound(&ok, &slow, 1.0));
+        assert!(sound(&[], &[], 1.0));
+        for k in [0, 17, 36] {
+            for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                for c in 0..3 {
+                    let mut x = ok.clone();
+                    x[k][c] = bad;
+                    assert!(!sound(&x, &slow, 1.0), "position {k} {c} = {bad}");
+                    let mut v = slow.clone();
+                    v[k][c] = bad;
+                    assert!(!sound(&ok, &v, 1.0), "velocity {k} {c} = {bad}");
+                }
+            }
+            let mut v = slow.clone();
+            v[k] = Vec3::new(0.0, 1.0001, 0.0);
+            assert!(!sound(&ok, &v, 1.0), "speed at {k}");
+            v[k] = Vec3::new(0.0, 1.0, 0.0);
+            assert!(sound(&ok, &v, 1.0), "speed exactly at the limit at {k}");
+        }
+    }
 }
