@@ -30,7 +30,7 @@ use crate::integrate::SolverSettings;
 
 const MAGIC: &[u8; 8] = b"FCSNAP\0\0";
 /// Current format version.
-pub const SNAPSHOT_VERSION: u32 = 2;
+pub const SNAPSHOT_VERSION: u32 = 3;
 const HEADER: usize = 8 + 4 + 4 + 8;
 
 /// FNV-1a over a stream of u64 words: cheap identity checks, not security.
