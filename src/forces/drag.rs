@@ -19,21 +19,28 @@ crate::simd_dispatch! { pub(super) fn add_tile(m: &Model, v: &[Vec3], d: Option<
 fn add_tile_kernel(m: &Model, v: &[Vec3], d: Option<&[Vec3]>, n: Option<&[Vec3]>, f: &mut [Vec3]) {
     let len = f.len();
     let (v, c) = (&v[..len], m.current);
-    if m.viscous_drag != 0.0 {
-        let k = m.viscous_drag;
-        for (fi, vi) in f.iter_mut().zip(v) {
-            *fi -= k * (vi - c);
+    let history = d.filter(|_| m.history_drag != 0.0);
+    match (m.viscous_drag, history) {
+        (0.0, None) => {}
+        (k, None) => {
+            for (fi, vi) in f.iter_mut().zip(v) {
+                *fi -= k * (vi - c);
+            }
         }
-    }
-    if let (Some(d), true) = (d, m.history_drag != 0.0) {
-        let (d, k) = (&d[..len], m.history_drag);
-        for t in 0..len {
-            let (rx, ry, rz) = (v[t].x - c.x, v[t].y - c.y, v[t].z - c.z);
-            let speed2 = rx * rx + ry * ry + rz * rz;
-            let dr = d[t].x * rx + d[t].y * ry + d[t].z * rz;
-            // (d . v_hat) v_hat = (d . rel) rel / |rel|^2; no direction (and no drag) at rest.
-            let s = if speed2 > 0.0 { k * dr / speed2 } else { 0.0 };
-            f[t] -= Vec3::new(s * rx, s * ry, s * rz);
+        (kv, Some(d)) => {
+            // One loop for both (same operations in the same order as two loops).
+            let (d, k) = (&d[..len], m.history_drag);
+            for t in 0..len {
+                if kv != 0.0 {
+                    f[t] -= kv * (v[t] - c);
+                }
+                let (rx, ry, rz) = (v[t].x - c.x, v[t].y - c.y, v[t].z - c.z);
+                let speed2 = rx * rx + ry * ry + rz * rz;
+                let dr = d[t].x * rx + d[t].y * ry + d[t].z * rz;
+                // (d . v_hat) v_hat = (d . rel) rel / |rel|^2; no direction (and no drag) at rest.
+                let s = if speed2 > 0.0 { k * dr / speed2 } else { 0.0 };
+                f[t] -= Vec3::new(s * rx, s * ry, s * rz);
+            }
         }
     }
     if let (Some(n), true) = (n, m.normal_drag != 0.0) {

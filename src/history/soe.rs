@@ -252,13 +252,7 @@ impl HalfDerivative for SumOfExponentials {
     }
 
     fn past_range(&self, first: usize, out: &mut [Vec3]) {
-        for ((o, p), q) in out
-            .iter_mut()
-            .zip(&self.prev[first..])
-            .zip(&self.pending[first..])
-        {
-            *o = self.w_prev * p + q;
-        }
+        past_widest(self.w_prev, &self.prev[first..], &self.pending[first..], out);
     }
 
     fn push(&mut self, v: &[Vec3], h: f64) {
@@ -345,6 +339,18 @@ impl HalfDerivative for SumOfExponentials {
         self.pending.fill(Vec3::zeros());
         self.has_prev = false;
         self.gap = 0.0;
+    }
+}
+
+crate::simd_dispatch! { fn past_widest(w_prev: f64, prev: &[Vec3], pending: &[Vec3], out: &mut [Vec3]) => past_kernel }
+
+/// `out = w_prev prev + pending`, element by element.
+#[inline(always)]
+fn past_kernel(w_prev: f64, prev: &[Vec3], pending: &[Vec3], out: &mut [Vec3]) {
+    let n = out.len();
+    let (prev, pending) = (&prev[..n], &pending[..n]);
+    for k in 0..n {
+        out[k] = w_prev * prev[k] + pending[k];
     }
 }
 
