@@ -15,8 +15,7 @@ use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
 use crate::forces::{self, Collider, ForceInput, ForceScratch, Plane, Sphere};
 use crate::history::{HalfDerivative, History, Scheme};
 use crate::integrate::{
-    self, explicit_euler, explicit_euler_range, implicit_euler, symplectic_euler, symplectic_euler_range,
-    ImplicitInput, ImplicitScratch, Integrator, SolverSettings, SolverStats,
+    self, implicit_euler, ImplicitInput, ImplicitScratch, Integrator, SolverSettings, SolverStats,
 };
 use crate::model::Model;
 use crate::parallel;
@@ -649,19 +648,14 @@ impl Cloth {
             colliders: &self.colliders,
         };
         let masses = &self.topology.masses;
-        let explicit = self.config.integrator != Integrator::ImplicitEuler;
+        let explicit = self.config.integrator.explicit_step();
         let friction = forces::friction_active(&self.colliders, &self.friction);
         // Whether every particle the integrator wrote (before pins) was sound; None when the
         // check is left to `check_sound`.
         let mut integrated_sound = None;
-        if explicit && !friction {
+        if let (Some(step), false) = (explicit, friction) {
             // Integrate each tile as soon as its forces are known, and check it there: no
             // force array is written and read back, no separate pass checks the result.
-            let step = if self.config.integrator == Integrator::ExplicitEuler {
-                explicit_euler_range
-            } else {
-                symplectic_euler_range
-            };
             let vmax2 = self.config.max_speed * self.config.max_speed;
             let all_sound = AtomicBool::new(true);
             let (x_new, v_new) = (
@@ -673,7 +667,14 @@ impl Cloth {
                 let r = p0..p0 + f.len();
                 // SAFETY: each tile is handed over once and tiles are disjoint.
                 let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
-                step(h, &x[r.clone()], &v_step[r.clone()], f, &masses[r], xn, vn);
+                let input = integrate::StepInput {
+                    h,
+                    x: &x[r.clone()],
+                    v: &v_step[r.clone()],
+                    force: f,
+                    masses: &masses[r],
+                };
+                step(&input, xn, vn);
                 if !integrate::sound(xn, vn, vmax2) {
                     all_sound.store(false, Ordering::Relaxed);
                 }
@@ -681,26 +682,18 @@ impl Cloth {
             integrated_sound = Some(all_sound.into_inner());
         } else {
             forces::accumulate_filled(&input, &mut s.forces, &mut s.force);
-            match self.config.integrator {
-                Integrator::ExplicitEuler => explicit_euler(
-                    h,
-                    &self.x,
-                    &s.v_step,
-                    &s.force,
-                    masses,
-                    &mut s.x_new,
-                    &mut s.v_new,
-                ),
-                Integrator::SymplecticEuler => symplectic_euler(
-                    h,
-                    &self.x,
-                    &s.v_step,
-                    &s.force,
-                    masses,
-                    &mut s.x_new,
-                    &mut s.v_new,
-                ),
-                Integrator::ImplicitEuler => {
+            match explicit {
+                Some(step) => {
+                    let input = integrate::StepInput {
+                        h,
+                        x: &self.x,
+                        v: &s.v_step,
+                        force: &s.force,
+                        masses,
+                    };
+                    integrate::step_all(step, &input, &mut s.x_new, &mut s.v_new)
+                }
+                None => {
                     forces::linearise(&input, w0, s.forces.normals(), &mut s.implicit.lin);
                     let inp = ImplicitInput {
                         h,

@@ -12,9 +12,9 @@ mod symplectic_euler;
 use crate::Vec3;
 
 pub use cg::{SolverSettings, SolverStats};
-pub use explicit_euler::{explicit_euler, explicit_euler_range};
+pub use explicit_euler::explicit_euler_range;
 pub use implicit_euler::{implicit_euler, ImplicitInput, ImplicitScratch};
-pub use symplectic_euler::{symplectic_euler, symplectic_euler_range};
+pub use symplectic_euler::symplectic_euler_range;
 
 /// Which integrator advances the cloth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -44,6 +44,15 @@ impl Integrator {
         }
     }
 
+    /// The per-particle step of an explicit integrator (None for the implicit one).
+    pub fn explicit_step(&self) -> Option<StepRange> {
+        match self {
+            Integrator::ExplicitEuler => Some(explicit_euler_range),
+            Integrator::SymplecticEuler => Some(symplectic_euler_range),
+            Integrator::ImplicitEuler => None,
+        }
+    }
+
     /// Short name for files and command lines.
     pub fn key(&self) -> &'static str {
         match self {
@@ -52,6 +61,44 @@ impl Integrator {
             Integrator::ImplicitEuler => "implicit",
         }
     }
+}
+
+/// What an explicit step reads: the step size and, per particle, positions, velocities,
+/// forces and masses (slices of one length).
+#[derive(Clone, Copy)]
+pub struct StepInput<'a> {
+    pub h: f64,
+    pub x: &'a [Vec3],
+    pub v: &'a [Vec3],
+    pub force: &'a [Vec3],
+    pub masses: &'a [f64],
+}
+
+impl<'a> StepInput<'a> {
+    /// The particles `r` only.
+    pub fn range(&self, r: std::ops::Range<usize>) -> StepInput<'a> {
+        StepInput {
+            h: self.h,
+            x: &self.x[r.clone()],
+            v: &self.v[r.clone()],
+            force: &self.force[r.clone()],
+            masses: &self.masses[r],
+        }
+    }
+}
+
+/// An explicit integrator's step for the particles of a [`StepInput`], into `x_new`, `v_new`.
+pub type StepRange = fn(&StepInput<'_>, &mut [Vec3], &mut [Vec3]);
+
+/// `step` for every particle, chunk by chunk (in parallel for large cloths).
+pub fn step_all(step: StepRange, s: &StepInput<'_>, x_new: &mut [Vec3], v_new: &mut [Vec3]) {
+    crate::parallel::chunks2(
+        crate::parallel::worth_it(s.x.len()),
+        (x_new, 1),
+        (v_new, 1),
+        crate::parallel::CHUNK,
+        |first, x_new, v_new| step(&s.range(first..first + x_new.len()), x_new, v_new),
+    );
 }
 
 crate::simd_dispatch! { pub fn sound(x: &[Vec3], v: &[Vec3], max_speed2: f64) -> bool => sound_kernel }
