@@ -52,14 +52,20 @@ impl Topology {
     /// Every spring must have i < j. Indices must be in range (the
     /// constructors check their input before calling this).
     pub fn new(
-        rest_positions: Vec<Vec3>,
+        mut rest_positions: Vec<Vec3>,
         masses: Vec<f64>,
         mut springs: Vec<Spring>,
-        triangles: Vec<[u32; 3]>,
+        mut triangles: Vec<[u32; 3]>,
         grid: Option<(u32, u32)>,
     ) -> Self {
         let n = rest_positions.len();
-        let spring_runs = runs::order_into_runs(&mut springs);
+        // The constructors build these by pushes: drop the spare capacity, they live as long
+        // as the cloth.
+        springs.shrink_to_fit();
+        triangles.shrink_to_fit();
+        rest_positions.shrink_to_fit();
+        let mut spring_runs = runs::order_into_runs(&mut springs);
+        spring_runs.shrink_to_fit();
         Self {
             spring_rest: springs.iter().map(|s| s.rest).collect(),
             spring_kinds: springs.iter().map(|s| s.kind as u8).collect(),

@@ -121,6 +121,11 @@ impl TileRuns {
             }
         }
         t.uniform_rest = t.runs.iter().map(|r| t.uniform(r)).collect();
+        // Built by pushes: drop the spare capacity (these live as long as the cloth).
+        t.rest.shrink_to_fit();
+        t.kinds.shrink_to_fit();
+        t.pads.shrink_to_fit();
+        t.runs.shrink_to_fit();
         t.chunk_runs = super::Adjacency::chunk_runs(n, &t.runs);
         t.max_offset = t.runs.iter().map(|r| r.offset as usize).max().unwrap_or(0);
         t
