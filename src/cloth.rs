@@ -737,14 +737,7 @@ impl Cloth {
             }
         }
         // Only pins changed particles after a sound integration: check just them then.
-        let pins_sound = || {
-            let (x, v) = (&self.scratch.x_new, &self.scratch.v_new);
-            let vmax2 = self.config.max_speed * self.config.max_speed;
-            self.pin_list.iter().all(|&i| {
-                let i = i as usize;
-                integrate::sound(&x[i..=i], &v[i..=i], vmax2)
-            })
-        };
+        let pins_sound = || self.pin_list.iter().all(|&i| !self.unsound(i as usize));
         if !(integrated_sound == Some(true) && pins_sound()) {
             self.check_sound(h)?;
         }
@@ -757,14 +750,18 @@ impl Cloth {
         Ok(())
     }
 
+    /// Whether the step's result for particle `i` is not finite or faster than `max_speed`.
+    fn unsound(&self, i: usize) -> bool {
+        let (x, v) = (&self.scratch.x_new[i], &self.scratch.v_new[i]);
+        let vmax = self.config.max_speed;
+        !x.iter().chain(v.iter()).all(|c| c.is_finite()) || v.norm_squared() > vmax * vmax
+    }
+
     fn check_sound(&self, dt: f64) -> Result<(), Error> {
         let s = &self.scratch;
         let vmax2 = self.config.max_speed * self.config.max_speed;
         let (x, v) = (&s.x_new, &s.v_new);
-        let bad = |i: usize| {
-            let finite = x[i].iter().chain(v[i].iter()).all(|c| c.is_finite());
-            !finite || v[i].norm_squared() > vmax2
-        };
+        let bad = |i: usize| self.unsound(i);
         let clean = |r: std::ops::Range<usize>| integrate::sound(&x[r.clone()], &v[r], vmax2);
         match parallel::first_failing(parallel::worth_it(x.len()), x.len(), clean, bad) {
             None => Ok(()),

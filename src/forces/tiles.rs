@@ -205,8 +205,23 @@ mod tests {
         m.gravity = Vec3::zeros();
         m.viscous_drag = 0.0;
         m.history_drag = 0.0;
-        let want = reference(&m, &t, &x, &q);
-        for topology in [&t, &buffered] {
+        // Rest lengths that differ within a family (as a mesh's do): the tiled pass reads them
+        // per slot instead of one number per run.
+        let mut springs = t.springs.clone();
+        for s in springs.iter_mut().step_by(7) {
+            s.rest *= 1.01;
+        }
+        let varied = Topology::new(
+            t.rest_positions.clone(),
+            t.masses.clone(),
+            springs,
+            t.triangles.clone(),
+            t.grid,
+        );
+        assert!(varied.tile_runs.uniform_rest.iter().all(|r| r.is_none()));
+        assert!(t.tile_runs.uniform_rest.iter().all(|r| r.is_some()));
+        for topology in [&t, &buffered, &varied] {
+            let want = reference(&m, topology, &x, &q);
             let input = ForceInput {
                 model: &m,
                 topology,

@@ -134,8 +134,7 @@ impl TileRuns {
     /// The rest length shared by every spring (not padding) of `run`, if there is one.
     fn uniform(&self, run: &SpringRun) -> Option<f64> {
         let slots = run.first_spring as usize..(run.first_spring + run.len) as usize;
-        let first_pad = self.pads.partition_point(|&q| (q as usize) < slots.start);
-        let mut pads = self.pads[first_pad..].iter().map(|&q| q as usize).peekable();
+        let mut pads = self.pads_in(slots.clone()).peekable();
         let mut shared: Option<f64> = None;
         for slot in slots {
             if pads.next_if_eq(&slot).is_some() {
