@@ -1,7 +1,8 @@
 //! Steps the 61 x 41 throughput cloth in blocks of 1000 steps and prints the fastest block in
 //! ns per particle-step: the least noisy figure on a shared machine, for comparing two builds
 //! while optimising (the benchmark of record is `examples/throughput.rs`, which reports medians).
-//! `cargo run --release --example step_cycles -- [fractional|regular] [blocks]`.
+//! `cargo run --release --example step_cycles -- [fractional|regular] [blocks] [WxH]`
+//! (default 61x41; blocks of 1000 steps, fewer for big cloths).
 
 use fraccloth::history::Scheme;
 use fraccloth::scenes::Variant;
@@ -12,12 +13,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let regular = args.get(1).is_some_and(|a| a == "regular");
     let blocks: u64 = args.get(2).map_or(Ok(20), |s| s.parse())?;
-    let (w, h) = (61u32, 41u32);
+    let (w, h) = match args.get(3) {
+        Some(size) => {
+            let (w, h) = size.split_once('x').ok_or("size must be WxH")?;
+            (w.parse::<u32>()?, h.parse::<u32>()?)
+        }
+        None => (61, 41),
+    };
+    let steps_per_block = (2_500_000 / (w as u64 * h as u64)).clamp(1, 1000);
     let topology = GridSpec {
         width: w,
         height: h,
         spacing: 0.01,
-        total_mass: 0.24,
+        // The same mass per particle at every size, so the same dt is stable.
+        total_mass: 0.24 * (w * h) as f64 / (61.0 * 41.0),
     }
     .build()?;
     let variant = if regular {
@@ -39,10 +48,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut best = f64::INFINITY;
     for _ in 0..blocks {
         let start = std::time::Instant::now();
-        for _ in 0..1000 {
+        for _ in 0..steps_per_block {
             cloth.step(5e-4)?;
         }
-        best = best.min(start.elapsed().as_secs_f64() / (1000.0 * cloth.vertex_count() as f64));
+        let per = steps_per_block as f64 * cloth.vertex_count() as f64;
+        best = best.min(start.elapsed().as_secs_f64() / per);
     }
     println!(
         "fastest block: {:.2} ns per particle-step ({:.2} M/s)",

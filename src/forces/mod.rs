@@ -154,14 +154,26 @@ where
         sink(p0, out);
     };
     let params = springs::params(input, par, &mut scratch.spring_inputs, filled);
-    if let Some(w) = tiles::window(t) {
-        scratch.windows.resize(3 * w * n.div_ceil(parallel::CHUNK), 0.0);
-        parallel::chunks(par, &mut scratch.windows, 3 * w, |first, window| {
-            let c0 = first / (3 * w) * parallel::CHUNK;
+    if let Some(layout) = tiles::Layout::of(t) {
+        // One window per task; task k walks groups k, k + tasks, ... (which task walks a group
+        // does not change its sums).
+        let groups = n.div_ceil(layout.group);
+        let tasks = if par {
+            groups.min(2 * rayon::current_num_threads())
+        } else {
+            1
+        };
+        let w = 3 * layout.window;
+        scratch.windows.resize(w * tasks, 0.0);
+        parallel::chunks(par, &mut scratch.windows[..w * tasks], w, |first, window| {
             let mut buf = [Vec3::zeros(); TILE];
-            tiles::spring_forces(&params, t, c0, parallel::CHUNK.min(n - c0), window, |p0, sums| {
-                finish(p0, sums, &mut buf[..sums[0].len()]);
-            });
+            for g in (first / w..groups).step_by(tasks) {
+                let c0 = g * layout.group;
+                let len = layout.group.min(n - c0);
+                tiles::spring_forces(&params, t, c0, len, window, |p0, sums| {
+                    finish(p0, sums, &mut buf[..sums[0].len()]);
+                });
+            }
         });
     } else {
         springs::compute(&params, &t.spring_runs, par, &mut scratch.springs);

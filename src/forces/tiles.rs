@@ -1,19 +1,20 @@
 //! Spring forces summed tile by tile, with no per-spring buffer: the fast path for topologies
 //! whose springs form long runs with short offsets (grids, row-ordered meshes).
 //!
-//! A chunk of particles `[c0, c1)` is walked in tiles of [`TILE`] particles. For each tile,
+//! A group of whole chunks of particles `[c0, c1)` ([`Layout`]) is walked in tiles of [`TILE`]
+//! particles. For each tile,
 //! every run's springs whose `i` end lies in the tile are evaluated into a small buffer, added
 //! with `+` at their `i` ends and with `-` at their `j` ends (`j = i + offset`, later in the
 //! array), into a rolling window of sums that covers the tile and the `max offset` particles
 //! after it. When a tile's springs are done, every spring touching a particle of the tile has
-//! been added (its `i` end is never after its `j` end), so the tile is handed to `finish`, and
-//! the window slides on. Before the first tile, the springs whose `i` end lies before `c0` and
-//! whose `j` end lies in the chunk are evaluated too (the previous chunk evaluates them as well,
-//! for its own `i` ends; a few per chunk boundary).
+//! been added (its `i` end is never after its `j` end), so the tile is handed to `finish`; the
+//! window slides on when the next tile would not fit. Before the first tile, the springs whose
+//! `i` end lies before `c0` and whose `j` end lies in the group are evaluated too (the previous
+//! group evaluates them as well, for its own `i` ends; a few per group boundary).
 //!
-//! Everything a tile touches (positions around it, the window) stays in L1 cache, and a
+//! Everything a tile touches (positions around it, the window) stays in L1 or L2 cache, and a
 //! spring's force is used where it is computed instead of being written out and read back.
-//! Each particle receives its springs in an order fixed by the topology and the chunk grid, so
+//! Each particle receives its springs in an order fixed by the topology and the group grid, so
 //! the sums do not depend on the thread count.
 
 use super::assemble::add_scaled_widest;
@@ -23,21 +24,44 @@ use crate::topology::Topology;
 /// Particles per tile.
 pub const TILE: usize = 256;
 
-/// Largest run offset the rolling window accepts (beyond it, the window would leave L1 and
-/// the per-spring buffer path is used).
-const MAX_OFFSET: usize = 1024;
+/// Largest run offset the tile path accepts: one [`crate::parallel::CHUNK`], so that a spring
+/// reaching into a group from before it ends in the group's first chunk (grids up to 2048
+/// columns). Beyond it, the per-spring buffer path is used.
+const MAX_OFFSET: usize = crate::parallel::CHUNK;
 
-/// Length of each component's window for `t`, or None when the tile path does not apply.
-pub(super) fn window(t: &Topology) -> Option<usize> {
-    let tr = &t.tile_runs;
-    let long = tr.rest.len() >= 8 * tr.runs.len();
-    // Lazily: the sum is formed only when the offset is known to be small.
-    (long && tr.max_offset <= MAX_OFFSET).then(|| TILE + tr.max_offset)
+/// How the tile path cuts a topology: groups of whole chunks, each walked by one task with one
+/// rolling window. Depends only on the topology, never on the thread count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Layout {
+    /// Numbers per component of the window: the largest offset plus whole tiles, at least as
+    /// many particles as the offset, so sliding it copies at most one number per particle.
+    pub window: usize,
+    /// Particles per group, a multiple of [`crate::parallel::CHUNK`].
+    pub group: usize,
 }
 
-/// Sums the spring forces of particles `c0 .. c0 + len` (one chunk) tile by tile and calls
-/// `finish(p0, sums)` for each tile, `sums[c][k]` being component c of the spring force on
-/// particle `p0 + k`. `window` holds `3 * w` numbers, `w` from [`window`].
+impl Layout {
+    /// The layout for `t`, or None when the tile path does not apply.
+    pub(super) fn of(t: &Topology) -> Option<Self> {
+        let tr = &t.tile_runs;
+        let long = tr.rest.len() >= 8 * tr.runs.len();
+        if !(long && tr.max_offset <= MAX_OFFSET) {
+            return None;
+        }
+        let chunk = crate::parallel::CHUNK;
+        let tiles = tr.max_offset.div_ceil(TILE).max(1);
+        Some(Self {
+            window: tr.max_offset + tiles * TILE,
+            // At least 8 offsets long: the springs evaluated twice at a group's start (see
+            // the module's doc) are then a few percent of the group's.
+            group: (8 * tr.max_offset).div_ceil(chunk).max(1) * chunk,
+        })
+    }
+}
+
+/// Sums the spring forces of particles `c0 .. c0 + len` (one group of [`Layout`]) tile by tile
+/// and calls `finish(p0, sums)` for each tile, `sums[c][k]` being component c of the spring
+/// force on particle `p0 + k`. `window` holds `3 * layout.window` numbers.
 pub(super) fn spring_forces<F>(
     p: &Params<'_>,
     t: &Topology,
@@ -50,7 +74,8 @@ pub(super) fn spring_forces<F>(
 {
     let w = window.len() / 3;
     let c1 = c0 + len;
-    let runs = t.tile_runs.chunk_runs.row(c0 / crate::parallel::CHUNK);
+    let chunk = crate::parallel::CHUNK;
+    let rows = &t.tile_runs.chunk_runs;
     let p = &Params {
         rest: &t.tile_runs.rest,
         kinds: &t.tile_runs.kinds,
@@ -58,25 +83,44 @@ pub(super) fn spring_forces<F>(
     };
     window.fill(0.0);
     let mut temp = [[0.0; TILE]; 3];
-    // Springs from before the chunk into it: only their j ends are ours.
-    add_range(p, t, runs, None, c0, c1, c0, w, window, &mut temp);
+    // Springs from before the group into it: only their j ends are ours (all in its first
+    // chunk, as no offset exceeds a chunk).
+    let mut start = c0;
+    add_range(
+        p,
+        t,
+        rows.row(c0 / chunk),
+        None,
+        c0,
+        c1,
+        start,
+        w,
+        window,
+        &mut temp,
+    );
     let mut base = c0;
     while base < c1 {
         let end = (base + TILE).min(c1);
-        add_range(p, t, runs, Some((base, end)), c0, c1, base, w, window, &mut temp);
-        let n = end - base;
+        // Slide the window to this tile when the tile's j ends would run past it.
+        if end - start + t.tile_runs.max_offset > w {
+            let shift = base - start;
+            for c in 0..3 {
+                let comp = &mut window[c * w..(c + 1) * w];
+                comp.copy_within(shift.., 0);
+                comp[w - shift..].fill(0.0);
+            }
+            start = base;
+        }
+        // The runs with i ends in this tile are among those of its chunk.
+        let runs = rows.row(base / chunk);
+        add_range(p, t, runs, Some((base, end)), c0, c1, start, w, window, &mut temp);
+        let (n, at) = (end - base, base - start);
         {
             let (x, rest) = window.split_at(w);
             let (y, z) = rest.split_at(w);
-            finish(base, [&x[..n], &y[..n], &z[..n]]);
+            finish(base, [&x[at..at + n], &y[at..at + n], &z[at..at + n]]);
         }
-        // Slide the window by one tile.
-        for c in 0..3 {
-            let comp = &mut window[c * w..(c + 1) * w];
-            comp.copy_within(TILE.min(w).., 0);
-            comp[w - TILE..].fill(0.0);
-        }
-        base += TILE;
+        base = end;
     }
 }
 
@@ -182,10 +226,10 @@ mod tests {
         .build()
         .unwrap();
         let n = t.vertex_count();
-        assert!(super::window(&t).is_some());
+        assert!(super::Layout::of(&t).is_some());
         let mut buffered = t.clone();
         buffered.tile_runs.max_offset = usize::MAX;
-        assert!(super::window(&buffered).is_none());
+        assert!(super::Layout::of(&buffered).is_none());
         // Deterministic pseudo-random displacements and rates.
         let mut seed = 12345u64;
         let mut rnd = || {
@@ -220,14 +264,41 @@ mod tests {
         );
         assert!(varied.tile_runs.uniform_rest.iter().all(|r| r.is_none()));
         assert!(t.tile_runs.uniform_rest.iter().all(|r| r.is_some()));
-        for topology in [&t, &buffered, &varied] {
-            let want = reference(&m, topology, &x, &q);
+        // 1500 columns: offsets up to 3000, so the window slides by several tiles, groups span
+        // several chunks and a tile's runs come from its own chunk.
+        let wide = GridSpec {
+            width: 1500,
+            height: 20,
+            spacing: 0.01,
+            total_mass: 1.0,
+        }
+        .build()
+        .unwrap();
+        let layout = super::Layout::of(&wide).unwrap();
+        assert!(layout.window > 4 * super::TILE && layout.group > crate::parallel::CHUNK);
+        assert!(wide.vertex_count() > layout.group);
+        let x_wide: Vec<Vec3> = wide
+            .rest_positions
+            .iter()
+            .map(|p| p + 0.002 * Vec3::new(rnd(), rnd(), rnd()))
+            .collect();
+        let q_wide: Vec<Vec3> = (0..wide.vertex_count())
+            .map(|_| Vec3::new(rnd(), rnd(), rnd()))
+            .collect();
+        for (topology, x, q) in [
+            (&t, &x, &q),
+            (&buffered, &x, &q),
+            (&varied, &x, &q),
+            (&wide, &x_wide, &q_wide),
+        ] {
+            let n = topology.vertex_count();
+            let want = reference(&m, topology, x, q);
             let input = ForceInput {
                 model: &m,
                 topology,
-                x: &x,
-                v: &q,
-                half_derivative: &q,
+                x,
+                v: q,
+                half_derivative: q,
                 colliders: &[],
             };
             let mut f = vec![Vec3::zeros(); n];
