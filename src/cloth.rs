@@ -13,7 +13,7 @@ pub use snapshot::SNAPSHOT_VERSION;
 
 use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
 use crate::forces::{self, Collider, ForceInput, ForceScratch, Plane, Sphere};
-use crate::history::{HalfDerivative, History, Scheme};
+use crate::history::{History, Scheme};
 use crate::integrate::{
     self, implicit_euler, ImplicitInput, ImplicitScratch, Integrator, SolverSettings, SolverStats,
 };
@@ -40,6 +40,8 @@ pub struct ClothConfig {
 
 /// Particles per tile of the pass before the forces (its arrays for a tile fit in L1).
 const PASS_TILE: usize = 256;
+// The history's pass needs ranges on its blocks (`History::begin_step`).
+const _: () = assert!(PASS_TILE % crate::history::SOE_BLOCK == 0 && parallel::CHUNK % PASS_TILE == 0);
 
 /// Most substeps one call may take.
 pub const MAX_SUBSTEPS: u32 = 1_000_000;
@@ -557,11 +559,9 @@ impl Cloth {
         // arrays the spring pass reads (positions and damping rate).
         let par = parallel::worth_it(n);
         let with_history = !self.history.is_off();
-        let mut w0 = 0.0;
-        if with_history {
-            self.history.prepare();
-            w0 = self.history.current_weight();
-        }
+        // The history folds the last accepted step in during this pass (SOE).
+        let past = with_history.then(|| self.history.begin_step());
+        let w0 = past.as_ref().map_or(0.0, |p| p.current_weight());
         // Fully pinned particles, ascending, to find those of a tile by bisection.
         s.hard_pins.clear();
         s.hard_pins
@@ -571,7 +571,7 @@ impl Cloth {
         let rate = forces::spring_rate(&self.config.model);
         let current = self.config.model.current;
         let (sx, sq) = s.forces.spring_arrays(n);
-        let (history, x, v, goal) = (&self.history, &self.x, &self.v, &s.goal);
+        let (x, v, goal) = (&self.x, &self.v, &s.goal);
         let (v_step, v_rel, half) = (
             parallel::Disjoint::new(&mut s.v_step),
             parallel::Disjoint::new(&mut s.v_rel),
@@ -615,8 +615,10 @@ impl Cloth {
                     v_step[k] = (goal[p] - x[k]) / h;
                     v_rel[k] = v_step[k] - current;
                 }
-                if with_history {
-                    history.past_range(lo, &mut half[t.clone()]);
+                if let Some(past) = &past {
+                    // SAFETY: every particle once; tiles start on multiples of PASS_TILE and
+                    // end on one or at the last particle, so on blocks of 16.
+                    unsafe { past.past_range(lo, &mut half[t.clone()]) };
                 }
                 // The damping rate's component arrays: none for undamped springs.
                 let (rate, q): (Option<&[Vec3]>, [&mut [f64]; 3]) = match rate {
@@ -639,6 +641,9 @@ impl Cloth {
                 );
             }
         });
+        if with_history {
+            self.history.end_step();
+        }
         let input = ForceInput {
             model: &self.config.model,
             topology: &self.topology,
@@ -744,7 +749,7 @@ impl Cloth {
         let s = &mut self.scratch;
         std::mem::swap(&mut self.x, &mut s.x_new);
         std::mem::swap(&mut self.v, &mut s.v_new);
-        self.history.push(&s.v_rel, h);
+        self.history.record(&mut s.v_rel, h);
         self.time += h;
         self.steps += 1;
         Ok(())

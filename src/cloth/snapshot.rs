@@ -1,11 +1,12 @@
 //! Snapshots: the complete state of a cloth as bytes, to save a bake and resume it later
 //! (or undo in a host), continuing bitwise identically.
 //!
-//! Format version 2, little-endian (version 1 stored the SOE modes in their in-memory block
-//! layout, which has since changed; it is refused):
+//! Format version 4, little-endian. Older versions are refused: version 1 stored the SOE modes
+//! in their in-memory block layout, version 2 unshifted modes, version 3 the SOE history's past
+//! sum instead of the sample that waits to be folded (`history/soe.rs`).
 //!
 //! ```text
-//! header   b"FCSNAP\0\0"  u32 version = 2  u32 flags = 0  u64 payload_len
+//! header   b"FCSNAP\0\0"  u32 version = 4  u32 flags = 0  u64 payload_len
 //! payload  u64 vertex_count  u64 spring_count  u64 triangle_count  u64 topology_fingerprint
 //!          u8 history_tag  u64 history_config_fingerprint
 //!          f64 time  u64 steps  vec3 current  f64 solver_tolerance  u32 solver_max_iterations
@@ -30,7 +31,7 @@ use crate::integrate::SolverSettings;
 
 const MAGIC: &[u8; 8] = b"FCSNAP\0\0";
 /// Current format version.
-pub const SNAPSHOT_VERSION: u32 = 3;
+pub const SNAPSHOT_VERSION: u32 = 4;
 const HEADER: usize = 8 + 4 + 4 + 8;
 
 /// FNV-1a over a stream of u64 words: cheap identity checks, not security.

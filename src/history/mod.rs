@@ -24,6 +24,8 @@ mod truncated;
 pub use full::Full;
 pub use kernel::panel_weights;
 pub use soe::SumOfExponentials;
+/// Particles per block of the SOE mode store (a step's pass hands the history whole blocks).
+pub(crate) use soe::LANES as SOE_BLOCK;
 pub use soe_kernel::SoeKernel;
 pub use truncated::{eq6_weights, Truncated};
 
@@ -126,7 +128,8 @@ pub enum History {
     Off,
     Truncated(Truncated),
     Full(Full),
-    SumOfExponentials(SumOfExponentials),
+    /// Boxed: the largest state by far.
+    SumOfExponentials(Box<SumOfExponentials>),
 }
 
 /// `clone_from` reuses the buffers when both sides hold the same scheme.
@@ -174,10 +177,10 @@ impl History {
                 tolerance,
                 horizon,
                 min_dt,
-            } => History::SumOfExponentials(SumOfExponentials::new(
+            } => History::SumOfExponentials(Box::new(SumOfExponentials::new(
                 SoeKernel::build(tolerance, min_dt, horizon)?,
                 n,
-            )),
+            ))),
         })
     }
 
@@ -186,7 +189,7 @@ impl History {
             History::Off => None,
             History::Truncated(s) => Some(s),
             History::Full(s) => Some(s),
-            History::SumOfExponentials(s) => Some(s),
+            History::SumOfExponentials(s) => Some(s.as_ref()),
         }
     }
 
@@ -195,7 +198,7 @@ impl History {
             History::Off => None,
             History::Truncated(s) => Some(s),
             History::Full(s) => Some(s),
-            History::SumOfExponentials(s) => Some(s),
+            History::SumOfExponentials(s) => Some(s.as_mut()),
         }
     }
 
@@ -242,11 +245,72 @@ impl History {
         }
     }
 
+    /// Begins a step's pass over the particles: readies the step's weights and returns what
+    /// gives `H_n` range by range ([`StepPast::past_range`]). After the pass, call
+    /// [`Self::end_step`].
+    pub(crate) fn begin_step(&mut self) -> StepPast<'_> {
+        match self {
+            History::SumOfExponentials(s) => StepPast::Soe(s.begin()),
+            other => {
+                other.prepare();
+                StepPast::Read(other)
+            }
+        }
+    }
+
+    /// Ends the pass begun by [`Self::begin_step`], which covered every particle once.
+    pub(crate) fn end_step(&mut self) {
+        if let History::SumOfExponentials(s) = self {
+            s.end();
+        }
+    }
+
+    /// Records the velocities of the accepted step of size `h` (one per particle). `v` may be
+    /// swapped for a buffer of the same length instead of copied (SOE).
+    pub(crate) fn record(&mut self, v: &mut Vec<Vec3>, h: f64) {
+        match self {
+            History::SumOfExponentials(s) => s.record(v, h),
+            other => other.push(v, h),
+        }
+    }
+
     /// Exponential modes in use (SOE only; 0 otherwise).
     pub fn mode_count(&self) -> usize {
         match self {
             History::SumOfExponentials(s) => s.mode_count(),
             _ => 0,
+        }
+    }
+}
+
+/// What one step's pass over the particles reads of the history, from [`History::begin_step`].
+pub(crate) enum StepPast<'a> {
+    /// Schemes whose past is read only.
+    Read(&'a History),
+    /// SOE, which folds the last accepted step into its modes during the pass.
+    Soe(soe::SoePass<'a>),
+}
+
+impl StepPast<'_> {
+    /// Weight w0 of the current velocity over this step.
+    pub(crate) fn current_weight(&self) -> f64 {
+        match self {
+            StepPast::Read(h) => h.current_weight(),
+            StepPast::Soe(s) => s.current_weight(),
+        }
+    }
+
+    /// Writes `H_n` of particles `first .. first + out.len()` into `out`.
+    ///
+    /// # Safety
+    /// Every particle is covered exactly once per pass, and ranges whose calls may overlap in
+    /// time start and end on blocks of 16 particles (or end at the last particle); see
+    /// [`soe::SoePass::past_range`].
+    pub(crate) unsafe fn past_range(&self, first: usize, out: &mut [Vec3]) {
+        match self {
+            StepPast::Read(h) => h.past_range(first, out),
+            // SAFETY: the caller's contract is the pass's.
+            StepPast::Soe(s) => unsafe { s.past_range(first, out) },
         }
     }
 }
