@@ -17,7 +17,6 @@
 //! Each particle receives its springs in an order fixed by the topology and the group grid, so
 //! the sums do not depend on the thread count.
 
-use super::assemble::add_scaled_widest;
 use super::springs::{run_uniform_widest, run_widest, Params};
 use crate::topology::Topology;
 
@@ -171,24 +170,45 @@ fn add_range(
             // +f at the i ends inside the chunk.
             let (a, b) = (lo.max(c0), (lo + m).min(c1));
             if a < b {
-                add3(1.0, temp, a - lo, b - lo, window, a - base, w);
+                add3_widest(true, temp, a - lo, b - lo, window, a - base, w);
             }
             // -f at the j ends inside the chunk.
             let (a, b) = ((lo + off).max(c0), (lo + m + off).min(c1));
             if a < b {
-                add3(-1.0, temp, a - lo - off, b - lo - off, window, a - base, w);
+                add3_widest(false, temp, a - lo - off, b - lo - off, window, a - base, w);
             }
             lo += m;
         }
     }
 }
 
-/// `window[c][at..] += sign * temp[c][from..to]` for the three components.
-#[inline]
-fn add3(sign: f64, temp: &[[f64; TILE]; 3], from: usize, to: usize, window: &mut [f64], at: usize, w: usize) {
-    for c in 0..3 {
+crate::simd_dispatch! { fn add3_widest(plus: bool, temp: &[[f64; TILE]; 3], from: usize, to: usize, window: &mut [f64], at: usize, w: usize) => add3 }
+
+/// `window[c][at..] += temp[c][from..to]` (or `-=` unless `plus`) for the three components:
+/// one dispatched call for all three, and a subtraction rather than a multiplication by -1
+/// (the same bits: `d + (-1 * s)` is `d - s` exactly).
+#[inline(always)]
+fn add3(
+    plus: bool,
+    temp: &[[f64; TILE]; 3],
+    from: usize,
+    to: usize,
+    window: &mut [f64],
+    at: usize,
+    w: usize,
+) {
+    for (c, src) in temp.iter().enumerate() {
         let dst = &mut window[c * w + at..c * w + at + (to - from)];
-        add_scaled_widest(sign, &temp[c][from..to], dst);
+        let src = &src[from..to];
+        if plus {
+            for (d, s) in dst.iter_mut().zip(src) {
+                *d += *s;
+            }
+        } else {
+            for (d, s) in dst.iter_mut().zip(src) {
+                *d -= *s;
+            }
+        }
     }
 }
 
