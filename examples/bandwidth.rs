@@ -74,6 +74,9 @@ fn main() -> Result<(), fraccloth::Error> {
         .iter()
         .map(|&k| format!("{k}: {:.1}", streams(48 << 20, k)))
         .collect();
-    println!("one thread, k arrays swept together (k: GB/s): {}", rates.join(", "));
+    println!(
+        "one thread, k arrays swept together (k: GB/s): {}",
+        rates.join(", ")
+    );
     Ok(())
 }
