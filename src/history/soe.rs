@@ -352,29 +352,15 @@ impl SumOfExponentials {
     pub(crate) fn begin(&mut self) -> SoePass<'_> {
         self.set_weights();
         self.plan = plan(&self.kernel, self.cut, &self.clock, &mut self.coef);
-        let p = self.plan;
-        let k = p.k;
+        let block = self.block();
+        let (c, v) = Coefficients::of(&self.coef, self.plan, self.w_prev, &self.prev, &self.newest);
         SoePass {
-            c: Coefficients {
-                decay: &self.coef.decay[..k],
-                a: &self.coef.a[..k],
-                b: &self.coef.b[..k],
-                next: &self.coef.next[..k],
-                shift: p.shift,
-                restart: p.restart,
-                fold: p.fold.is_some(),
-                zero: p.zero,
-                w_prev: self.w_prev,
-            },
+            c,
             w0: self.w0,
             n: self.n,
-            block: self.kernel.len() * 3 * LANES,
+            block,
             prev: &self.prev,
-            v: if p.fold.is_some() {
-                &self.newest
-            } else {
-                &self.prev
-            },
+            v,
             modes: parallel::Disjoint::new(&mut self.modes),
         }
     }
@@ -537,22 +523,7 @@ impl HalfDerivative for SumOfExponentials {
         // path (which uses `begin`), so it may allocate.
         let mut coef = ModeCoefficients::new(self.kernel.len());
         let p = plan(&self.kernel, self.cut, &self.clock, &mut coef);
-        let c = Coefficients {
-            decay: &coef.decay[..p.k],
-            a: &coef.a[..p.k],
-            b: &coef.b[..p.k],
-            next: &coef.next[..p.k],
-            shift: p.shift,
-            restart: p.restart,
-            fold: p.fold.is_some(),
-            zero: p.zero,
-            w_prev: self.w_prev,
-        };
-        let v = if p.fold.is_some() {
-            &self.newest
-        } else {
-            &self.prev
-        };
+        let (c, v) = Coefficients::of(&coef, p, self.w_prev, &self.prev, &self.newest);
         let end = first + out.len();
         let block = self.block();
         let mut modes = vec![0.0; block];
@@ -609,6 +580,32 @@ struct Coefficients<'a> {
     /// Whether the sum is taken as zero (the first sample).
     zero: bool,
     w_prev: f64,
+}
+
+impl<'a> Coefficients<'a> {
+    /// The coefficients of plan `p` (filled into `coef` by [`plan`]), and the newest sample the
+    /// pass works from: the recorded one `newest` when it folds, else the folded `prev`.
+    fn of(
+        coef: &'a ModeCoefficients,
+        p: Plan,
+        w_prev: f64,
+        prev: &'a [Vec3],
+        newest: &'a [Vec3],
+    ) -> (Self, &'a [Vec3]) {
+        let k = p.k;
+        let c = Coefficients {
+            decay: &coef.decay[..k],
+            a: &coef.a[..k],
+            b: &coef.b[..k],
+            next: &coef.next[..k],
+            shift: p.shift,
+            restart: p.restart,
+            fold: p.fold.is_some(),
+            zero: p.zero,
+            w_prev,
+        };
+        (c, if p.fold.is_some() { newest } else { prev })
+    }
 }
 
 crate::simd_dispatch! { fn pass_blocks_widest(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64], out: &mut [Vec3]) => pass_blocks }
