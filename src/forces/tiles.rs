@@ -5,7 +5,8 @@
 //! particles. For each tile,
 //! every run's springs whose `i` end lies in the tile are evaluated into a small buffer, added
 //! with `+` at their `i` ends and with `-` at their `j` ends (`j = i + offset`, later in the
-//! array), into a rolling window of sums that covers the tile and the `max offset` particles
+//! array; a particle that is both gets `f_i - f_j` in one update), into a rolling window of
+//! sums that covers the tile and the `max offset` particles
 //! after it. When a tile's springs are done, every spring touching a particle of the tile has
 //! been added (its `i` end is never after its `j` end), so the tile is handed to `finish`; the
 //! window slides on when the next tile would not fit. Before the first tile, the springs whose
@@ -167,17 +168,84 @@ fn add_range(
             for q in tr.pads_in(s..s + m) {
                 (tx[q - s], ty[q - s], tz[q - s]) = (0.0, 0.0, 0.0);
             }
-            // +f at the i ends inside the chunk.
-            let (a, b) = (lo.max(c0), (lo + m).min(c1));
-            if a < b {
-                add3_widest(true, temp, a - lo, b - lo, window, a - base, w);
-            }
-            // -f at the j ends inside the chunk.
-            let (a, b) = ((lo + off).max(c0), (lo + m + off).min(c1));
-            if a < b {
-                add3_widest(false, temp, a - lo - off, b - lo - off, window, a - base, w);
-            }
+            // +f at the i ends and -f at the j ends inside the group.
+            let ends = Ends {
+                i: (lo.max(c0), (lo + m).min(c1)),
+                j: ((lo + off).max(c0), (lo + m + off).min(c1)),
+            };
+            add_piece(temp, lo, off, ends, window, base, w);
             lo += m;
+        }
+    }
+}
+
+/// The particles a piece adds to, as ranges `[start, end)` (empty when `start >= end`): its
+/// springs' `i` ends and its springs' `j` ends inside the group.
+#[derive(Clone, Copy)]
+struct Ends {
+    i: (usize, usize),
+    j: (usize, usize),
+}
+
+/// Adds the forces `temp` of the springs `lo ..` (offset `off`) into the window (which starts at
+/// particle `base`): `+f` at the particles of `ends.i`, `-f` at those of `ends.j`. A particle
+/// that is both (a spring's `i` end and another's `j` end; most are, as runs are long) gets
+/// its net force `f_i - f_j` in one update, so the window is read and written once per
+/// particle per piece.
+fn add_piece(
+    temp: &[[f64; TILE]; 3],
+    lo: usize,
+    off: usize,
+    ends: Ends,
+    window: &mut [f64],
+    base: usize,
+    w: usize,
+) {
+    let ((ia, ib), (ja, jb)) = (ends.i, ends.j);
+    // Both: [oa, ob), empty when the two ranges do not overlap.
+    let (oa, ob) = (ia.max(ja), ib.min(jb));
+    let plus = |a: usize, b: usize, window: &mut [f64]| {
+        if a < b {
+            add3_widest(true, temp, a - lo, b - lo, window, a - base, w);
+        }
+    };
+    let minus = |a: usize, b: usize, window: &mut [f64]| {
+        if a < b {
+            add3_widest(false, temp, a - lo - off, b - lo - off, window, a - base, w);
+        }
+    };
+    if oa < ob {
+        plus(ia, ib.min(oa), window);
+        plus(ia.max(ob), ib, window);
+        minus(ja, jb.min(oa), window);
+        minus(ja.max(ob), jb, window);
+        net3_widest(temp, oa - lo, oa - lo - off, ob - oa, window, oa - base, w);
+    } else {
+        plus(ia, ib, window);
+        minus(ja, jb, window);
+    }
+}
+
+crate::simd_dispatch! { fn net3_widest(temp: &[[f64; TILE]; 3], from_i: usize, from_j: usize, len: usize, window: &mut [f64], at: usize, w: usize) => net3 }
+
+/// `window[c][at + k] += temp[c][from_i + k] - temp[c][from_j + k]` for `k < len` and the three
+/// components: the net force of the spring with its `i` end there and the one with its `j` end
+/// there.
+#[inline(always)]
+fn net3(
+    temp: &[[f64; TILE]; 3],
+    from_i: usize,
+    from_j: usize,
+    len: usize,
+    window: &mut [f64],
+    at: usize,
+    w: usize,
+) {
+    for (c, src) in temp.iter().enumerate() {
+        let dst = &mut window[c * w + at..c * w + at + len];
+        let (si, sj) = (&src[from_i..from_i + len], &src[from_j..from_j + len]);
+        for ((d, a), b) in dst.iter_mut().zip(si).zip(sj) {
+            *d += *a - *b;
         }
     }
 }
