@@ -29,6 +29,7 @@
 // Physics loops walk several per-particle arrays with one index; that reads better than zips.
 #![allow(clippy::needless_range_loop)]
 
+pub mod aligned;
 mod bytes;
 pub mod cloth;
 pub mod error;

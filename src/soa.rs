@@ -8,20 +8,21 @@
 //! and the spring pass reads and writes those: one shuffle per particle instead of one per
 //! spring end.
 
+use crate::aligned::AlignedF64;
 use crate::parallel;
 use crate::Vec3;
 
-/// Three component arrays of equal length.
+/// Three component arrays of equal length, each starting on a cache line.
 #[derive(Clone, Debug, Default)]
 pub struct Soa3 {
-    pub c: [Vec<f64>; 3],
+    pub c: [AlignedF64; 3],
 }
 
 impl Soa3 {
     /// Sets the length of every component array (new entries are zero).
     pub fn resize(&mut self, n: usize) {
         for a in &mut self.c {
-            a.resize(n, 0.0);
+            a.resize(n);
         }
     }
 

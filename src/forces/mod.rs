@@ -48,7 +48,7 @@ pub struct ForceScratch {
     faces: Vec<Vec3>,
     springs: Soa3,
     spring_inputs: springs::SpringScratch,
-    windows: Vec<f64>,
+    windows: crate::aligned::AlignedF64,
 }
 
 impl ForceScratch {
@@ -164,7 +164,7 @@ where
             1
         };
         let w = 3 * layout.window;
-        scratch.windows.resize(w * tasks, 0.0);
+        scratch.windows.resize(w * tasks);
         parallel::chunks(par, &mut scratch.windows[..w * tasks], w, |first, window| {
             let mut buf = [Vec3::zeros(); TILE];
             for g in (first / w..groups).step_by(tasks) {

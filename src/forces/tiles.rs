@@ -51,7 +51,8 @@ impl Layout {
         let chunk = crate::parallel::CHUNK;
         let tiles = tr.max_offset.div_ceil(TILE).max(1);
         Some(Self {
-            window: tr.max_offset + tiles * TILE,
+            // Whole cache lines per component, so each component starts on one.
+            window: (tr.max_offset + tiles * TILE).next_multiple_of(8),
             // At least 8 offsets long: the springs evaluated twice at a group's start (see
             // the module's doc) are then a few percent of the group's.
             group: (8 * tr.max_offset).div_ceil(chunk).max(1) * chunk,

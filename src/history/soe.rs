@@ -88,7 +88,7 @@ pub struct SumOfExponentials {
     kernel: Arc<SoeKernel>,
     /// Block-major: block b holds `[K][3][LANES]` numbers (see the type's docs); the lanes
     /// past `n` in the last block stay zero. Each is a shifted mode `M_l` (module docs).
-    modes: Vec<f64>,
+    modes: crate::aligned::AlignedF64,
     /// The newest sample folded into the modes.
     prev: Vec<Vec3>,
     /// The sample recorded by the last accepted step, waiting to be folded while `clock.recorded`
@@ -313,7 +313,7 @@ impl SumOfExponentials {
             cut,
             n,
             kernel: Arc::new(kernel),
-            modes: vec![0.0; n.div_ceil(LANES) * k * 3 * LANES],
+            modes: crate::aligned::AlignedF64::zeros(n.div_ceil(LANES) * k * 3 * LANES),
             prev: vec![Vec3::zeros(); n],
             newest: vec![Vec3::zeros(); n],
             clock: Clock::default(),

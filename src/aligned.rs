@@ -1,0 +1,112 @@
+//! A growable array of f64 whose first number starts a cache line (64 bytes), so that the
+//! vector loops over it (AVX-512: one cache line per load) never split a load or a store across
+//! two lines. `Vec<f64>` only promises 8-byte alignment, and a large one from `malloc` starts
+//! 16 bytes into a page: every 64-byte access then touches two lines.
+
+use std::ops::{Deref, DerefMut};
+
+/// One cache line of numbers.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(64))]
+struct Line([f64; 8]);
+
+const PER_LINE: usize = 8;
+
+/// `len` numbers in whole cache lines.
+#[derive(Debug, Default, PartialEq)]
+pub struct AlignedF64 {
+    lines: Vec<Line>,
+    len: usize,
+}
+
+impl Clone for AlignedF64 {
+    fn clone(&self) -> Self {
+        Self {
+            lines: self.lines.clone(),
+            len: self.len,
+        }
+    }
+
+    /// Reuses the allocation when it is large enough (as `Vec::clone_from` does).
+    fn clone_from(&mut self, source: &Self) {
+        self.lines.clone_from(&source.lines);
+        self.len = source.len;
+    }
+}
+
+impl AlignedF64 {
+    /// `len` zeros.
+    pub fn zeros(len: usize) -> Self {
+        Self {
+            lines: vec![Line::default(); len.div_ceil(PER_LINE)],
+            len,
+        }
+    }
+
+    /// Sets the length to `len`; new entries are zero.
+    pub fn resize(&mut self, len: usize) {
+        let old = self.len;
+        self.lines.resize(len.div_ceil(PER_LINE), Line::default());
+        self.len = len;
+        if len > old {
+            // Entries after the old length in its last line may hold stale numbers.
+            self[old..].fill(0.0);
+        }
+    }
+}
+
+impl Deref for AlignedF64 {
+    type Target = [f64];
+
+    fn deref(&self) -> &[f64] {
+        // SAFETY: `Line` is `repr(C)` around `[f64; 8]` with no padding (size 64 = 8 * 8), so
+        // the lines are `8 * lines.len() >= len` contiguous, initialised f64s.
+        unsafe { std::slice::from_raw_parts(self.lines.as_ptr().cast::<f64>(), self.len) }
+    }
+}
+
+impl DerefMut for AlignedF64 {
+    fn deref_mut(&mut self) -> &mut [f64] {
+        // SAFETY: as in `deref`, and `&mut self` borrows the lines exclusively.
+        unsafe { std::slice::from_raw_parts_mut(self.lines.as_mut_ptr().cast::<f64>(), self.len) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn starts_on_a_cache_line_and_holds_its_length() {
+        for len in [0, 1, 7, 8, 9, 1000, 123_457] {
+            let mut a = AlignedF64::zeros(len);
+            assert_eq!(a.len(), len);
+            assert!(a.iter().all(|&x| x == 0.0));
+            assert_eq!(a.as_ptr() as usize % 64, 0);
+            if len > 0 {
+                a[len - 1] = 2.5;
+            }
+            let b = a.clone();
+            assert_eq!(b.as_ptr() as usize % 64, 0);
+            assert_eq!(&b[..], &a[..]);
+            let mut c = AlignedF64::zeros(3);
+            c.clone_from(&a);
+            assert_eq!(&c[..], &a[..]);
+            assert_eq!(c.as_ptr() as usize % 64, 0);
+        }
+    }
+
+    #[test]
+    fn resizing_keeps_the_numbers_and_zeroes_new_ones() {
+        let mut a = AlignedF64::zeros(13);
+        a.iter_mut().enumerate().for_each(|(k, x)| *x = k as f64 + 1.0);
+        a.resize(10);
+        assert_eq!(a[9], 10.0);
+        // Growing again within the same lines: the old numbers past 10 do not come back.
+        a.resize(20);
+        assert_eq!(a.len(), 20);
+        assert_eq!(a[9], 10.0);
+        assert!(a[10..].iter().all(|&x| x == 0.0));
+        assert_eq!(a.as_ptr() as usize % 64, 0);
+    }
+}
