@@ -12,11 +12,23 @@ struct Line([f64; 8]);
 
 const PER_LINE: usize = 8;
 
-/// `len` numbers in whole cache lines.
-#[derive(Debug, Default, PartialEq)]
+/// `len` numbers in whole cache lines. Compares and prints as the slice of its `len` numbers.
+#[derive(Default)]
 pub struct AlignedF64 {
     lines: Vec<Line>,
     len: usize,
+}
+
+impl PartialEq for AlignedF64 {
+    fn eq(&self, other: &Self) -> bool {
+        self[..] == other[..]
+    }
+}
+
+impl std::fmt::Debug for AlignedF64 {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self[..].fmt(f)
+    }
 }
 
 impl Clone for AlignedF64 {
@@ -108,5 +120,14 @@ mod tests {
         assert_eq!(a[9], 10.0);
         assert!(a[10..].iter().all(|&x| x == 0.0));
         assert_eq!(a.as_ptr() as usize % 64, 0);
+        // Equal as slices, whatever the unused end of the last line holds.
+        let mut b = AlignedF64::zeros(20);
+        b[..10].copy_from_slice(&a[..10]);
+        let mut c = b.clone();
+        c.resize(21);
+        c[20] = 7.0;
+        c.resize(20);
+        assert_eq!(b, c);
+        assert_eq!(format!("{b:?}"), format!("{:?}", &b[..]));
     }
 }
