@@ -163,16 +163,19 @@ where
         } else {
             1
         };
-        let w = 3 * layout.window;
+        let w = layout.scratch();
         scratch.windows.resize(w * tasks);
         parallel::chunks(par, &mut scratch.windows[..w * tasks], w, |first, window| {
             let mut buf = [Vec3::zeros(); TILE];
             for g in (first / w..groups).step_by(tasks) {
                 let c0 = g * layout.group;
                 let len = layout.group.min(n - c0);
-                tiles::spring_forces(&params, t, c0, len, window, |p0, sums| {
-                    finish(p0, sums, &mut buf[..sums[0].len()]);
-                });
+                let finish = |p0: usize, sums: [&[f64]; 3]| finish(p0, sums, &mut buf[..sums[0].len()]);
+                if layout.gather_runs > 0 {
+                    tiles::spring_forces_gathered(&params, t, &layout, c0, len, window, finish);
+                } else {
+                    tiles::spring_forces(&params, t, c0, len, window, finish);
+                }
             }
         });
     } else {

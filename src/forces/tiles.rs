@@ -13,7 +13,14 @@
 //! `i` end lies before `c0` and whose `j` end lies in the group are evaluated too (the previous
 //! group evaluates them as well, for its own `i` ends; a few per group boundary).
 //!
-//! Everything a tile touches (positions around it, the window) stays in L1 or L2 cache, and a
+//! **Gathered** ([`spring_forces_gathered`], topologies of at most [`GATHER_RUNS`] runs: grids):
+//! instead of one window of sums, each run keeps a window of its springs' forces by `i` end
+//! (zero where it has none). A tile evaluates its runs into their windows and then each particle
+//! `p` sums `F_k[p] - F_k[p - offset_k]` over the runs in registers and writes it once, where the
+//! window of sums above is read and written once per run. The windows keep each run's last
+//! `offset` forces when they slide.
+//!
+//! Everything a tile touches (positions around it, the windows) stays in L1 or L2 cache, and a
 //! spring's force is used where it is computed instead of being written out and read back.
 //! Each particle receives its springs in an order fixed by the topology and the group grid, so
 //! the sums do not depend on the thread count.
@@ -38,7 +45,22 @@ pub(super) struct Layout {
     pub window: usize,
     /// Particles per group, a multiple of [`crate::parallel::CHUNK`].
     pub group: usize,
+    /// Runs when the topology has at most [`GATHER_RUNS`] of them (a grid has six), and the
+    /// tiles are summed by [`spring_forces_gathered`]; 0 otherwise.
+    pub gather_runs: usize,
+    /// Entries before a tile in each force window of the gather path: the largest offset,
+    /// rounded up to whole cache lines so that a tile's entries start on one.
+    pub lead: usize,
+    /// Numbers per component of each force window: `lead` and [`GATHER_TILES`] tiles or more.
+    pub force_window: usize,
 }
+
+/// Tiles a force window of the gather path holds after its lead: it slides (copies each run's
+/// last `offset` forces to its front) once every so many tiles.
+const GATHER_TILES: usize = 4;
+
+/// Most runs [`spring_forces_gathered`] keeps force windows for.
+pub(super) const GATHER_RUNS: usize = 8;
 
 impl Layout {
     /// The layout for `t`, or None when the tile path does not apply.
@@ -56,7 +78,24 @@ impl Layout {
             // At least 8 offsets long: the springs evaluated twice at a group's start (see
             // the module's doc) are then a few percent of the group's.
             group: (8 * tr.max_offset).div_ceil(chunk).max(1) * chunk,
+            gather_runs: if tr.runs.len() <= GATHER_RUNS {
+                tr.runs.len()
+            } else {
+                0
+            },
+            lead: tr.max_offset.next_multiple_of(8),
+            force_window: tr.max_offset.next_multiple_of(8) + tiles.max(GATHER_TILES) * TILE,
         })
+    }
+
+    /// Numbers of scratch one task needs: the window of sums, or the gather path's force
+    /// windows (one per run) and a tile of sums.
+    pub(super) fn scratch(&self) -> usize {
+        if self.gather_runs > 0 {
+            3 * self.force_window * self.gather_runs + 3 * TILE
+        } else {
+            3 * self.window
+        }
     }
 }
 
@@ -122,6 +161,195 @@ pub(super) fn spring_forces<F>(
             finish(base, [&x[at..at + n], &y[at..at + n], &z[at..at + n]]);
         }
         base = end;
+    }
+}
+
+/// [`spring_forces`] for topologies with at most [`GATHER_RUNS`] runs (grids), by gathering:
+/// each run `k` keeps a window `F_k` of the forces of its springs by `i` end (zero where the run
+/// has no spring), and each particle `p` of a tile sums `F_k[p] - F_k[p - offset_k]` over the runs
+/// in registers, writing its sum once. No window of sums is read and written back per run, as
+/// [`spring_forces`] does. `scratch` holds [`Layout::scratch`] numbers; `layout` is this
+/// topology's.
+pub(super) fn spring_forces_gathered<F>(
+    p: &Params<'_>,
+    t: &Topology,
+    layout: &Layout,
+    c0: usize,
+    len: usize,
+    scratch: &mut [f64],
+    mut finish: F,
+) where
+    F: FnMut(usize, [&[f64]; 3]),
+{
+    let tr = &t.tile_runs;
+    let (runs, w, lead) = (&tr.runs, layout.force_window, layout.lead);
+    debug_assert!(runs.len() == layout.gather_runs && w >= lead + TILE && lead >= tr.max_offset);
+    let p = &Params {
+        rest: &tr.rest,
+        kinds: &tr.kinds,
+        ..*p
+    };
+    let (forces, sums) = scratch.split_at_mut(3 * w * runs.len());
+    let c1 = c0 + len;
+    // Particle i's entry in a force window is `i + lead - origin`: the windows start `lead`
+    // particles before `origin`, so particles before 0 have entries too.
+    let mut origin = c0;
+    let at = |i: usize, origin: usize| i + lead - origin;
+    // The springs from before the group into it (`i` in [c0 - off, c0)); zero where none.
+    for (k, run) in runs.iter().enumerate() {
+        let off = run.offset as usize;
+        let window = &mut forces[3 * w * k..3 * w * (k + 1)];
+        for c in 0..3 {
+            window[c * w + lead - off..c * w + lead].fill(0.0);
+        }
+        evaluate(p, t, k, c0.saturating_sub(off), c0, window, lead, origin);
+    }
+    let mut base = c0;
+    while base < c1 {
+        let end = (base + TILE).min(c1);
+        if at(end, origin) > w {
+            // Slide: keep, for each run, the forces of the `offset` particles before `base`.
+            let shift = base - origin;
+            for (k, run) in runs.iter().enumerate() {
+                let off = run.offset as usize;
+                for c in 0..3 {
+                    let comp = &mut forces[(3 * k + c) * w..(3 * k + c + 1) * w];
+                    comp.copy_within(shift + lead - off..shift + lead, lead - off);
+                }
+            }
+            origin = base;
+        }
+        for k in 0..runs.len() {
+            let window = &mut forces[3 * w * k..3 * w * (k + 1)];
+            evaluate(p, t, k, base, end, window, lead, origin);
+        }
+        let m = end - base;
+        let (sx, rest) = sums.split_at_mut(TILE);
+        let (sy, sz) = rest.split_at_mut(TILE);
+        let mut plus = [0usize; GATHER_RUNS];
+        let mut minus = [0usize; GATHER_RUNS];
+        for (k, run) in runs.iter().enumerate() {
+            plus[k] = 3 * w * k + at(base, origin);
+            minus[k] = plus[k] - run.offset as usize;
+        }
+        gather_widest(
+            forces,
+            w,
+            runs.len(),
+            plus,
+            minus,
+            [&mut sx[..m], &mut sy[..m], &mut sz[..m]],
+        );
+        finish(base, [&sx[..m], &sy[..m], &sz[..m]]);
+        base = end;
+    }
+}
+
+/// Writes the forces of run `k`'s springs with `i` end in `[from, to)` into its force `window`
+/// (3 components of `window.len() / 3` numbers; particle `i` at `i + lead - origin`): zero
+/// where the run has no spring or a padding slot.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn evaluate(
+    p: &Params<'_>,
+    t: &Topology,
+    k: usize,
+    from: usize,
+    to: usize,
+    window: &mut [f64],
+    lead: usize,
+    origin: usize,
+) {
+    let tr = &t.tile_runs;
+    let run = &tr.runs[k];
+    let i0 = run.first_vertex as usize;
+    let w = window.len() / 3;
+    let at = |i: usize| i + lead - origin;
+    let (lo, hi) = (from.max(i0), to.min(i0 + run.len as usize));
+    if lo >= hi {
+        for c in 0..3 {
+            window[c * w + at(from)..c * w + at(to)].fill(0.0);
+        }
+        return;
+    }
+    for c in 0..3 {
+        window[c * w + at(from)..c * w + at(lo)].fill(0.0);
+        window[c * w + at(hi)..c * w + at(to)].fill(0.0);
+    }
+    let (m, s) = (hi - lo, run.first_spring as usize + (lo - i0));
+    let a = at(lo);
+    let (x, rest) = window.split_at_mut(w);
+    let (y, z) = rest.split_at_mut(w);
+    let out = [&mut x[a..a + m], &mut y[a..a + m], &mut z[a..a + m]];
+    match tr.uniform_rest[k] {
+        Some(r) => run_uniform_widest(p, run, s, r, out),
+        None => run_widest(p, run, s, out),
+    }
+    for q in tr.pads_in(s..s + m) {
+        let at = a + (q - s);
+        (x[at], y[at], z[at]) = (0.0, 0.0, 0.0);
+    }
+}
+
+crate::simd_dispatch! { fn gather_widest(forces: &[f64], w: usize, runs: usize, plus: [usize; GATHER_RUNS], minus: [usize; GATHER_RUNS], out: [&mut [f64]; 3]) => gather }
+
+/// `out[c][q] = sum_k (forces[plus[k] + c w + q] - forces[minus[k] + c w + q])` over the first
+/// `runs` runs, in run order: one loop per run count, so the runs are unrolled and the sum stays
+/// in registers.
+#[inline(always)]
+fn gather(
+    forces: &[f64],
+    w: usize,
+    runs: usize,
+    plus: [usize; GATHER_RUNS],
+    minus: [usize; GATHER_RUNS],
+    out: [&mut [f64]; 3],
+) {
+    macro_rules! by_count {
+        ($($r:literal)*) => {
+            match runs {
+                $($r => gather_n::<$r>(forces, w, &plus, &minus, out),)*
+                _ => unreachable!("at most GATHER_RUNS runs"),
+            }
+        };
+    }
+    by_count!(1 2 3 4 5 6 7 8)
+}
+
+#[inline(always)]
+fn gather_n<const R: usize>(
+    forces: &[f64],
+    w: usize,
+    plus: &[usize; GATHER_RUNS],
+    minus: &[usize; GATHER_RUNS],
+    out: [&mut [f64]; 3],
+) {
+    for (c, o) in out.into_iter().enumerate() {
+        let m = o.len();
+        let pl: [&[f64]; R] = std::array::from_fn(|k| &forces[plus[k] + c * w..plus[k] + c * w + m]);
+        let mi: [&[f64]; R] = std::array::from_fn(|k| &forces[minus[k] + c * w..minus[k] + c * w + m]);
+        // Blocks of 8 as fixed-size arrays (no bounds checks, so the loop vectorises), then the
+        // rest; the same operations in the same order either way.
+        const B: usize = 8;
+        let whole = m / B * B;
+        for q in (0..whole).step_by(B) {
+            let mut sum = [0.0; B];
+            for k in 0..R {
+                let a: &[f64; B] = pl[k][q..q + B].try_into().expect("a block of 8");
+                let b: &[f64; B] = mi[k][q..q + B].try_into().expect("a block of 8");
+                for l in 0..B {
+                    sum[l] += a[l] - b[l];
+                }
+            }
+            o[q..q + B].copy_from_slice(&sum);
+        }
+        for q in whole..m {
+            let mut sum = 0.0;
+            for k in 0..R {
+                sum += pl[k][q] - mi[k][q];
+            }
+            o[q] = sum;
+        }
     }
 }
 
@@ -374,11 +602,30 @@ mod tests {
         let q_wide: Vec<Vec3> = (0..wide.vertex_count())
             .map(|_| Vec3::new(rnd(), rnd(), rnd()))
             .collect();
+        // Gaps of six springs in every family at four places: 30 runs, too many for the gather
+        // path, so the window-of-sums path runs.
+        let holes: Vec<_> = t
+            .springs
+            .iter()
+            .filter(|s| !(1..=4).any(|k| (2000 * k..2000 * k + 6).contains(&s.i)))
+            .copied()
+            .collect();
+        let holes = Topology::new(
+            t.rest_positions.clone(),
+            t.masses.clone(),
+            holes,
+            t.triangles.clone(),
+            t.grid,
+        );
+        let gathered = |t: &Topology| super::Layout::of(t).is_some_and(|l| l.gather_runs > 0);
+        assert!(super::Layout::of(&holes).is_some() && !gathered(&holes));
+        assert!(gathered(&t) && gathered(&varied) && gathered(&wide));
         for (topology, x, q) in [
             (&t, &x, &q),
             (&buffered, &x, &q),
             (&varied, &x, &q),
             (&wide, &x_wide, &q_wide),
+            (&holes, &x, &q),
         ] {
             let n = topology.vertex_count();
             let want = reference(&m, topology, x, q);
