@@ -12,11 +12,12 @@
 //! The cloth: a grid at 1 cm spacing (so every size is equally stiff and the same dt is stable),
 //! 0.096 g per particle, top row pinned, in a 0.2 m/s cross current so it keeps moving; dt =
 //! 0.5 ms (the issue names 1 ms, at which the regular model is refused as unstable on this
-//! cloth; a step costs the same at any dt). Timed: the stepping loop only (`Cloth::step`), after a warm-up of 20 steps and at least
-//! a fifth of the timed span,
-//! for at least 0.5 s of wall clock (0.15 s with --quick), split into 7 windows whose median
-//! rate is reported. Threads: a rayon pool of that many
-//! threads around the loop. Every step must succeed; a failed step aborts the run.
+//! cloth; a step costs the same at any dt). Timed: the stepping loop only (`Cloth::step`), after
+//! a warm-up of 20 steps and at least a fifth of the timed span, for at least 0.5 s of wall clock
+//! per thread count (0.15 s with --quick), split into 7 windows whose median rate is reported.
+//! Threads: a rayon pool of that many threads around the loop. The 1- and 2-thread runs step two
+//! identical cloths in alternating windows, and the speedup column is the median of the ratios
+//! of adjacent windows (see `measure`). Every step must succeed; a failed step aborts the run.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::error::Error;
@@ -125,38 +126,64 @@ fn build(c: &Config, w: u32, h: u32) -> Result<Cloth, Box<dyn Error>> {
     Ok(cloth)
 }
 
-/// Particle-steps per second of `c` at `w x h` on `threads` threads.
-fn measure(c: &Config, w: u32, h: u32, threads: usize, min_secs: f64) -> Result<f64, Box<dyn Error>> {
-    let mut cloth = build(c, w, h)?;
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
-    let rate = pool.install(|| -> Result<f64, fraccloth::Error> {
-        // Warm-up: 20 steps, and at least a fifth of the timed span (caches, page faults, and
-        // the CPU's clock, which a short warm-up left low for the first configuration run).
-        let warm = Instant::now();
-        let mut warm_steps = 0;
-        while warm_steps < 20 || warm.elapsed().as_secs_f64() < min_secs / 5.0 {
-            cloth.step(DT)?;
-            warm_steps += 1;
-        }
-        // The median of WINDOWS timed windows: this machine is shared, and a median is not
-        // moved by a window that another tenant slowed down.
-        let mut rates = Vec::with_capacity(WINDOWS);
-        for _ in 0..WINDOWS {
+/// One cloth stepping in its own rayon pool of `threads` threads.
+struct Runner {
+    cloth: Cloth,
+    pool: rayon::ThreadPool,
+}
+
+impl Runner {
+    fn new(c: &Config, w: u32, h: u32, threads: usize) -> Result<Self, Box<dyn Error>> {
+        Ok(Self {
+            cloth: build(c, w, h)?,
+            pool: rayon::ThreadPoolBuilder::new().num_threads(threads).build()?,
+        })
+    }
+
+    /// Steps for at least `secs` (and at least `min_steps` steps); particle-steps per second.
+    fn run(&mut self, secs: f64, min_steps: u64) -> Result<f64, fraccloth::Error> {
+        let cloth = &mut self.cloth;
+        self.pool.install(|| {
             let start = Instant::now();
             let mut steps = 0u64;
-            while start.elapsed().as_secs_f64() < min_secs / WINDOWS as f64 || steps < 5 {
+            while start.elapsed().as_secs_f64() < secs || steps < min_steps {
                 for _ in 0..5 {
                     cloth.step(DT)?;
                 }
                 steps += 5;
             }
-            let secs = start.elapsed().as_secs_f64();
-            rates.push(steps as f64 * cloth.vertex_count() as f64 / secs);
-        }
-        rates.sort_by(f64::total_cmp);
-        Ok(rates[WINDOWS / 2])
-    })?;
-    Ok(rate)
+            Ok(steps as f64 * cloth.vertex_count() as f64 / start.elapsed().as_secs_f64())
+        })
+    }
+}
+
+fn median(mut x: Vec<f64>) -> f64 {
+    x.sort_by(f64::total_cmp);
+    x[x.len() / 2]
+}
+
+/// Particle-steps per second of `c` at `w x h` on one thread and on two, and the speedup: two
+/// identical cloths, one per pool, timed in alternating windows (1 thread, then 2, WINDOWS
+/// times). Each rate is the median of its windows; the speedup is the median of the ratios of
+/// each pair of adjacent windows, so a slow spell of the shared machine that spans a pair
+/// slows both of its windows and moves the ratio less than it moves either rate.
+fn measure(c: &Config, w: u32, h: u32, min_secs: f64) -> Result<(f64, f64, f64), Box<dyn Error>> {
+    let mut one = Runner::new(c, w, h, 1)?;
+    let mut two = Runner::new(c, w, h, 2)?;
+    // Warm-up: 20 steps, and at least a fifth of the timed span each (caches, page faults, and
+    // the CPU's clock, which a short warm-up left low for the first configuration run).
+    one.run(min_secs / 5.0, 20)?;
+    two.run(min_secs / 5.0, 20)?;
+    let (mut r1, mut r2, mut ratio) = (vec![], vec![], vec![]);
+    let window = min_secs / WINDOWS as f64;
+    for _ in 0..WINDOWS {
+        let a = one.run(window, 5)?;
+        let b = two.run(window, 5)?;
+        r1.push(a);
+        r2.push(b);
+        ratio.push(b / a);
+    }
+    Ok((median(r1), median(r2), median(ratio)))
 }
 
 struct Row {
@@ -212,8 +239,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             continue;
         }
         for &(w, h) in &sizes {
-            let one = measure(&c, w, h, 1, min_secs)?;
-            let two = measure(&c, w, h, 2, min_secs)?;
+            let (one, two, speedup) = measure(&c, w, h, min_secs)?;
             let n = (w * h) as usize;
             println!(
                 "{:<36} {:>9} {:>14.2} {:>14.2} {:>8.2}",
@@ -221,7 +247,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                 n,
                 one / 1e6,
                 two / 1e6,
-                two / one
+                speedup
             );
             rows.push(Row {
                 config: c.name,
