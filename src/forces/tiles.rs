@@ -45,7 +45,8 @@ pub(super) struct Layout {
     pub window: usize,
     /// Particles per group, a multiple of [`crate::parallel::CHUNK`].
     pub group: usize,
-    /// Runs when the topology has at most [`GATHER_RUNS`] of them (a grid has six), and the
+    /// Runs when the topology has at most [`GATHER_RUNS`] of them (a grid has eight; a few more
+    /// allow a grid with holes or a row-ordered mesh), and the
     /// tiles are summed by [`spring_forces_gathered`]; 0 otherwise.
     pub gather_runs: usize,
     /// Entries before a tile in each force window of the gather path: the largest offset,
@@ -60,7 +61,7 @@ pub(super) struct Layout {
 const GATHER_TILES: usize = 4;
 
 /// Most runs [`spring_forces_gathered`] keeps force windows for.
-pub(super) const GATHER_RUNS: usize = 8;
+pub(super) const GATHER_RUNS: usize = 12;
 
 impl Layout {
     /// The layout for `t`, or None when the tile path does not apply.
@@ -313,7 +314,7 @@ fn gather(
             }
         };
     }
-    by_count!(1 2 3 4 5 6 7 8)
+    by_count!(1 2 3 4 5 6 7 8 9 10 11 12)
 }
 
 #[inline(always)]
@@ -602,7 +603,7 @@ mod tests {
         let q_wide: Vec<Vec3> = (0..wide.vertex_count())
             .map(|_| Vec3::new(rnd(), rnd(), rnd()))
             .collect();
-        // Gaps of six springs in every family at four places: 30 runs, too many for the gather
+        // Gaps of six springs in every family at four places: 40 runs, too many for the gather
         // path, so the window-of-sums path runs.
         let holes: Vec<_> = t
             .springs
@@ -617,7 +618,24 @@ mod tests {
             t.triangles.clone(),
             t.grid,
         );
+        // One gap in the horizontal stretch family only, inside a tile: 9 runs, gathered, with
+        // two runs of one family each covering part of a tile.
+        let gap: Vec<_> = t
+            .springs
+            .iter()
+            .filter(|s| !(s.j == s.i + 1 && (3000..3006).contains(&s.i)))
+            .copied()
+            .collect();
+        let gap = Topology::new(
+            t.rest_positions.clone(),
+            t.masses.clone(),
+            gap,
+            t.triangles.clone(),
+            t.grid,
+        );
+        assert_eq!(gap.tile_runs.runs.len(), t.tile_runs.runs.len() + 1);
         let gathered = |t: &Topology| super::Layout::of(t).is_some_and(|l| l.gather_runs > 0);
+        assert!(gathered(&gap));
         assert!(super::Layout::of(&holes).is_some() && !gathered(&holes));
         assert!(gathered(&t) && gathered(&varied) && gathered(&wide));
         for (topology, x, q) in [
@@ -626,6 +644,7 @@ mod tests {
             (&varied, &x, &q),
             (&wide, &x_wide, &q_wide),
             (&holes, &x, &q),
+            (&gap, &x, &q),
         ] {
             let n = topology.vertex_count();
             let want = reference(&m, topology, x, q);
