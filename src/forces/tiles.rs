@@ -26,7 +26,7 @@
 //! the sums do not depend on the thread count.
 
 use super::springs::{run_uniform_widest, run_widest, Params};
-use crate::topology::Topology;
+use crate::topology::{TileRuns, Topology};
 
 /// Particles per tile.
 pub const TILE: usize = 256;
@@ -266,29 +266,35 @@ fn evaluate(
     let i0 = run.first_vertex as usize;
     let w = window.len() / 3;
     let at = |i: usize| i + lead - origin;
-    let (lo, hi) = (from.max(i0), to.min(i0 + run.len as usize));
-    if lo >= hi {
-        for c in 0..3 {
-            window[c * w + at(from)..c * w + at(to)].fill(0.0);
-        }
-        return;
-    }
+    // The run's springs in [from, to) are [lo, hi); zero around them (everywhere when none).
+    let lo = from.max(i0).min(to);
+    let hi = to.min(i0 + run.len as usize).max(lo);
     for c in 0..3 {
         window[c * w + at(from)..c * w + at(lo)].fill(0.0);
         window[c * w + at(hi)..c * w + at(to)].fill(0.0);
     }
-    let (m, s) = (hi - lo, run.first_spring as usize + (lo - i0));
-    let a = at(lo);
+    if lo == hi {
+        return;
+    }
+    let (a, b) = (at(lo), at(hi));
     let (x, rest) = window.split_at_mut(w);
     let (y, z) = rest.split_at_mut(w);
-    let out = [&mut x[a..a + m], &mut y[a..a + m], &mut z[a..a + m]];
+    let s = run.first_spring as usize + (lo - i0);
+    evaluate_slots(p, tr, k, s, [&mut x[a..b], &mut y[a..b], &mut z[a..b]]);
+}
+
+/// Evaluates the slots `s .. s + out[0].len()` of run `k` into `out`; padding slots were
+/// evaluated like springs and are set to no force.
+#[inline]
+fn evaluate_slots(p: &Params<'_>, tr: &TileRuns, k: usize, s: usize, out: [&mut [f64]; 3]) {
+    let run = &tr.runs[k];
+    let [x, y, z] = out;
     match tr.uniform_rest[k] {
-        Some(r) => run_uniform_widest(p, run, s, r, out),
-        None => run_widest(p, run, s, out),
+        Some(r) => run_uniform_widest(p, run, s, r, [&mut *x, &mut *y, &mut *z]),
+        None => run_widest(p, run, s, [&mut *x, &mut *y, &mut *z]),
     }
-    for q in tr.pads_in(s..s + m) {
-        let at = a + (q - s);
-        (x[at], y[at], z[at]) = (0.0, 0.0, 0.0);
+    for q in tr.pads_in(s..s + x.len()) {
+        (x[q - s], y[q - s], z[q - s]) = (0.0, 0.0, 0.0);
     }
 }
 
@@ -374,7 +380,6 @@ fn add_range(
     let tr = &t.tile_runs;
     for &r in runs {
         let run = &tr.runs[r as usize];
-        let uniform = tr.uniform_rest[r as usize];
         let i0 = run.first_vertex as usize;
         let off = run.offset as usize;
         let i_end = i0 + run.len as usize;
@@ -389,15 +394,7 @@ fn add_range(
             let m = (hi - lo).min(TILE);
             let s = run.first_spring as usize + (lo - i0);
             let [tx, ty, tz] = temp;
-            let out = [&mut tx[..m], &mut ty[..m], &mut tz[..m]];
-            match uniform {
-                Some(rest) => run_uniform_widest(p, run, s, rest, out),
-                None => run_widest(p, run, s, out),
-            }
-            // Padding slots were evaluated like springs: no force.
-            for q in tr.pads_in(s..s + m) {
-                (tx[q - s], ty[q - s], tz[q - s]) = (0.0, 0.0, 0.0);
-            }
+            evaluate_slots(p, tr, r as usize, s, [&mut tx[..m], &mut ty[..m], &mut tz[..m]]);
             // +f at the i ends and -f at the j ends inside the group.
             let ends = Ends {
                 i: (lo.max(c0), (lo + m).min(c1)),
@@ -605,34 +602,21 @@ mod tests {
             .collect();
         // Gaps of six springs in every family at four places: 40 runs, too many for the gather
         // path, so the window-of-sums path runs.
-        let holes: Vec<_> = t
-            .springs
-            .iter()
-            .filter(|s| !(1..=4).any(|k| (2000 * k..2000 * k + 6).contains(&s.i)))
-            .copied()
-            .collect();
-        let holes = Topology::new(
-            t.rest_positions.clone(),
-            t.masses.clone(),
-            holes,
-            t.triangles.clone(),
-            t.grid,
-        );
+        // The grid `t` with only the springs `keep` accepts.
+        let keeping = |keep: &dyn Fn(&crate::topology::Spring) -> bool| {
+            let springs = t.springs.iter().filter(|s| keep(s)).copied().collect();
+            Topology::new(
+                t.rest_positions.clone(),
+                t.masses.clone(),
+                springs,
+                t.triangles.clone(),
+                t.grid,
+            )
+        };
+        let holes = keeping(&|s| !(1..=4).any(|k| (2000 * k..2000 * k + 6).contains(&s.i)));
         // One gap in the horizontal stretch family only, inside a tile: 9 runs, gathered, with
         // two runs of one family each covering part of a tile.
-        let gap: Vec<_> = t
-            .springs
-            .iter()
-            .filter(|s| !(s.j == s.i + 1 && (3000..3006).contains(&s.i)))
-            .copied()
-            .collect();
-        let gap = Topology::new(
-            t.rest_positions.clone(),
-            t.masses.clone(),
-            gap,
-            t.triangles.clone(),
-            t.grid,
-        );
+        let gap = keeping(&|s| !(s.j == s.i + 1 && (3000..3006).contains(&s.i)));
         assert_eq!(gap.tile_runs.runs.len(), t.tile_runs.runs.len() + 1);
         let gathered = |t: &Topology| super::Layout::of(t).is_some_and(|l| l.gather_runs > 0);
         assert!(gathered(&gap));

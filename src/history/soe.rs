@@ -397,7 +397,8 @@ impl SumOfExponentials {
         {
             let pass = self.begin();
             parallel::for_chunks(parallel::worth_it(n), n, parallel::CHUNK, |first, len| {
-                let mut out = [Vec3::zeros(); 256];
+                // Whole blocks per tile, so every tile but a chunk's last starts on a block.
+                let mut out = [Vec3::zeros(); 16 * LANES];
                 for t in (first..first + len).step_by(out.len()) {
                     let m = (first + len - t).min(out.len());
                     // SAFETY: each task covers its own chunk, tile by tile; chunks and tiles
