@@ -570,7 +570,17 @@ impl Cloth {
         let hard_pins = &s.hard_pins;
         let rate = forces::spring_rate(&self.config.model);
         let current = self.config.model.current;
-        let (sx, sq) = s.forces.spring_arrays(n);
+        // A tile walk transposes its own spring inputs; only other topologies need them here.
+        let arrays = !forces::tiled(&self.topology);
+        let (sx, sq) = s.forces.spring_arrays(if arrays { n } else { 0 });
+        // This chunk's part of a component array, or nothing when the arrays are not kept.
+        fn part<'a>(a: &parallel::Disjoint<'a, f64>, r: std::ops::Range<usize>) -> &'a mut [f64] {
+            if a.is_empty() {
+                return &mut [];
+            }
+            // SAFETY: every task borrows only its own chunk `r` of each array.
+            unsafe { a.range(r) }
+        }
         let (x, v, goal) = (&self.x, &self.v, &s.goal);
         let (v_step, v_rel, half) = (
             parallel::Disjoint::new(&mut s.v_step),
@@ -582,30 +592,28 @@ impl Cloth {
         parallel::for_chunks(par, n, parallel::CHUNK, |first, len| {
             let r = first..first + len;
             // SAFETY: every task borrows only its own chunk `r` of each array.
-            let (v_step, v_rel, half, sx, sy, sz, qx, qy, qz) = unsafe {
+            let (v_step, v_rel, half) = unsafe {
                 (
                     v_step.range(r.clone()),
                     v_rel.range(r.clone()),
                     half.range(r.clone()),
-                    sx.range(r.clone()),
-                    sy.range(r.clone()),
-                    sz.range(r.clone()),
-                    qx.range(r.clone()),
-                    qy.range(r.clone()),
-                    qz.range(r.clone()),
                 )
             };
+            let (sx, sy, sz) = (part(&sx, r.clone()), part(&sy, r.clone()), part(&sz, r.clone()));
+            let (qx, qy, qz) = (part(&qx, r.clone()), part(&qy, r.clone()), part(&qz, r.clone()));
             let (x, v) = (&x[r.clone()], &v[r.clone()]);
             // Tile by tile, so that the loops below find the tile's numbers in L1.
             for t0 in (0..len).step_by(PASS_TILE) {
                 let t = t0..(t0 + PASS_TILE).min(len);
+                // The tile in the component arrays: nothing when they are not kept.
+                let ts = if arrays { t.clone() } else { 0..0 };
                 prepass::velocities_and_positions(
                     &x[t.clone()],
                     &v[t.clone()],
                     current,
                     &mut v_step[t.clone()],
                     &mut v_rel[t.clone()],
-                    [&mut sx[t.clone()], &mut sy[t.clone()], &mut sz[t.clone()]],
+                    [&mut sx[ts.clone()], &mut sy[ts.clone()], &mut sz[ts.clone()]],
                 );
                 // Fully pinned particles move to their goals: that is their velocity.
                 let (lo, hi) = (first + t.start, first + t.end);
@@ -624,12 +632,13 @@ impl Cloth {
                 let (rate, q): (Option<&[Vec3]>, [&mut [f64]; 3]) = match rate {
                     forces::SpringRate::None if !with_history => continue,
                     forces::SpringRate::None => (None, [&mut [], &mut [], &mut []]),
-                    forces::SpringRate::HalfDerivative => {
-                        (None, [&mut qx[t.clone()], &mut qy[t.clone()], &mut qz[t.clone()]])
-                    }
+                    forces::SpringRate::HalfDerivative => (
+                        None,
+                        [&mut qx[ts.clone()], &mut qy[ts.clone()], &mut qz[ts.clone()]],
+                    ),
                     forces::SpringRate::Velocity => (
                         Some(&v_step[t.clone()]),
-                        [&mut qx[t.clone()], &mut qy[t.clone()], &mut qz[t.clone()]],
+                        [&mut qx[ts.clone()], &mut qy[ts.clone()], &mut qz[ts.clone()]],
                     ),
                 };
                 prepass::add_current_and_split(

@@ -131,6 +131,11 @@ impl<'a, T> Disjoint<'a, T> {
         }
     }
 
+    /// Whether the slice is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
     /// The elements `r`. Panics when `r` is out of bounds.
     ///
     /// # Safety

@@ -6,8 +6,8 @@ use crate::Vec3;
 
 crate::simd_dispatch! { pub(super) fn velocities_and_positions(x: &[Vec3], v: &[Vec3], current: Vec3, v_step: &mut [Vec3], v_rel: &mut [Vec3], sx: [&mut [f64]; 3]) => velocities_and_positions_kernel }
 
-/// `v_step = v`, `v_rel = v - current`, and the positions `x` into component arrays `sx`;
-/// all slices of one length.
+/// `v_step = v`, `v_rel = v - current`, and the positions `x` into component arrays `sx`
+/// (unless they are empty); all other slices of one length.
 #[inline(always)]
 fn velocities_and_positions_kernel(
     x: &[Vec3],
@@ -20,6 +20,13 @@ fn velocities_and_positions_kernel(
     let n = v_step.len();
     let (x, v, v_rel) = (&x[..n], &v[..n], &mut v_rel[..n]);
     let [px, py, pz] = sx;
+    if px.is_empty() {
+        for k in 0..n {
+            v_step[k] = v[k];
+            v_rel[k] = v[k] - current;
+        }
+        return;
+    }
     let (px, py, pz) = (&mut px[..n], &mut py[..n], &mut pz[..n]);
     for k in 0..n {
         v_step[k] = v[k];

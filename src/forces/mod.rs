@@ -7,6 +7,7 @@ mod assemble;
 mod body;
 mod contact;
 mod drag;
+mod inputs;
 mod jacobian;
 mod normals;
 mod springs;
@@ -54,7 +55,7 @@ pub struct ForceScratch {
 impl ForceScratch {
     /// The component arrays the spring pass reads, positions and damping rate (see
     /// [`spring_rate`]), sized for `n` particles: for a caller that fills them in a pass of
-    /// its own and then calls [`accumulate_filled`].
+    /// its own and then calls [`accumulate_filled`]. Needed only when [`tiled`] is false.
     pub fn spring_arrays(&mut self, n: usize) -> (&mut Soa3, &mut Soa3) {
         let s = &mut self.spring_inputs;
         s.x.resize(n);
@@ -66,6 +67,12 @@ impl ForceScratch {
     pub fn normals(&self) -> &[Vec3] {
         &self.normals
     }
+}
+
+/// Whether the spring pass of `t` walks tiles ([`tiles`]), reading its positions and rates
+/// from windows of its own: then it never reads [`ForceScratch::spring_arrays`].
+pub fn tiled(t: &Topology) -> bool {
+    tiles::Layout::of(t).is_some()
 }
 
 /// Writes the total force on every particle into `f` (N).
@@ -153,8 +160,14 @@ where
         }
         sink(p0, out);
     };
-    let params = springs::params(input, par, &mut scratch.spring_inputs, filled);
-    if let Some(layout) = tiles::Layout::of(t) {
+    let layout = tiles::Layout::of(t);
+    let params = springs::params(
+        input,
+        par,
+        &mut scratch.spring_inputs,
+        !filled && layout.is_none(),
+    );
+    if let Some(layout) = layout {
         // One window per task; task k walks groups k, k + tasks, ... (which task walks a group
         // does not change its sums).
         let groups = n.div_ceil(layout.group);
@@ -167,14 +180,18 @@ where
         scratch.windows.resize(w * tasks);
         parallel::chunks(par, &mut scratch.windows[..w * tasks], w, |first, window| {
             let mut buf = [Vec3::zeros(); TILE];
+            let (sums, inputs) = window.split_at_mut(layout.sums_scratch());
+            let rate = springs::rate(input);
             for g in (first / w..groups).step_by(tasks) {
                 let c0 = g * layout.group;
                 let len = layout.group.min(n - c0);
                 let finish = |p0: usize, sums: [&[f64]; 3]| finish(p0, sums, &mut buf[..sums[0].len()]);
+                let start = c0.saturating_sub(t.tile_runs.max_offset);
+                let mut inputs = inputs::InputWindow::new(input.x, rate, inputs, start);
                 if layout.gather_runs > 0 {
-                    tiles::spring_forces_gathered(&params, t, &layout, c0, len, window, finish);
+                    tiles::spring_forces_gathered(&params, t, &layout, c0, len, sums, &mut inputs, finish);
                 } else {
-                    tiles::spring_forces(&params, t, c0, len, window, finish);
+                    tiles::spring_forces(&params, t, c0, len, sums, &mut inputs, finish);
                 }
             }
         });

@@ -31,6 +31,9 @@ pub(super) struct Params<'a> {
     pub x: [&'a [f64]; 3],
     /// Rate the damping acts on (v or D^{1/2}x); `x` when undamped (then never read).
     pub q: [&'a [f64]; 3],
+    /// The particle at index 0 of `x` and `q`: 0 for whole-cloth arrays, the window's first
+    /// particle for a tile walk's window ([`super::inputs`]).
+    pub base: usize,
     /// Rest length and family of each spring (or slot of a padded run).
     pub rest: &'a [f64],
     pub kinds: &'a [u8],
@@ -64,22 +67,28 @@ pub fn spring_rate(m: &crate::model::Model) -> SpringRate {
     }
 }
 
+/// The array the spring damping of `input` acts on, or None for undamped springs.
+pub(super) fn rate<'a>(input: &ForceInput<'a>) -> Option<&'a [crate::Vec3]> {
+    match spring_rate(input.model) {
+        SpringRate::None => None,
+        SpringRate::Velocity => Some(input.v),
+        SpringRate::HalfDerivative => Some(input.half_derivative),
+    }
+}
+
 /// What the spring pass reads; copies the positions and the damping rate into `scratch`
-/// (component arrays) unless `filled` says the caller already did.
+/// (component arrays) when `fill` says so (unless the caller did, or a tile walk reads them
+/// from windows of its own, [`super::inputs`]).
 pub(super) fn params<'a>(
     input: &ForceInput<'a>,
     parallel: bool,
     scratch: &'a mut SpringScratch,
-    filled: bool,
+    fill: bool,
 ) -> Params<'a> {
     let m = input.model;
-    let rate: Option<&[crate::Vec3]> = match spring_rate(m) {
-        SpringRate::None => None,
-        SpringRate::Velocity => Some(input.v),
-        SpringRate::HalfDerivative => Some(input.half_derivative),
-    };
+    let rate = rate(input);
     let t = input.topology;
-    if !filled {
+    if fill {
         scratch.x.fill_from(parallel, input.x);
         if let Some(q) = rate {
             scratch.q.fill_from(parallel, q);
@@ -98,6 +107,7 @@ pub(super) fn params<'a>(
         } else {
             scratch.x.slices()
         },
+        base: 0,
         rest: &t.spring_rest,
         kinds: &t.spring_kinds,
     }
@@ -151,6 +161,7 @@ fn run_kernel<'a, const UNIFORM: bool>(
     let j0 = i0 + run.offset as usize;
     let ks = p.stiffness[p.kinds[first_spring] as usize];
     let ends = |a: [&'a [f64]; 3], s: usize| [&a[0][s..s + n], &a[1][s..s + n], &a[2][s..s + n]];
+    let (i0, j0) = (i0 - p.base, j0 - p.base);
     let ([xi, yi, zi], [xj, yj, zj]) = (ends(p.x, i0), ends(p.x, j0));
     let ([qxi, qyi, qzi], [qxj, qyj, qzj]) = (ends(p.q, i0), ends(p.q, j0));
     let rest: &[f64] = if UNIFORM {

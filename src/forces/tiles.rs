@@ -25,6 +25,7 @@
 //! Each particle receives its springs in an order fixed by the topology and the group grid, so
 //! the sums do not depend on the thread count.
 
+use super::inputs::InputWindow;
 use super::springs::{run_uniform_widest, run_widest, Params};
 use crate::topology::{TileRuns, Topology};
 
@@ -54,6 +55,10 @@ pub(super) struct Layout {
     pub lead: usize,
     /// Numbers per component of each force window: `lead` and [`GATHER_TILES`] tiles or more.
     pub force_window: usize,
+    /// Particles in the window of spring inputs ([`InputWindow`]): what the springs from before a
+    /// group read (twice the largest offset) or what a tile's springs read (a tile and the
+    /// largest offset), and [`GATHER_TILES`] tiles more, so that it slides once every few tiles.
+    pub inputs: usize,
 }
 
 /// Tiles a force window of the gather path holds after its lead: it slides (copies each run's
@@ -86,12 +91,18 @@ impl Layout {
             },
             lead: tr.max_offset.next_multiple_of(8),
             force_window: tr.max_offset.next_multiple_of(8) + tiles.max(GATHER_TILES) * TILE,
+            inputs: ((2 * tr.max_offset).max(tr.max_offset + TILE) + GATHER_TILES * TILE).next_multiple_of(8),
         })
     }
 
     /// Numbers of scratch one task needs: the window of sums, or the gather path's force
-    /// windows (one per run) and a tile of sums.
+    /// windows (one per run) and a tile of sums; then its window of spring inputs.
     pub(super) fn scratch(&self) -> usize {
+        self.sums_scratch() + InputWindow::scratch(self.inputs)
+    }
+
+    /// The part of [`Self::scratch`] before the window of spring inputs.
+    pub(super) fn sums_scratch(&self) -> usize {
         if self.gather_runs > 0 {
             3 * self.force_window * self.gather_runs + 3 * TILE
         } else {
@@ -102,13 +113,15 @@ impl Layout {
 
 /// Sums the spring forces of particles `c0 .. c0 + len` (one group of [`Layout`]) tile by tile
 /// and calls `finish(p0, sums)` for each tile, `sums[c][k]` being component c of the spring
-/// force on particle `p0 + k`. `window` holds `3 * layout.window` numbers.
+/// force on particle `p0 + k`. `window` holds `3 * layout.window` numbers; the springs read
+/// their positions and rates from `inputs`, which starts at `c0 - max_offset` (or 0).
 pub(super) fn spring_forces<F>(
     p: &Params<'_>,
     t: &Topology,
     c0: usize,
     len: usize,
     window: &mut [f64],
+    inputs: &mut InputWindow<'_>,
     mut finish: F,
 ) where
     F: FnMut(usize, [&[f64]; 3]),
@@ -117,6 +130,7 @@ pub(super) fn spring_forces<F>(
     let c1 = c0 + len;
     let chunk = crate::parallel::CHUNK;
     let rows = &t.tile_runs.chunk_runs;
+    let max_offset = t.tile_runs.max_offset;
     let p = &Params {
         rest: &t.tile_runs.rest,
         kinds: &t.tile_runs.kinds,
@@ -127,8 +141,9 @@ pub(super) fn spring_forces<F>(
     // Springs from before the group into it: only their j ends are ours (all in its first
     // chunk, as no offset exceeds a chunk).
     let mut start = c0;
+    inputs.cover(c0.saturating_sub(max_offset), c0 + max_offset);
     add_range(
-        p,
+        &inputs.params(p),
         t,
         rows.row(c0 / chunk),
         None,
@@ -154,7 +169,20 @@ pub(super) fn spring_forces<F>(
         }
         // The runs with i ends in this tile are among those of its chunk.
         let runs = rows.row(base / chunk);
-        add_range(p, t, runs, Some((base, end)), c0, c1, start, w, window, &mut temp);
+        inputs.cover(base, end + max_offset);
+        let pt = inputs.params(p);
+        add_range(
+            &pt,
+            t,
+            runs,
+            Some((base, end)),
+            c0,
+            c1,
+            start,
+            w,
+            window,
+            &mut temp,
+        );
         let (n, at) = (end - base, base - start);
         {
             let (x, rest) = window.split_at(w);
@@ -169,8 +197,9 @@ pub(super) fn spring_forces<F>(
 /// each run `k` keeps a window `F_k` of the forces of its springs by `i` end (zero where the run
 /// has no spring), and each particle `p` of a tile sums `F_k[p] - F_k[p - offset_k]` over the runs
 /// in registers, writing its sum once. No window of sums is read and written back per run, as
-/// [`spring_forces`] does. `scratch` holds [`Layout::scratch`] numbers; `layout` is this
-/// topology's.
+/// [`spring_forces`] does. `scratch` holds [`Layout::sums_scratch`] numbers; `layout` is
+/// this topology's; `inputs` as for [`spring_forces`].
+#[allow(clippy::too_many_arguments)]
 pub(super) fn spring_forces_gathered<F>(
     p: &Params<'_>,
     t: &Topology,
@@ -178,6 +207,7 @@ pub(super) fn spring_forces_gathered<F>(
     c0: usize,
     len: usize,
     scratch: &mut [f64],
+    inputs: &mut InputWindow<'_>,
     mut finish: F,
 ) where
     F: FnMut(usize, [&[f64]; 3]),
@@ -197,13 +227,15 @@ pub(super) fn spring_forces_gathered<F>(
     let mut origin = c0;
     let at = |i: usize, origin: usize| i + lead - origin;
     // The springs from before the group into it (`i` in [c0 - off, c0)); zero where none.
+    inputs.cover(c0.saturating_sub(tr.max_offset), c0 + tr.max_offset);
+    let pt = inputs.params(p);
     for (k, run) in runs.iter().enumerate() {
         let off = run.offset as usize;
         let window = &mut forces[3 * w * k..3 * w * (k + 1)];
         for c in 0..3 {
             window[c * w + lead - off..c * w + lead].fill(0.0);
         }
-        evaluate(p, t, k, c0.saturating_sub(off), c0, window, lead, origin);
+        evaluate(&pt, t, k, c0.saturating_sub(off), c0, window, lead, origin);
     }
     let mut base = c0;
     while base < c1 {
@@ -220,9 +252,11 @@ pub(super) fn spring_forces_gathered<F>(
             }
             origin = base;
         }
+        inputs.cover(base, end + tr.max_offset);
+        let pt = inputs.params(p);
         for k in 0..runs.len() {
             let window = &mut forces[3 * w * k..3 * w * (k + 1)];
-            evaluate(p, t, k, base, end, window, lead, origin);
+            evaluate(&pt, t, k, base, end, window, lead, origin);
         }
         let m = end - base;
         let (sx, rest) = sums.split_at_mut(TILE);
