@@ -1,8 +1,10 @@
 //! Steps the 61 x 41 throughput cloth in blocks of 1000 steps and prints the fastest block in
 //! ns per particle-step: the least noisy figure on a shared machine, for comparing two builds
 //! while optimising (the benchmark of record is `examples/throughput.rs`, which reports medians).
-//! `cargo run --release --example step_cycles -- [fractional|regular] [blocks] [WxH]`
-//! (default 61x41; blocks of 1000 steps, fewer for big cloths).
+//! `cargo run --release --example step_cycles -- [fractional|regular|memoryless] [blocks] [WxH]`
+//! (default 61x41; blocks of 1000 steps, fewer for big cloths). `memoryless` is the fractional
+//! model with the history switched off (`Scheme::Off`): the same step without the fractional
+//! memory's work and bytes, to tell what the history costs at a size from what the rest does.
 
 use fraccloth::history::Scheme;
 use fraccloth::scenes::Variant;
@@ -11,7 +13,12 @@ use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, RegularDrag, Vec3};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
-    let regular = args.get(1).is_some_and(|a| a == "regular");
+    let variant_arg = args.get(1).map_or("fractional", String::as_str);
+    let regular = variant_arg == "regular";
+    let memoryless = variant_arg == "memoryless";
+    if !matches!(variant_arg, "fractional" | "regular" | "memoryless") {
+        return Err(format!("unknown variant {variant_arg}: fractional, regular or memoryless").into());
+    }
     let blocks: u64 = args.get(2).map_or(Ok(20), |s| s.parse())?;
     let (w, h) = match args.get(3) {
         Some(size) => {
@@ -38,7 +45,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     model.current = Vec3::new(0.0, 0.0, 0.2);
     let config = ClothConfig {
         model,
-        scheme: if regular { Scheme::Off } else { Scheme::DEFAULT },
+        scheme: if regular || memoryless {
+            Scheme::Off
+        } else {
+            Scheme::DEFAULT
+        },
         integrator: Integrator::SymplecticEuler,
         ..ClothConfig::default()
     };
