@@ -677,22 +677,43 @@ impl Cloth {
                 parallel::Disjoint::new(&mut s.v_new),
             );
             let v_step = &s.v_step;
-            forces::accumulate_tiles(&input, &mut s.forces, |p0, f| {
-                let r = p0..p0 + f.len();
-                // SAFETY: each tile is handed over once and tiles are disjoint.
-                let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
-                let input = integrate::StepInput {
-                    h,
-                    x: &x[r.clone()],
-                    v: &v_step[r.clone()],
-                    force: f,
-                    masses: &masses[r],
-                };
-                step(&input, xn, vn);
-                if !integrate::sound(xn, vn, vmax2) {
-                    all_sound.store(false, Ordering::Relaxed);
-                }
-            });
+            let soa_step = self.config.integrator.explicit_step_soa();
+            if let (Some(step), true) = (soa_step, forces::soa_applies(&input)) {
+                // The same, on the component arrays the tile walk has in cache.
+                forces::accumulate_tiles_soa(&input, &mut s.forces, |tile| {
+                    let r = tile.p0..tile.p0 + tile.force[0].len();
+                    // SAFETY: each tile is handed over once and tiles are disjoint.
+                    let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
+                    let input = integrate::SoaStepInput {
+                        h,
+                        x: tile.x,
+                        v: tile.v,
+                        force: tile.force,
+                        masses: &masses[r],
+                        max_speed2: vmax2,
+                    };
+                    if !step(&input, xn, vn) {
+                        all_sound.store(false, Ordering::Relaxed);
+                    }
+                });
+            } else {
+                forces::accumulate_tiles(&input, &mut s.forces, |p0, f| {
+                    let r = p0..p0 + f.len();
+                    // SAFETY: each tile is handed over once and tiles are disjoint.
+                    let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
+                    let input = integrate::StepInput {
+                        h,
+                        x: &x[r.clone()],
+                        v: &v_step[r.clone()],
+                        force: f,
+                        masses: &masses[r],
+                    };
+                    step(&input, xn, vn);
+                    if !integrate::sound(xn, vn, vmax2) {
+                        all_sound.store(false, Ordering::Relaxed);
+                    }
+                });
+            }
             integrated_sound = Some(all_sound.into_inner());
         } else {
             forces::accumulate_filled(&input, &mut s.forces, &mut s.force);

@@ -6,7 +6,8 @@
 //! that shuffling, not the arithmetic, bounded the pass. So the positions (and the rate the
 //! spring damping acts on) are copied once per step into three plain arrays, one per component,
 //! and the spring pass reads and writes those: one shuffle per particle instead of one per
-//! spring end.
+//! spring end. (Tiled topologies, grids among them, copy into a window per tile walk instead:
+//! [`crate::forces`]' `inputs` module.)
 
 use crate::aligned::AlignedF64;
 use crate::parallel;

@@ -31,3 +31,18 @@ fn add_weight_to_springs(springs: [&[f64]; 3], masses: &[f64], gravity: Vec3, ou
         out[k] = Vec3::new(sx[k], sy[k], sz[k]) + masses[k] * gravity;
     }
 }
+
+crate::simd_dispatch! { pub(super) fn add_weight_widest(forces: [&mut [f64]; 3], masses: &[f64], gravity: Vec3) => add_weight }
+
+/// `forces[c][k] += masses[k] gravity[c]`: a tile's spring sums (component arrays) plus the net
+/// weight, the same numbers as [`add_weight_to_springs`] writes as `Vec3`s.
+#[inline(always)]
+fn add_weight(forces: [&mut [f64]; 3], masses: &[f64], gravity: Vec3) {
+    for (c, f) in forces.into_iter().enumerate() {
+        let len = f.len();
+        let g = gravity[c];
+        for (fk, &m) in f.iter_mut().zip(&masses[..len]) {
+            *fk += m * g;
+        }
+    }
+}

@@ -50,3 +50,45 @@ fn add_tile_kernel(m: &Model, v: &[Vec3], d: Option<&[Vec3]>, n: Option<&[Vec3]>
         }
     }
 }
+
+crate::simd_dispatch! { pub(super) fn add_tile_soa(m: &Model, v: [&[f64]; 3], d: Option<[&[f64]; 3]>, f: [&mut [f64]; 3]) => add_tile_soa_kernel }
+
+/// [`add_tile`] on component arrays, without the normal drag: the same numbers, operation for
+/// operation, several times faster (no shuffling of `Vec3`s into lanes).
+#[inline(always)]
+fn add_tile_soa_kernel(m: &Model, v: [&[f64]; 3], d: Option<[&[f64]; 3]>, f: [&mut [f64]; 3]) {
+    let [fx, fy, fz] = f;
+    let len = fx.len();
+    let (fy, fz) = (&mut fy[..len], &mut fz[..len]);
+    let (vx, vy, vz) = (&v[0][..len], &v[1][..len], &v[2][..len]);
+    let c = m.current;
+    let history = d.filter(|_| m.history_drag != 0.0);
+    match (m.viscous_drag, history) {
+        (0.0, None) => {}
+        (k, None) => {
+            for t in 0..len {
+                fx[t] -= k * (vx[t] - c.x);
+                fy[t] -= k * (vy[t] - c.y);
+                fz[t] -= k * (vz[t] - c.z);
+            }
+        }
+        (kv, Some(d)) => {
+            let (dx, dy, dz) = (&d[0][..len], &d[1][..len], &d[2][..len]);
+            let k = m.history_drag;
+            for t in 0..len {
+                let (rx, ry, rz) = (vx[t] - c.x, vy[t] - c.y, vz[t] - c.z);
+                if kv != 0.0 {
+                    fx[t] -= kv * rx;
+                    fy[t] -= kv * ry;
+                    fz[t] -= kv * rz;
+                }
+                let speed2 = rx * rx + ry * ry + rz * rz;
+                let dr = dx[t] * rx + dy[t] * ry + dz[t] * rz;
+                let s = if speed2 > 0.0 { k * dr / speed2 } else { 0.0 };
+                fx[t] -= s * rx;
+                fy[t] -= s * ry;
+                fz[t] -= s * rz;
+            }
+        }
+    }
+}

@@ -1,23 +1,55 @@
-//! The spring pass's inputs for a tile walk ([`super::tiles`]): the positions and the rate the
-//! damping acts on, as component arrays, for the particles around the walk's current tile only.
+//! What a tile walk ([`super::tiles`]) reads of the particles, as component arrays, for the
+//! particles around the walk's current tile only: positions and the rate the spring damping
+//! acts on (for the springs), and the velocities and half-derivatives a tile's drag and
+//! integrator read (for [`super::accumulate_tiles_soa`]).
 //!
 //! The spring kernel reads each particle about sixteen times per step (two ends of eight runs on
-//! a grid), so it wants them as plain component arrays ([`crate::soa`]). Copying a whole step's
-//! positions and rates into cloth-sized component arrays in a pass of their own, and reading them
-//! back in the tile walk, streams 48 bytes per particle out to memory and back on a cloth larger
-//! than the cache. Instead, each walk transposes the step's `Vec3` arrays into a window of its own
-//! just ahead of the springs that read them: the window stays in cache, and the `Vec3` rows it
-//! reads are the ones the walk's drag and integrator read a moment later.
+//! a grid), and the drag and integrator loops are several times faster on component arrays than
+//! on `Vec3`s, which they would have to shuffle apart. Copying a whole step's positions and rates
+//! into cloth-sized component arrays in a pass of their own, and reading them back in the tile
+//! walk, would stream 48 bytes per particle out to memory and back on a cloth larger than the
+//! cache. Instead, each walk transposes the step's `Vec3` arrays into a window of its own just
+//! ahead of the springs that read them: the window stays in cache.
 
 use super::springs::Params;
 use crate::Vec3;
 
+/// Which of the window's arrays the spring damping acts on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Rate {
+    /// Undamped springs: no rate is read.
+    None,
+    /// The velocities.
+    Velocity,
+    /// The half-derivatives.
+    Half,
+}
+
+/// The step's arrays a window copies from: positions always, velocities and half-derivatives
+/// when some reader needs them (all of one length).
+#[derive(Clone, Copy)]
+pub(super) struct Sources<'a> {
+    pub x: &'a [Vec3],
+    pub v: Option<&'a [Vec3]>,
+    pub half: Option<&'a [Vec3]>,
+    pub rate: Rate,
+}
+
+/// Component arrays of a tile's particles: positions, and velocities and half-derivatives
+/// when the window keeps them.
+pub(super) struct TileState<'b> {
+    pub x: [&'b [f64]; 3],
+    pub v: Option<[&'b [f64]; 3]>,
+    pub half: Option<[&'b [f64]; 3]>,
+}
+
 /// A window of component arrays over particles `[origin, origin + cap)`, filled up to `filled`.
 pub(super) struct InputWindow<'a> {
-    x: &'a [Vec3],
-    /// The damping rate, or None for undamped springs (then only positions are kept).
-    q: Option<&'a [Vec3]>,
-    /// Six component arrays of `cap` numbers each: x, y, z of the positions, then of the rate.
+    /// Positions, velocities, half-derivatives: groups 0, 1, 2 of `buf`.
+    sources: [Option<&'a [Vec3]>; 3],
+    rate: Rate,
+    /// Three groups of three component arrays of `cap` numbers each (x, y, z per group); a
+    /// group without a source is not written.
     buf: &'a mut [f64],
     cap: usize,
     origin: usize,
@@ -27,15 +59,21 @@ pub(super) struct InputWindow<'a> {
 impl<'a> InputWindow<'a> {
     /// Numbers of scratch a window of `cap` particles needs.
     pub fn scratch(cap: usize) -> usize {
-        6 * cap
+        9 * cap
     }
 
-    /// An empty window at particle `start`; `buf` holds [`Self::scratch`] numbers.
-    pub fn new(x: &'a [Vec3], q: Option<&'a [Vec3]>, buf: &'a mut [f64], start: usize) -> Self {
-        let cap = buf.len() / 6;
+    /// An empty window at particle `start`; `buf` holds [`Self::scratch`] numbers. The rate's
+    /// source must be present.
+    pub fn new(s: Sources<'a>, buf: &'a mut [f64], start: usize) -> Self {
+        debug_assert!(match s.rate {
+            Rate::None => true,
+            Rate::Velocity => s.v.is_some(),
+            Rate::Half => s.half.is_some(),
+        });
+        let cap = buf.len() / 9;
         Self {
-            x,
-            q,
+            sources: [Some(s.x), s.v, s.half],
+            rate: s.rate,
             buf,
             cap,
             origin: start,
@@ -47,7 +85,8 @@ impl<'a> InputWindow<'a> {
     /// before `keep` when the window has to slide. `keep` never decreases between calls, and
     /// `upto - keep` is at most the window's capacity.
     pub fn cover(&mut self, keep: usize, upto: usize) {
-        let upto = upto.min(self.x.len());
+        let n = self.sources[0].map_or(0, <[Vec3]>::len);
+        let upto = upto.min(n);
         debug_assert!(keep >= self.origin && upto - keep.min(upto) <= self.cap);
         if upto <= self.filled {
             return;
@@ -56,46 +95,64 @@ impl<'a> InputWindow<'a> {
         if upto - self.origin > cap {
             // Slide: keep [keep, filled) at the front.
             let (from, to) = (keep - self.origin, self.filled.max(keep) - self.origin);
-            let comps = if self.q.is_some() { 6 } else { 3 };
-            for c in 0..comps {
-                self.buf[c * cap..(c + 1) * cap].copy_within(from..to, 0);
+            for (g, src) in self.sources.iter().enumerate() {
+                if src.is_some() {
+                    for c in 3 * g..3 * g + 3 {
+                        self.buf[c * cap..(c + 1) * cap].copy_within(from..to, 0);
+                    }
+                }
             }
             self.origin = keep;
             self.filled = self.filled.max(keep);
         }
         let (a, b) = (self.filled - self.origin, upto - self.origin);
-        let (px, rest) = self.buf.split_at_mut(cap);
-        let (py, rest) = rest.split_at_mut(cap);
-        let (pz, rest) = rest.split_at_mut(cap);
-        transpose_widest(
-            &self.x[self.filled..upto],
-            [&mut px[a..b], &mut py[a..b], &mut pz[a..b]],
-        );
-        if let Some(q) = self.q {
-            let (qx, rest) = rest.split_at_mut(cap);
-            let (qy, qz) = rest.split_at_mut(cap);
-            transpose_widest(
-                &q[self.filled..upto],
-                [&mut qx[a..b], &mut qy[a..b], &mut qz[a..b]],
-            );
+        for (g, src) in self.sources.iter().enumerate() {
+            if let Some(src) = src {
+                let group = &mut self.buf[3 * g * cap..3 * (g + 1) * cap];
+                let (px, rest) = group.split_at_mut(cap);
+                let (py, pz) = rest.split_at_mut(cap);
+                transpose_widest(
+                    &src[self.filled..upto],
+                    [&mut px[a..b], &mut py[a..b], &mut pz[a..b]],
+                );
+            }
         }
         self.filled = upto;
     }
 
+    /// Group `g`'s component arrays over the whole window.
+    fn group(&self, g: usize) -> [&[f64]; 3] {
+        let cap = self.cap;
+        std::array::from_fn(|c| &self.buf[(3 * g + c) * cap..(3 * g + c + 1) * cap])
+    }
+
     /// `p` reading its positions and rate from this window.
     pub fn params<'b>(&'b self, p: &Params<'b>) -> Params<'b> {
-        let cap = self.cap;
-        let comp = |c: usize| &self.buf[c * cap..(c + 1) * cap];
-        let x = [comp(0), comp(1), comp(2)];
+        let x = self.group(0);
         Params {
             x,
-            q: if self.q.is_some() {
-                [comp(3), comp(4), comp(5)]
-            } else {
-                x
+            q: match self.rate {
+                Rate::None => x,
+                Rate::Velocity => self.group(1),
+                Rate::Half => self.group(2),
             },
             base: self.origin,
             ..*p
+        }
+    }
+
+    /// The component arrays of particles `[from, to)`, which must be covered.
+    pub fn tile(&self, from: usize, to: usize) -> TileState<'_> {
+        debug_assert!(from >= self.origin && to <= self.filled);
+        let (a, b) = (from - self.origin, to - self.origin);
+        let part = |g: usize| {
+            let [x, y, z] = self.group(g);
+            [&x[a..b], &y[a..b], &z[a..b]]
+        };
+        TileState {
+            x: part(0),
+            v: self.sources[1].map(|_| part(1)),
+            half: self.sources[2].map(|_| part(2)),
         }
     }
 }
@@ -120,13 +177,26 @@ mod tests {
     #[test]
     fn the_window_holds_what_it_covers_across_slides() {
         let n = 1000;
-        let x: Vec<Vec3> = (0..n)
-            .map(|i| Vec3::new(i as f64, 2.0 * i as f64, -(i as f64)))
-            .collect();
-        let q: Vec<Vec3> = (0..n).map(|i| Vec3::new(0.5 * i as f64, 7.0, i as f64)).collect();
-        for with_q in [false, true] {
+        let make = |a: f64, b: f64| -> Vec<Vec3> {
+            (0..n).map(|i| Vec3::new(a * i as f64, b, -(i as f64))).collect()
+        };
+        let (x, v, h) = (make(1.0, 2.0), make(0.5, 7.0), make(-3.0, 0.25));
+        let cases = [
+            (None, None, Rate::None),
+            (Some(&v[..]), None, Rate::Velocity),
+            (None, Some(&h[..]), Rate::Half),
+            (Some(&v[..]), Some(&h[..]), Rate::Half),
+            (Some(&v[..]), Some(&h[..]), Rate::Velocity),
+        ];
+        for (vs, hs, rate) in cases {
             let mut buf = vec![f64::NAN; InputWindow::scratch(100)];
-            let mut w = InputWindow::new(&x, with_q.then_some(&q[..]), &mut buf, 30);
+            let sources = Sources {
+                x: &x,
+                v: vs,
+                half: hs,
+                rate,
+            };
+            let mut w = InputWindow::new(sources, &mut buf, 30);
             // Steps of 23 keeping the last 40: slides many times, ends clamped at n.
             let mut keep = 30;
             while keep < n {
@@ -142,11 +212,22 @@ mod tests {
                     kinds: &[],
                 };
                 let p = w.params(&p);
-                for i in keep..upto.min(n) {
-                    let at = i - p.base;
-                    assert_eq!([p.x[0][at], p.x[1][at], p.x[2][at]], [x[i].x, x[i].y, x[i].z]);
-                    let r = if with_q { q[i] } else { x[i] };
-                    assert_eq!([p.q[0][at], p.q[1][at], p.q[2][at]], [r.x, r.y, r.z]);
+                let end = upto.min(n);
+                let tile = w.tile(keep, end);
+                let at = |a: [&[f64]; 3], k: usize| [a[0][k], a[1][k], a[2][k]];
+                let expect = |src: &[Vec3], i: usize| [src[i].x, src[i].y, src[i].z];
+                for i in keep..end {
+                    let (j, k) = (i - p.base, i - keep);
+                    assert_eq!(at(p.x, j), expect(&x, i));
+                    let r = match rate {
+                        Rate::None => &x,
+                        Rate::Velocity => &v,
+                        Rate::Half => &h,
+                    };
+                    assert_eq!(at(p.q, j), expect(r, i));
+                    assert_eq!(at(tile.x, k), expect(&x, i));
+                    assert_eq!(tile.v.map(|a| at(a, k)), vs.map(|s| expect(s, i)));
+                    assert_eq!(tile.half.map(|a| at(a, k)), hs.map(|s| expect(s, i)));
                 }
                 keep += 23;
             }

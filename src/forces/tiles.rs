@@ -55,15 +55,20 @@ pub(super) struct Layout {
     pub lead: usize,
     /// Numbers per component of each force window: `lead` and [`GATHER_TILES`] tiles or more.
     pub force_window: usize,
-    /// Particles in the window of spring inputs ([`InputWindow`]): what the springs from before a
+    /// Particles in the window of inputs ([`InputWindow`]): what the springs from before a
     /// group read (twice the largest offset) or what a tile's springs read (a tile and the
-    /// largest offset), and [`GATHER_TILES`] tiles more, so that it slides once every few tiles.
+    /// largest offset), and [`INPUT_TILES`] tiles more, so that it slides once every few tiles.
     pub inputs: usize,
 }
 
 /// Tiles a force window of the gather path holds after its lead: it slides (copies each run's
 /// last `offset` forces to its front) once every so many tiles.
 const GATHER_TILES: usize = 4;
+
+/// Tiles the window of inputs holds beyond what one tile reads: it slides once every so many
+/// tiles. 1, 2 and 4 measured the same at 61 x 41 (`step_cycles`, 28.3-28.9 ns); 2 keeps the
+/// window (nine component arrays) smaller than 4 and slides half as often as 1.
+const INPUT_TILES: usize = 2;
 
 /// Most runs [`spring_forces_gathered`] keeps force windows for.
 pub(super) const GATHER_RUNS: usize = 12;
@@ -91,7 +96,7 @@ impl Layout {
             },
             lead: tr.max_offset.next_multiple_of(8),
             force_window: tr.max_offset.next_multiple_of(8) + tiles.max(GATHER_TILES) * TILE,
-            inputs: ((2 * tr.max_offset).max(tr.max_offset + TILE) + GATHER_TILES * TILE).next_multiple_of(8),
+            inputs: ((2 * tr.max_offset).max(tr.max_offset + TILE) + INPUT_TILES * TILE).next_multiple_of(8),
         })
     }
 
@@ -112,9 +117,10 @@ impl Layout {
 }
 
 /// Sums the spring forces of particles `c0 .. c0 + len` (one group of [`Layout`]) tile by tile
-/// and calls `finish(p0, sums)` for each tile, `sums[c][k]` being component c of the spring
-/// force on particle `p0 + k`. `window` holds `3 * layout.window` numbers; the springs read
-/// their positions and rates from `inputs`, which starts at `c0 - max_offset` (or 0).
+/// and calls `finish(p0, sums, inputs)` for each tile, `sums[c][k]` being component c of the
+/// spring force on particle `p0 + k` (the finisher may add to them), with the tile covered by
+/// `inputs`. `window` holds `3 * layout.window` numbers; the springs read their positions and
+/// rates from `inputs`, which starts at `c0 - max_offset` (or 0).
 pub(super) fn spring_forces<F>(
     p: &Params<'_>,
     t: &Topology,
@@ -124,7 +130,7 @@ pub(super) fn spring_forces<F>(
     inputs: &mut InputWindow<'_>,
     mut finish: F,
 ) where
-    F: FnMut(usize, [&[f64]; 3]),
+    F: FnMut(usize, [&mut [f64]; 3], &InputWindow<'_>),
 {
     let w = window.len() / 3;
     let c1 = c0 + len;
@@ -185,9 +191,10 @@ pub(super) fn spring_forces<F>(
         );
         let (n, at) = (end - base, base - start);
         {
-            let (x, rest) = window.split_at(w);
-            let (y, z) = rest.split_at(w);
-            finish(base, [&x[at..at + n], &y[at..at + n], &z[at..at + n]]);
+            let (x, rest) = window.split_at_mut(w);
+            let (y, z) = rest.split_at_mut(w);
+            let sums = [&mut x[at..at + n], &mut y[at..at + n], &mut z[at..at + n]];
+            finish(base, sums, inputs);
         }
         base = end;
     }
@@ -210,7 +217,7 @@ pub(super) fn spring_forces_gathered<F>(
     inputs: &mut InputWindow<'_>,
     mut finish: F,
 ) where
-    F: FnMut(usize, [&[f64]; 3]),
+    F: FnMut(usize, [&mut [f64]; 3], &InputWindow<'_>),
 {
     let tr = &t.tile_runs;
     let (runs, w, lead) = (&tr.runs, layout.force_window, layout.lead);
@@ -275,7 +282,7 @@ pub(super) fn spring_forces_gathered<F>(
             minus,
             [&mut sx[..m], &mut sy[..m], &mut sz[..m]],
         );
-        finish(base, [&sx[..m], &sy[..m], &sz[..m]]);
+        finish(base, [&mut sx[..m], &mut sy[..m], &mut sz[..m]], inputs);
         base = end;
     }
 }

@@ -12,9 +12,9 @@ mod symplectic_euler;
 use crate::Vec3;
 
 pub use cg::{SolverSettings, SolverStats};
-pub use explicit_euler::explicit_euler_range;
+pub use explicit_euler::{explicit_euler_range, explicit_euler_soa};
 pub use implicit_euler::{implicit_euler, ImplicitInput, ImplicitScratch};
-pub use symplectic_euler::symplectic_euler_range;
+pub use symplectic_euler::{symplectic_euler_range, symplectic_euler_soa};
 
 /// Which integrator advances the cloth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -49,6 +49,15 @@ impl Integrator {
         match self {
             Integrator::ExplicitEuler => Some(explicit_euler_range),
             Integrator::SymplecticEuler => Some(symplectic_euler_range),
+            Integrator::ImplicitEuler => None,
+        }
+    }
+
+    /// [`Self::explicit_step`] on component arrays, checking its results as it writes them.
+    pub fn explicit_step_soa(&self) -> Option<StepSoa> {
+        match self {
+            Integrator::ExplicitEuler => Some(explicit_euler_soa),
+            Integrator::SymplecticEuler => Some(symplectic_euler_soa),
             Integrator::ImplicitEuler => None,
         }
     }
@@ -90,6 +99,41 @@ impl<'a> StepInput<'a> {
 /// An explicit integrator's step for the particles of a [`StepInput`], into `x_new`, `v_new`.
 pub type StepRange = fn(&StepInput<'_>, &mut [Vec3], &mut [Vec3]);
 
+/// [`StepInput`] as component arrays (`[x, y, z]`, each of one length), as a tile walk has them
+/// in cache ([`crate::forces::accumulate_tiles_soa`]).
+#[derive(Clone, Copy)]
+pub struct SoaStepInput<'a> {
+    pub h: f64,
+    pub x: [&'a [f64]; 3],
+    pub v: [&'a [f64]; 3],
+    pub force: [&'a [f64]; 3],
+    pub masses: &'a [f64],
+    /// Largest speed squared a sound result may have, (m/s)^2.
+    pub max_speed2: f64,
+}
+
+/// An explicit integrator's step for the particles of a [`SoaStepInput`], into `x_new` and
+/// `v_new` (as `Vec3`s; the same numbers as its [`StepRange`]), returning whether every result
+/// is sound as [`sound`] says.
+pub type StepSoa = fn(&SoaStepInput<'_>, &mut [Vec3], &mut [Vec3]) -> bool;
+
+/// Writes particle `k`'s new state and says whether it is sound, as [`sound`] does.
+#[inline(always)]
+fn store_checked(
+    k: usize,
+    x: [f64; 3],
+    v: [f64; 3],
+    x_new: &mut [Vec3],
+    v_new: &mut [Vec3],
+    max_speed2: f64,
+) -> bool {
+    x_new[k] = Vec3::new(x[0], x[1], x[2]);
+    v_new[k] = Vec3::new(v[0], v[1], v[2]);
+    let position = (x[0] * 0.0 + x[1] * 0.0) + x[2] * 0.0;
+    let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + position;
+    s <= max_speed2
+}
+
 /// `step` for every particle, chunk by chunk (in parallel for large cloths).
 pub fn step_all(step: StepRange, s: &StepInput<'_>, x_new: &mut [Vec3], v_new: &mut [Vec3]) {
     crate::parallel::chunks2(
@@ -121,6 +165,66 @@ fn sound_kernel(x: &[Vec3], v: &[Vec3], max_speed2: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn component_array_steps_match_their_vec3_steps_bit_for_bit_and_check_soundness() {
+        let n = 37;
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut vec3s =
+            |scale: f64| -> Vec<Vec3> { (0..n).map(|_| scale * Vec3::new(rnd(), rnd(), rnd())).collect() };
+        let (x, v, f) = (vec3s(1.0), vec3s(3.0), vec3s(1e-2));
+        let masses: Vec<f64> = (0..n).map(|k| 1e-4 * (1.0 + k as f64)).collect();
+        let comps =
+            |a: &[Vec3]| -> [Vec<f64>; 3] { std::array::from_fn(|c| a.iter().map(|p| p[c]).collect()) };
+        for integrator in [Integrator::ExplicitEuler, Integrator::SymplecticEuler] {
+            let (aos, soa) = (
+                integrator.explicit_step().unwrap(),
+                integrator.explicit_step_soa().unwrap(),
+            );
+            // Sound; one velocity too fast; one position not finite.
+            for (case, max_speed2) in [(0, 1e6), (1, 1.0), (2, 1e6)] {
+                let mut f = f.clone();
+                if case == 2 {
+                    f[11].y = f64::INFINITY;
+                }
+                let (xc, vc, fc) = (comps(&x), comps(&v), comps(&f));
+                let s = StepInput {
+                    h: 1e-3,
+                    x: &x,
+                    v: &v,
+                    force: &f,
+                    masses: &masses,
+                };
+                let (mut xa, mut va) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
+                aos(&s, &mut xa, &mut va);
+                let c = SoaStepInput {
+                    h: 1e-3,
+                    x: [&xc[0], &xc[1], &xc[2]],
+                    v: [&vc[0], &vc[1], &vc[2]],
+                    force: [&fc[0], &fc[1], &fc[2]],
+                    masses: &masses,
+                    max_speed2,
+                };
+                let (mut xs, mut vs) = (vec![Vec3::zeros(); n], vec![Vec3::zeros(); n]);
+                let ok = soa(&c, &mut xs, &mut vs);
+                let bits =
+                    |a: &[Vec3]| -> Vec<[u64; 3]> { a.iter().map(|p| p.map(f64::to_bits).into()).collect() };
+                assert_eq!(
+                    (bits(&xs), bits(&vs)),
+                    (bits(&xa), bits(&va)),
+                    "{integrator:?} case {case}"
+                );
+                assert_eq!(ok, sound(&xa, &va, max_speed2), "{integrator:?} case {case}");
+                assert_eq!(ok, case == 0, "{integrator:?} case {case}");
+            }
+        }
+    }
 
     #[test]
     fn sound_refuses_every_non_finite_number_and_excess_speed() {
