@@ -173,10 +173,10 @@ where
     );
 }
 
-/// Whether [`accumulate_tiles_soa`] can evaluate `input`: a tiled topology ([`tiled`]), and
-/// none of the terms it leaves out (normal drag, contacts).
+/// Whether [`accumulate_tiles_soa`] can evaluate `input`: a tiled topology ([`tiled`]) without
+/// normal drag (which needs vertex normals).
 pub fn soa_applies(input: &ForceInput<'_>) -> bool {
-    tiled(input.topology) && input.model.normal_drag == 0.0 && input.colliders.is_empty()
+    tiled(input.topology) && input.model.normal_drag == 0.0
 }
 
 /// A tile's total forces and state as component arrays, each `[x, y, z]` of one length: what
@@ -217,6 +217,15 @@ where
         let [fx, fy, fz] = s;
         body::add_weight_widest([&mut *fx, &mut *fy, &mut *fz], &masses[p0..p0 + len], gravity);
         drag::add_tile_soa(m, v, tile.half, [&mut *fx, &mut *fy, &mut *fz]);
+        if !input.colliders.is_empty() {
+            // Particle by particle, as `Vec3`s: the same numbers as `for_each_tile`'s contacts.
+            let at = |a: [&[f64]; 3], k: usize| Vec3::new(a[0][k], a[1][k], a[2][k]);
+            for k in 0..len {
+                let mut f = Vec3::new(fx[k], fy[k], fz[k]);
+                contact::add(m, input.colliders, &at(tile.x, k), &at(v, k), &mut f);
+                (fx[k], fy[k], fz[k]) = (f.x, f.y, f.z);
+            }
+        }
         sink(TileSoa {
             p0,
             force: [fx, fy, fz],
@@ -367,16 +376,29 @@ mod tests {
                 SpringDamping::Velocity,
                 SpringDamping::None,
             ];
-            for (mode, viscous, history) in [(0, 1e-3, 2e-3), (1, 0.0, 2e-3), (2, 1e-3, 0.0), (0, 0.0, 0.0)] {
+            // A sphere pushing on the particles around the middle one (inside the margin).
+            let sphere = [Collider::Sphere(Sphere {
+                center: x[n / 2] + Vec3::new(0.0, 0.0, 0.004),
+                radius: 0.02,
+                velocity: Vec3::new(0.1, 0.0, 0.0),
+            })];
+            let cases = [
+                (0, 1e-3, 2e-3, false),
+                (1, 0.0, 2e-3, true),
+                (2, 1e-3, 0.0, false),
+                (0, 0.0, 0.0, true),
+            ];
+            for (mode, viscous, history, with_sphere) in cases {
                 m.spring_damping_mode = damping[mode];
                 (m.viscous_drag, m.history_drag) = (viscous, history);
+                let colliders: &[Collider] = if with_sphere { &sphere } else { &[] };
                 let input = ForceInput {
                     model: &m,
                     topology: &t,
                     x: &x,
                     v: &v,
                     half_derivative: &half,
-                    colliders: &[],
+                    colliders,
                 };
                 assert!(soa_applies(&input));
                 let mut expected = vec![Vec3::zeros(); n];
@@ -402,7 +424,7 @@ mod tests {
     }
 
     #[test]
-    fn component_array_tiles_refuse_what_they_leave_out() {
+    fn component_array_tiles_refuse_normal_drag_and_untiled_topologies() {
         let t = GridSpec {
             width: 30,
             height: 30,
@@ -429,7 +451,7 @@ mod tests {
             })
         };
         assert!(input(&m, &[]));
-        assert!(!input(&m, &[sphere]));
+        assert!(input(&m, &[sphere]));
         let mut untiled = t.clone();
         untiled.tile_runs.max_offset = usize::MAX;
         assert!(!soa_applies(&ForceInput {
