@@ -122,22 +122,7 @@ where
 {
     let m = input.model;
     let t = input.topology;
-    let n = input.x.len();
-    let par = parallel::worth_it(n);
-    let with_normals = m.normal_drag != 0.0;
-    if with_normals {
-        scratch.normals.resize(n, Vec3::zeros());
-        scratch.faces.resize(t.triangles.len(), Vec3::zeros());
-        normals::vertex_normals_with(
-            input.x,
-            &t.triangles,
-            &t.vertex_triangles,
-            par,
-            &mut scratch.faces,
-            &mut scratch.normals,
-        );
-    }
-    let normals = with_normals.then_some(&scratch.normals[..]);
+    let normals = update_normals(input, scratch).then_some(&scratch.normals[..]);
     let gravity = body_acceleration(m);
     let half = (!input.half_derivative.is_empty()).then_some(input.half_derivative);
     // Everything but the springs, added to the springs' sums `s` of the tile starting at p0;
@@ -173,10 +158,28 @@ where
     );
 }
 
-/// Whether [`accumulate_tiles_soa`] can evaluate `input`: a tiled topology ([`tiled`]) without
-/// normal drag (which needs vertex normals).
+/// Computes the vertex normals into `scratch` when the normal drag needs them; says whether.
+fn update_normals(input: &ForceInput<'_>, scratch: &mut ForceScratch) -> bool {
+    let (t, n) = (input.topology, input.x.len());
+    if input.model.normal_drag == 0.0 {
+        return false;
+    }
+    scratch.normals.resize(n, Vec3::zeros());
+    scratch.faces.resize(t.triangles.len(), Vec3::zeros());
+    normals::vertex_normals_with(
+        input.x,
+        &t.triangles,
+        &t.vertex_triangles,
+        parallel::worth_it(n),
+        &mut scratch.faces,
+        &mut scratch.normals,
+    );
+    true
+}
+
+/// Whether [`accumulate_tiles_soa`] can evaluate `input`: a tiled topology ([`tiled`]).
 pub fn soa_applies(input: &ForceInput<'_>) -> bool {
-    tiled(input.topology) && input.model.normal_drag == 0.0
+    tiled(input.topology)
 }
 
 /// A tile's total forces and state as component arrays, each `[x, y, z]` of one length: what
@@ -199,10 +202,8 @@ pub fn accumulate_tiles_soa<S>(input: &ForceInput<'_>, scratch: &mut ForceScratc
 where
     S: Fn(TileSoa<'_>) + Sync,
 {
-    assert!(
-        soa_applies(input),
-        "accumulate_tiles_soa: normal drag, contacts or an untiled topology"
-    );
+    assert!(soa_applies(input), "accumulate_tiles_soa: an untiled topology");
+    let normals = update_normals(input, scratch).then_some(&scratch.normals[..]);
     let m = input.model;
     let gravity = body_acceleration(m);
     let masses = &input.topology.masses;
@@ -217,9 +218,17 @@ where
         let [fx, fy, fz] = s;
         body::add_weight_widest([&mut *fx, &mut *fy, &mut *fz], &masses[p0..p0 + len], gravity);
         drag::add_tile_soa(m, v, tile.half, [&mut *fx, &mut *fy, &mut *fz]);
+        let at = |a: [&[f64]; 3], k: usize| Vec3::new(a[0][k], a[1][k], a[2][k]);
+        if let Some(normals) = normals {
+            // As `Vec3`s, as in `drag::add_tile`: the same numbers.
+            let (nr, k_n, c) = (&normals[p0..p0 + len], m.normal_drag, m.current);
+            for k in 0..len {
+                let f = Vec3::new(fx[k], fy[k], fz[k]) - k_n * (at(v, k) - c).dot(&nr[k]) * nr[k];
+                (fx[k], fy[k], fz[k]) = (f.x, f.y, f.z);
+            }
+        }
         if !input.colliders.is_empty() {
             // Particle by particle, as `Vec3`s: the same numbers as `for_each_tile`'s contacts.
-            let at = |a: [&[f64]; 3], k: usize| Vec3::new(a[0][k], a[1][k], a[2][k]);
             for k in 0..len {
                 let mut f = Vec3::new(fx[k], fy[k], fz[k]);
                 contact::add(m, input.colliders, &at(tile.x, k), &at(v, k), &mut f);
@@ -382,15 +391,18 @@ mod tests {
                 radius: 0.02,
                 velocity: Vec3::new(0.1, 0.0, 0.0),
             })];
+            // Spring damping, viscous, history and normal drag, and whether the sphere is there.
             let cases = [
-                (0, 1e-3, 2e-3, false),
-                (1, 0.0, 2e-3, true),
-                (2, 1e-3, 0.0, false),
-                (0, 0.0, 0.0, true),
+                (0, 1e-3, 2e-3, 0.0, false),
+                (1, 0.0, 2e-3, 0.0, true),
+                (2, 1e-3, 0.0, 0.0, false),
+                (0, 0.0, 0.0, 0.0, true),
+                (1, 1e-3, 0.0, 5e-3, false),
+                (0, 0.0, 2e-3, 5e-3, true),
             ];
-            for (mode, viscous, history, with_sphere) in cases {
+            for (mode, viscous, history, normal, with_sphere) in cases {
                 m.spring_damping_mode = damping[mode];
-                (m.viscous_drag, m.history_drag) = (viscous, history);
+                (m.viscous_drag, m.history_drag, m.normal_drag) = (viscous, history, normal);
                 let colliders: &[Collider] = if with_sphere { &sphere } else { &[] };
                 let input = ForceInput {
                     model: &m,
@@ -424,7 +436,7 @@ mod tests {
     }
 
     #[test]
-    fn component_array_tiles_refuse_normal_drag_and_untiled_topologies() {
+    fn component_array_tiles_need_a_tiled_topology() {
         let t = GridSpec {
             width: 30,
             height: 30,
@@ -452,6 +464,8 @@ mod tests {
         };
         assert!(input(&m, &[]));
         assert!(input(&m, &[sphere]));
+        m.normal_drag = 0.1;
+        assert!(input(&m, &[]));
         let mut untiled = t.clone();
         untiled.tile_runs.max_offset = usize::MAX;
         assert!(!soa_applies(&ForceInput {
@@ -462,7 +476,5 @@ mod tests {
             half_derivative: &[],
             colliders: &[],
         }));
-        m.normal_drag = 0.1;
-        assert!(!input(&m, &[]));
     }
 }
