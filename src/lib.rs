@@ -46,6 +46,8 @@ pub mod render;
 pub mod scenes;
 pub mod simd;
 pub mod soa;
+#[cfg(test)]
+mod testing;
 pub mod topology;
 
 /// 3-vector of f64, the core's only vector type.

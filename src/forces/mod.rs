@@ -343,17 +343,8 @@ fn walk<T>(
 mod tests {
     use super::*;
     use crate::model::SpringDamping;
+    use crate::testing::numbers;
     use crate::topology::GridSpec;
-
-    /// Deterministic pseudo-random numbers in [-0.5, 0.5).
-    fn numbers(mut seed: u64) -> impl FnMut() -> f64 {
-        move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        }
-    }
 
     #[test]
     fn component_array_tiles_carry_the_same_forces_and_state_bit_for_bit() {

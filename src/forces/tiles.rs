@@ -587,13 +587,7 @@ mod tests {
         buffered.tile_runs.max_offset = usize::MAX;
         assert!(super::Layout::of(&buffered).is_none());
         // Deterministic pseudo-random displacements and rates.
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = crate::testing::numbers(12345);
         let x: Vec<Vec3> = t
             .rest_positions
             .iter()

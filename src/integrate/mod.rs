@@ -117,21 +117,34 @@ pub struct SoaStepInput<'a> {
 /// is sound as [`sound`] says.
 pub type StepSoa = fn(&SoaStepInput<'_>, &mut [Vec3], &mut [Vec3]) -> bool;
 
-/// Writes particle `k`'s new state and says whether it is sound, as [`sound`] does.
+/// The loop of a [`StepSoa`]: `update(x, v, f, h / m)` gives a particle's new position and
+/// velocity from its position, velocity and force (components); each result is stored and
+/// checked as [`sound`] checks it.
 #[inline(always)]
-fn store_checked(
-    k: usize,
-    x: [f64; 3],
-    v: [f64; 3],
+fn step_soa_with(
+    s: &SoaStepInput<'_>,
     x_new: &mut [Vec3],
     v_new: &mut [Vec3],
-    max_speed2: f64,
+    update: impl Fn([f64; 3], [f64; 3], [f64; 3], f64) -> ([f64; 3], [f64; 3]),
 ) -> bool {
-    x_new[k] = Vec3::new(x[0], x[1], x[2]);
-    v_new[k] = Vec3::new(v[0], v[1], v[2]);
-    let position = (x[0] * 0.0 + x[1] * 0.0) + x[2] * 0.0;
-    let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + position;
-    s <= max_speed2
+    let n = x_new.len();
+    let v_new = &mut v_new[..n];
+    let (x, v, f, masses) = (
+        s.x.map(|a| &a[..n]),
+        s.v.map(|a| &a[..n]),
+        s.force.map(|a| &a[..n]),
+        &s.masses[..n],
+    );
+    let mut ok = true;
+    for k in 0..n {
+        let at = |a: [&[f64]; 3]| -> [f64; 3] { std::array::from_fn(|c| a[c][k]) };
+        let (xn, vn) = update(at(x), at(v), at(f), s.h / masses[k]);
+        x_new[k] = Vec3::new(xn[0], xn[1], xn[2]);
+        v_new[k] = Vec3::new(vn[0], vn[1], vn[2]);
+        let position = (xn[0] * 0.0 + xn[1] * 0.0) + xn[2] * 0.0;
+        ok &= (vn[0] * vn[0] + vn[1] * vn[1] + vn[2] * vn[2]) + position <= s.max_speed2;
+    }
+    ok
 }
 
 /// `step` for every particle, chunk by chunk (in parallel for large cloths).
@@ -169,13 +182,7 @@ mod tests {
     #[test]
     fn component_array_steps_match_their_vec3_steps_bit_for_bit_and_check_soundness() {
         let n = 37;
-        let mut seed = 7u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = crate::testing::numbers(7);
         let mut vec3s =
             |scale: f64| -> Vec<Vec3> { (0..n).map(|_| scale * Vec3::new(rnd(), rnd(), rnd())).collect() };
         let (x, v, f) = (vec3s(1.0), vec3s(3.0), vec3s(1e-2));

@@ -4,7 +4,7 @@
 //! makes the undamped part stable up to `h < 2/omega` instead of never; damping is still
 //! explicit.
 
-use super::{store_checked, SoaStepInput, StepInput};
+use super::{step_soa_with, SoaStepInput, StepInput};
 use crate::Vec3;
 
 crate::simd_dispatch! { pub fn symplectic_euler_range(s: &StepInput<'_>, x_new: &mut [Vec3], v_new: &mut [Vec3]) => symplectic_euler_kernel }
@@ -33,20 +33,10 @@ crate::simd_dispatch! { pub fn symplectic_euler_soa(s: &SoaStepInput<'_>, x_new:
 /// [`symplectic_euler_range`] on component arrays, checking each result.
 #[inline(always)]
 fn symplectic_euler_soa_kernel(s: &SoaStepInput<'_>, x_new: &mut [Vec3], v_new: &mut [Vec3]) -> bool {
-    let n = x_new.len();
-    let (h, v_new) = (s.h, &mut v_new[..n]);
-    let (x, v, f, masses) = (
-        s.x.map(|a| &a[..n]),
-        s.v.map(|a| &a[..n]),
-        s.force.map(|a| &a[..n]),
-        &s.masses[..n],
-    );
-    let mut ok = true;
-    for k in 0..n {
-        let hm = h / masses[k];
-        let vn: [f64; 3] = std::array::from_fn(|c| v[c][k] + hm * f[c][k]);
-        let xn: [f64; 3] = std::array::from_fn(|c| x[c][k] + h * vn[c]);
-        ok &= store_checked(k, xn, vn, x_new, v_new, s.max_speed2);
-    }
-    ok
+    let h = s.h;
+    // v += (h / m) f, then x += h v_new: as in the `Vec3` kernel above.
+    step_soa_with(s, x_new, v_new, |x, v, f, hm| {
+        let vn: [f64; 3] = std::array::from_fn(|c| v[c] + hm * f[c]);
+        (std::array::from_fn(|c| x[c] + h * vn[c]), vn)
+    })
 }
