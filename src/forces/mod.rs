@@ -285,6 +285,10 @@ fn walk<T>(
             SpringRate::Velocity => Rate::Velocity,
             SpringRate::HalfDerivative => Rate::Half,
         };
+        assert!(
+            rate != Rate::Half || half.is_some(),
+            "fractional spring damping needs the half-derivatives (ForceInput::half_derivative)"
+        );
         let sources = Sources {
             x: input.x,
             v: (soa || rate == Rate::Velocity).then_some(input.v),
