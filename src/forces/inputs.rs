@@ -11,19 +11,8 @@
 //! cache. Instead, each walk transposes the step's `Vec3` arrays into a window of its own just
 //! ahead of the springs that read them: the window stays in cache.
 
-use super::springs::Params;
+use super::springs::{Params, SpringRate};
 use crate::Vec3;
-
-/// Which of the window's arrays the spring damping acts on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Rate {
-    /// Undamped springs: no rate is read.
-    None,
-    /// The velocities.
-    Velocity,
-    /// The half-derivatives.
-    Half,
-}
 
 /// The step's arrays a window copies from: positions always, velocities and half-derivatives
 /// when some reader needs them (all of one length).
@@ -32,7 +21,8 @@ pub(super) struct Sources<'a> {
     pub x: &'a [Vec3],
     pub v: Option<&'a [Vec3]>,
     pub half: Option<&'a [Vec3]>,
-    pub rate: Rate,
+    /// What the spring damping acts on: the velocities, the half-derivatives, or nothing.
+    pub rate: SpringRate,
 }
 
 /// Component arrays of a tile's particles: positions, and velocities and half-derivatives
@@ -47,7 +37,7 @@ pub(super) struct TileState<'b> {
 pub(super) struct InputWindow<'a> {
     /// Positions, velocities, half-derivatives: groups 0, 1, 2 of `buf`.
     sources: [Option<&'a [Vec3]>; 3],
-    rate: Rate,
+    rate: SpringRate,
     /// Three groups of three component arrays of `cap` numbers each (x, y, z per group); a
     /// group without a source is not written.
     buf: &'a mut [f64],
@@ -66,9 +56,9 @@ impl<'a> InputWindow<'a> {
     /// source must be present.
     pub fn new(s: Sources<'a>, buf: &'a mut [f64], start: usize) -> Self {
         debug_assert!(match s.rate {
-            Rate::None => true,
-            Rate::Velocity => s.v.is_some(),
-            Rate::Half => s.half.is_some(),
+            SpringRate::None => true,
+            SpringRate::Velocity => s.v.is_some(),
+            SpringRate::HalfDerivative => s.half.is_some(),
         });
         let cap = buf.len() / 9;
         Self {
@@ -132,9 +122,9 @@ impl<'a> InputWindow<'a> {
         Params {
             x,
             q: match self.rate {
-                Rate::None => x,
-                Rate::Velocity => self.group(1),
-                Rate::Half => self.group(2),
+                SpringRate::None => x,
+                SpringRate::Velocity => self.group(1),
+                SpringRate::HalfDerivative => self.group(2),
             },
             base: self.origin,
             ..*p
@@ -182,11 +172,11 @@ mod tests {
         };
         let (x, v, h) = (make(1.0, 2.0), make(0.5, 7.0), make(-3.0, 0.25));
         let cases = [
-            (None, None, Rate::None),
-            (Some(&v[..]), None, Rate::Velocity),
-            (None, Some(&h[..]), Rate::Half),
-            (Some(&v[..]), Some(&h[..]), Rate::Half),
-            (Some(&v[..]), Some(&h[..]), Rate::Velocity),
+            (None, None, SpringRate::None),
+            (Some(&v[..]), None, SpringRate::Velocity),
+            (None, Some(&h[..]), SpringRate::HalfDerivative),
+            (Some(&v[..]), Some(&h[..]), SpringRate::HalfDerivative),
+            (Some(&v[..]), Some(&h[..]), SpringRate::Velocity),
         ];
         for (vs, hs, rate) in cases {
             let mut buf = vec![f64::NAN; InputWindow::scratch(100)];
@@ -220,9 +210,9 @@ mod tests {
                     let (j, k) = (i - p.base, i - keep);
                     assert_eq!(at(p.x, j), expect(&x, i));
                     let r = match rate {
-                        Rate::None => &x,
-                        Rate::Velocity => &v,
-                        Rate::Half => &h,
+                        SpringRate::None => &x,
+                        SpringRate::Velocity => &v,
+                        SpringRate::HalfDerivative => &h,
                     };
                     assert_eq!(at(p.q, j), expect(r, i));
                     assert_eq!(at(tile.x, k), expect(&x, i));

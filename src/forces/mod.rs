@@ -26,7 +26,7 @@ use crate::soa::Soa3;
 use crate::topology::Topology;
 use crate::Vec3;
 use assemble::TILE;
-use inputs::{InputWindow, Rate, Sources};
+use inputs::{InputWindow, Sources};
 
 /// Everything the forces read at one instant.
 pub struct ForceInput<'a> {
@@ -280,19 +280,15 @@ fn walk<T>(
         // What the window keeps: positions, the springs' damping rate, and for `soa` the
         // velocities and the half-derivatives the history drag reads.
         let half = (!input.half_derivative.is_empty()).then_some(input.half_derivative);
-        let rate = match spring_rate(m) {
-            SpringRate::None => Rate::None,
-            SpringRate::Velocity => Rate::Velocity,
-            SpringRate::HalfDerivative => Rate::Half,
-        };
+        let rate = spring_rate(m);
         assert!(
-            rate != Rate::Half || half.is_some(),
+            rate != SpringRate::HalfDerivative || half.is_some(),
             "fractional spring damping needs the half-derivatives (ForceInput::half_derivative)"
         );
         let sources = Sources {
             x: input.x,
-            v: (soa || rate == Rate::Velocity).then_some(input.v),
-            half: if soa && m.history_drag != 0.0 || rate == Rate::Half {
+            v: (soa || rate == SpringRate::Velocity).then_some(input.v),
+            half: if (soa && m.history_drag != 0.0) || rate == SpringRate::HalfDerivative {
                 half
             } else {
                 None

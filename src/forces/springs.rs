@@ -67,15 +67,6 @@ pub fn spring_rate(m: &crate::model::Model) -> SpringRate {
     }
 }
 
-/// The array the spring damping of `input` acts on, or None for undamped springs.
-pub(super) fn rate<'a>(input: &ForceInput<'a>) -> Option<&'a [crate::Vec3]> {
-    match spring_rate(input.model) {
-        SpringRate::None => None,
-        SpringRate::Velocity => Some(input.v),
-        SpringRate::HalfDerivative => Some(input.half_derivative),
-    }
-}
-
 /// What the spring pass reads; copies the positions and the damping rate into `scratch`
 /// (component arrays) when `fill` says so (unless the caller did, or a tile walk reads them
 /// from windows of its own, [`super::inputs`]).
@@ -86,7 +77,11 @@ pub(super) fn params<'a>(
     fill: bool,
 ) -> Params<'a> {
     let m = input.model;
-    let rate = rate(input);
+    let rate: Option<&[crate::Vec3]> = match spring_rate(m) {
+        SpringRate::None => None,
+        SpringRate::Velocity => Some(input.v),
+        SpringRate::HalfDerivative => Some(input.half_derivative),
+    };
     let t = input.topology;
     if fill {
         scratch.x.fill_from(parallel, input.x);
