@@ -1,51 +1,262 @@
-//! The look descriptors on synthetic displacement fields with known answers.
+//! The look meter on synthetic caches whose answers are known in closed form.
+//!
+//! Each field moves the centre column of a hanging 0.4 m grid out of its plane by
+//! `z(y, t)`, y the depth below the top edge; the meter must find the drive, the axis and
+//! the column by itself and return each descriptor within 5 % (half-waves within 0.1).
 
-use fraccloth::look::{bump_count, describe, half_amplitude_distance, travel_speed};
+use std::f64::consts::PI;
 
-#[test]
-fn bumps_are_runs_of_one_sign_above_the_threshold() {
-    assert_eq!(bump_count(&[0.0, 0.01, 0.02, 0.01], 0.005), 1);
-    assert_eq!(bump_count(&[0.01, 0.02, -0.01, -0.03, 0.02], 0.005), 3);
-    // Small wiggles below the threshold do not count, and do not split a bump.
-    assert_eq!(bump_count(&[0.01, 0.001, -0.002, 0.02, 0.01], 0.005), 1);
-    assert_eq!(bump_count(&[0.001, -0.001], 0.005), 0);
-    // A sampled sine with 2.5 periods over the column has 5 half-waves.
-    let p: Vec<f64> = (0..200)
-        .map(|j| (std::f64::consts::TAU * 2.5 * j as f64 / 200.0 + 0.1).sin())
-        .collect();
-    assert_eq!(bump_count(&p, 0.05), 5);
+use fraccloth::look::{measure, Look};
+use fraccloth::{GridSpec, Vec3};
+
+const L: f64 = 0.4; // column length, m
+const FPS: f64 = 30.0;
+const SECONDS: f64 = 8.0;
+const F: f64 = 0.5; // drive frequency, Hz
+const W: f64 = 2.0 * PI * F;
+
+/// A 21 x 41 grid at 1 cm hanging in the plane z = 0, moved by `z(y, t)`.
+fn bake(z: impl Fn(f64, f64) -> f64) -> Look {
+    bake_with(21, 41, z, false)
 }
 
-#[test]
-fn half_amplitude_distance_of_an_exponential_envelope() {
-    // env(j) = exp(-j s / L): halves after L ln 2.
-    let (s, l) = (0.01, 0.1);
-    let env: Vec<f64> = (0..100).map(|j| (-(j as f64) * s / l).exp()).collect();
-    let d = half_amplitude_distance(&env, s).unwrap();
-    assert!((d - l * 2f64.ln()).abs() <= s, "{d}");
-    // An envelope that never halves: None.
-    assert_eq!(half_amplitude_distance(&[1.0, 0.9, 0.8, 0.7], s), None);
-}
-
-#[test]
-fn travel_speed_of_a_travelling_wave() {
-    // d = A sin(k y - w t) with y = j s: speed w / k.
-    let (s, dt, k, w) = (0.01, 1.0 / 30.0, 20.0, 3.0);
-    let field: Vec<Vec<f64>> = (0..300)
-        .map(|t| {
-            (0..41)
-                .map(|j| (k * j as f64 * s - w * t as f64 * dt).sin())
+/// `lying`: the rest mesh lies flat in the x-y plane and the cache is z-up, as a cloth
+/// modelled on the floor in another tool and then hung would be.
+fn bake_with(width: u32, height: u32, z: impl Fn(f64, f64) -> f64, lying: bool) -> Look {
+    let spacing = L / f64::from(height - 1);
+    let grid = GridSpec {
+        width,
+        height,
+        spacing,
+        total_mass: 0.1,
+    }
+    .build()
+    .unwrap();
+    let rest = grid.rest_positions.clone();
+    let frames_n = (SECONDS * FPS) as usize + 1;
+    let times: Vec<f64> = (0..frames_n).map(|k| k as f64 / FPS).collect();
+    let frames: Vec<Vec<Vec3>> = times
+        .iter()
+        .map(|&t| {
+            rest.iter()
+                .map(|p| {
+                    let depth = -p.y;
+                    let d = z(depth, t);
+                    if lying {
+                        // Hanging in x-z with z up, displaced along y.
+                        Vec3::new(p.x, d, p.y)
+                    } else {
+                        Vec3::new(p.x, p.y, p.z + d)
+                    }
+                })
                 .collect()
         })
         .collect();
-    let v = travel_speed(&field, 10, 30, dt, s, 60).unwrap();
-    // Resolution is one frame of lag: 0.2 m over about 1.33 s = 40 frames.
-    assert!((v - w / k).abs() < 0.01, "{v} vs {}", w / k);
-    let look = describe(&field, s, dt, 0.05);
-    assert!((look.travel_speed.unwrap() - w / k).abs() < 0.01);
-    // 41 rows of 0.01 m = 0.4 m = 2.55 half-wavelengths (pi / 20 = 0.157 m): 3 or 4 runs per
-    // frame, counting the partial ones at the ends; 3.55 on average.
-    assert!((look.mean_bumps - 3.55).abs() < 0.05, "{}", look.mean_bumps);
-    assert_eq!(look.half_amplitude_distance, None);
-    assert!((look.max_displacement - 1.0).abs() < 1e-3);
+    let (rest_in, up) = if lying {
+        // At rest it lies flat: (x, y) in the floor plane z = 0.
+        (
+            rest.iter().map(|p| Vec3::new(p.x, p.y, 0.0)).collect::<Vec<_>>(),
+            Vec3::z(),
+        )
+    } else {
+        (rest, Vec3::y())
+    };
+    measure(&rest_in, &grid.triangles, &frames, &times, up).unwrap()
+}
+
+fn close(got: f64, want: f64, rel: f64, what: &str) {
+    assert!(
+        (got - want).abs() <= rel * want.abs(),
+        "{what}: got {got}, want {want} (within {}%)",
+        rel * 100.0
+    );
+}
+
+fn half_waves(got: f64, want: f64) {
+    assert!((got - want).abs() <= 0.1, "half-waves: got {got}, want {want}");
+}
+
+fn travelling(c: f64, decay: Option<f64>) -> impl Fn(f64, f64) -> f64 {
+    move |y: f64, t: f64| {
+        let env = decay.map_or(1.0, |l| (-y / l).exp());
+        0.04 * env * (W * (t - y / c)).sin()
+    }
+}
+
+#[test]
+fn travelling_waves_without_decay() {
+    for c in [0.05, 0.133, 0.6] {
+        let look = bake(travelling(c, None));
+        let d = &look.descriptors;
+        close(look.drive_frequency, F, 0.01, "drive");
+        half_waves(d.half_waves, W * L / (PI * c));
+        close(d.travel_speed.expect("a wave travels"), c, 0.05, "travel");
+        assert_eq!(d.half_amplitude_depth, None, "c = {c}");
+        close(d.mid_ratio, 1.0, 0.05, "mid");
+        close(d.bottom_ratio, 1.0, 0.05, "bottom");
+        let z = d.zigzag.unwrap();
+        assert!((0.9..=1.15).contains(&z), "smooth wave zigzag {z} at c = {c}");
+        close(d.hang_depth, L, 0.01, "hang");
+    }
+}
+
+#[test]
+fn travelling_waves_decaying_over_20_and_10_cm() {
+    for c in [0.05, 0.133, 0.6] {
+        for l in [0.2, 0.1] {
+            let look = bake(travelling(c, Some(l)));
+            let d = &look.descriptors;
+            let visible = (l * 10f64.ln()).min(L);
+            half_waves(d.half_waves, W * visible / (PI * c));
+            close(d.visible_depth, visible, 0.05, "visible depth");
+            close(d.travel_speed.expect("a wave travels"), c, 0.05, "travel");
+            close(
+                d.half_amplitude_depth.expect("halves"),
+                l * 2f64.ln(),
+                0.05,
+                "half depth",
+            );
+            close(d.mid_ratio, (-L / 2.0 / l).exp(), 0.05, "mid");
+            close(d.bottom_ratio, (-L / l).exp(), 0.05, "bottom");
+            let z = d.zigzag.unwrap();
+            assert!(
+                (0.85..=1.2).contains(&z),
+                "decaying wave zigzag {z} at c = {c}, l = {l}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_whole_period_lag_is_read_as_the_slow_wave_it_is() {
+    // At 0.1 m/s the row three quarters down lags the one a quarter down by exactly one
+    // period (a lag search that starts at one frame aliases this): 4 half-waves.
+    let look = bake(travelling(0.1, None));
+    half_waves(look.descriptors.half_waves, 4.0);
+    close(look.descriptors.travel_speed.unwrap(), 0.1, 0.05, "travel");
+}
+
+#[test]
+fn a_column_moving_in_phase_carries_no_wave() {
+    let look = bake(|_, t| 0.04 * (W * t).sin());
+    let d = &look.descriptors;
+    half_waves(d.half_waves, 0.0);
+    assert_eq!(d.travel_speed, None);
+    assert_eq!(d.half_amplitude_depth, None);
+    close(d.mid_ratio, 1.0, 0.01, "mid");
+    assert_eq!(d.bulges, 0.0);
+}
+
+#[test]
+fn standing_modes_do_not_travel() {
+    // Amplitude cos(pi y / 0.8): falls to zero at the bottom, phase constant.
+    let look = bake(|y, t| 0.04 * (PI * y / (2.0 * L)).cos() * (W * t).sin());
+    let d = &look.descriptors;
+    half_waves(d.half_waves, 0.0);
+    assert_eq!(d.travel_speed, None);
+    close(d.half_amplitude_depth.unwrap(), 2.0 * L / 3.0, 0.05, "half depth");
+    close(d.mid_ratio, (PI / 4.0).cos(), 0.05, "mid");
+    assert!(d.bottom_ratio < 0.01);
+    close(d.visible_depth, 2.0 * L / PI * 0.1f64.acos(), 0.05, "visible");
+    // One with a node a sixth of the way down: the rows below the node are not visible.
+    let look = bake(|y, t| 0.04 * (3.0 * PI * y / (2.0 * L)).cos() * (W * t).sin());
+    assert_eq!(look.descriptors.travel_speed, None);
+    half_waves(look.descriptors.half_waves, 0.0);
+}
+
+#[test]
+fn a_rigid_tilt_lagging_90_degrees_is_not_a_wave() {
+    // The column translates with the top and tilts about it a quarter period later.
+    let (a, theta) = (0.02, 0.1);
+    let look = bake(|y, t| a * (W * t).sin() + theta * y * (W * t - PI / 2.0).sin());
+    let d = &look.descriptors;
+    assert_eq!(d.travel_speed, None, "a straight column does not carry a wave");
+    // By definition: the bottom's phase lag, atan(theta L / a), over pi.
+    half_waves(d.half_waves, (theta * L / a).atan() / PI);
+    assert_eq!(d.bulges, 0.0, "a straight column has no bulges");
+    close(
+        d.bottom_ratio,
+        (1.0 + (theta * L / a).powi(2)).sqrt(),
+        0.05,
+        "bottom",
+    );
+}
+
+#[test]
+fn a_top_moving_over_a_still_cloth_carries_no_wave() {
+    let look = bake(|y, t| 0.04 * (1.0 - y / 0.05).max(0.0) * (W * t).sin());
+    let d = &look.descriptors;
+    half_waves(d.half_waves, 0.0);
+    assert_eq!(d.travel_speed, None);
+    close(d.half_amplitude_depth.unwrap(), 0.025, 0.05, "half depth");
+    close(d.visible_depth, 0.045, 0.05, "visible depth");
+    assert!(d.mid_ratio < 1e-9 && d.bottom_ratio < 1e-9);
+}
+
+#[test]
+fn grid_scale_zigzag_on_a_smooth_wave_is_flagged() {
+    let smooth = bake(travelling(0.133, Some(0.2)));
+    // The same wave with a ripple alternating row to row, 10 % of the local amplitude.
+    let rough = bake(|y, t| {
+        let row = (y / 0.01).round() as i64;
+        let sign = if row % 2 == 0 { 1.0 } else { -1.0 };
+        travelling(0.133, Some(0.2))(y, t) * (1.0 + 0.1 * sign)
+    });
+    let (zs, zr) = (
+        smooth.descriptors.zigzag.unwrap(),
+        rough.descriptors.zigzag.unwrap(),
+    );
+    assert!(zs < 1.2, "smooth {zs}");
+    assert!(zr > 3.0, "rough {zr}");
+    // The ripple does not change the phase: the wave is still read right.
+    close(rough.descriptors.travel_speed.unwrap(), 0.133, 0.05, "travel");
+    half_waves(rough.descriptors.half_waves, smooth.descriptors.half_waves);
+}
+
+#[test]
+fn bulges_count_the_side_view_extrema() {
+    // Three half-waves of 4 cm: two or three interior extrema per frame, depending on the
+    // phase (an extremum near the bottom edge is confirmed only if the column turns back by
+    // 5 mm before it ends).
+    let b = bake(travelling(0.133, None)).descriptors.bulges;
+    assert!((2.2..=3.0).contains(&b), "{b}");
+    // A 2 mm wave makes no bulge at all.
+    let small = bake(|y, t| 0.002 * (W * (t - y / 0.133)).sin());
+    assert_eq!(small.descriptors.bulges, 0.0);
+}
+
+#[test]
+fn caches_from_other_tools_lying_flat_at_rest_z_up_even_width() {
+    // 20 columns: no vertex sits on the centre line; the nearest column is measured.
+    let look = bake_with(20, 41, travelling(0.133, Some(0.2)), true);
+    let d = &look.descriptors;
+    half_waves(d.half_waves, W * L / (PI * 0.133));
+    close(d.travel_speed.unwrap(), 0.133, 0.05, "travel");
+    close(d.hang_depth, L, 0.01, "hang");
+    assert!(
+        (look.out_of_plane.abs() - Vec3::y()).norm() < 1e-9,
+        "{}",
+        look.out_of_plane
+    );
+}
+
+#[test]
+fn json_has_the_documented_keys() {
+    let json = bake(travelling(0.133, None)).to_json();
+    for key in [
+        "half_waves",
+        "travel_speed",
+        "half_amplitude_depth",
+        "mid_ratio",
+        "bottom_ratio",
+        "zigzag",
+        "bulges",
+        "hang_depth",
+    ] {
+        assert!(
+            json.contains(&format!("\"{key}\": ")),
+            "{key} missing from {json}"
+        );
+    }
+    assert!(json.contains("\"half_amplitude_depth\": null"));
 }

@@ -78,7 +78,7 @@ fn the_sphere_appears_in_the_picture() {
     }
     .build()
     .unwrap();
-    scene.run_until(3.0).unwrap(); // the sphere has pushed through the cloth towards the camera
+    scene.run_until(3.5).unwrap(); // the sphere has pushed through the cloth and come out in front
     let cam = camera(&scene, 200, 150);
     let pix = draw(&scene, &cam);
     let sphere = pix.pixels().iter().filter(|p| is_sphere(p)).count();
@@ -94,4 +94,60 @@ fn the_sphere_appears_in_the_picture() {
     let plain = draw(&swing, &cam);
     let none = plain.pixels().iter().filter(|p| is_sphere(p)).count();
     assert!(none < sphere / 10, "{none} grey pixels without a sphere");
+}
+
+/// A smoothly bent sheet draws smoothly: along a vertical line through the cloth, the
+/// brightness changes by small steps (flat shading jumps at every row of facets, drawing
+/// horizontal stripes that are not in the cloth).
+#[test]
+fn a_smooth_bend_draws_without_stripes() {
+    let grid = fraccloth::GridSpec {
+        width: 31,
+        height: 21,
+        spacing: 0.02,
+        total_mass: 0.1,
+    }
+    .build()
+    .unwrap();
+    let bent: Vec<fraccloth::Vec3> = grid
+        .rest_positions
+        .iter()
+        .map(|p| fraccloth::Vec3::new(p.x, p.y, 0.06 * (p.y * 9.0).sin()))
+        .collect();
+    let cam = Camera::for_rest_shape(&grid.rest_positions, 320, 240);
+    let mut pix = Pixmap::new(320, 240).unwrap();
+    render_frame(
+        &Scene3d {
+            positions: &bent,
+            triangles: &grid.triangles,
+            spheres: &[],
+        },
+        &cam,
+        &mut pix,
+    );
+    // The brightest jump between vertically adjacent cloth pixels in the middle column.
+    let (top, bottom) = (
+        cam.project(&grid.rest_positions[15]),
+        cam.project(&grid.rest_positions[20 * 31 + 15]),
+    );
+    let x = ((top.0 + bottom.0) / 2.0) as u32;
+    let mut worst = 0i32;
+    let mut last: Option<i32> = None;
+    for y in (top.1 as u32 + 4)..(bottom.1 as u32 - 4) {
+        let p = pix.pixel(x, y).unwrap();
+        if !is_cloth(&p) {
+            last = None;
+            continue;
+        }
+        let lum = i32::from(p.red()) + i32::from(p.green());
+        if let Some(l) = last {
+            worst = worst.max((lum - l).abs());
+        }
+        last = Some(lum);
+    }
+    assert!(worst > 0, "no cloth found along the line");
+    assert!(
+        worst <= 12,
+        "brightness jumps by {worst} between adjacent pixels: stripes"
+    );
 }

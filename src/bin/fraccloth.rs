@@ -5,6 +5,7 @@
 //! the look of each (`fraccloth::look`).
 //!
 //! With no arguments it bakes the fractional `swing` scene (61 x 41, 8 s) into `out/`.
+//! `fraccloth look CACHE --rest REST.obj` measures the look of any point cache.
 
 use std::fmt::Write as _;
 use std::fs::File;
@@ -12,21 +13,61 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use clap::Parser;
+use clap::{Parser, Subcommand};
+use fraccloth::export::{read_cache, read_obj};
 use fraccloth::export::{write_obj, CacheFormat, CacheWriter};
 use fraccloth::history::Scheme;
-use fraccloth::look::{describe, Look};
-use fraccloth::render::{contact_sheet, render_frame, save_png, Camera, GifWriter, Scene3d};
+use fraccloth::look::{measure, Look};
+use fraccloth::render::{
+    contact_sheet, render_frame, save_png, side_view, space_time, Camera, GifWriter, Scene3d,
+};
 use fraccloth::scenes::{Scene, SceneKind, SceneSpec, Variant, DEFAULT_DT};
-use fraccloth::{HalfDerivative, Integrator, RegularDrag};
+use fraccloth::{HalfDerivative, Integrator, RegularDrag, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use tiny_skia::Pixmap;
 
 #[derive(Parser, Debug)]
 #[command(
     version,
-    about = "Bake an underwater cloth scene to PC2 and MDD point caches, an OBJ rest mesh and preview pictures"
+    about = "Bake an underwater cloth scene to PC2 and MDD point caches, an OBJ rest mesh and preview pictures",
+    args_conflicts_with_subcommands = true
 )]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    bake: Args,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Measure the look of a point cache of a hanging cloth driven at its top edge:
+    /// half-waves, travel speed, depth of the motion, zigzag, bulges (docs/look.md).
+    Look(LookArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct LookArgs {
+    /// The cache: an MDD (frame times inside) or a PC2 (give --fps).
+    cache: PathBuf,
+    /// The rest mesh (OBJ) with the cache's vertex order.
+    #[arg(long)]
+    rest: PathBuf,
+    /// Frames per second (required for PC2; overrides an MDD's own times).
+    #[arg(long)]
+    fps: Option<f64>,
+    /// The up axis of the cache: x, y, z, -x, -y or -z (Blender's own caches are z-up).
+    #[arg(long, default_value = "y")]
+    up: String,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Also write the side view and the space-time plot as PNGs with this path prefix.
+    #[arg(long)]
+    pictures: Option<PathBuf>,
+}
+
+#[derive(clap::Args, Debug)]
 struct Args {
     /// Scene: swing, sway or sphere.
     #[arg(long, default_value = "swing")]
@@ -161,6 +202,68 @@ fn io(path: &Path) -> impl Fn(std::io::Error) -> String + '_ {
     move |e| format!("{}: {e}", path.display())
 }
 
+fn parse_up(s: &str) -> Result<Vec3, String> {
+    let (sign, axis) = s.strip_prefix('-').map_or((1.0, s), |a| (-1.0, a));
+    let v = match axis.trim_start_matches('+') {
+        "x" => Vec3::x(),
+        "y" => Vec3::y(),
+        "z" => Vec3::z(),
+        _ => return Err(format!("--up {s:?}: give x, y, z, -x, -y or -z")),
+    };
+    Ok(sign * v)
+}
+
+/// Side view and space-time plot of a measured look, at `prefix-side.png` and
+/// `prefix-spacetime.png`; returns the two paths.
+fn write_look_pictures(look: &Look, title: &str, prefix: &Path) -> Result<[PathBuf; 2], String> {
+    let stem = prefix.file_name().and_then(|s| s.to_str()).unwrap_or("look");
+    let side = prefix.with_file_name(format!("{stem}-side.png"));
+    let st = prefix.with_file_name(format!("{stem}-spacetime.png"));
+    let pix = side_view(look, title, 360, 480).ok_or("cannot draw the side view")?;
+    save_png(&pix, &side).map_err(io(&side))?;
+    let pix = space_time(look, title, 640, 360).ok_or("cannot draw the space-time plot")?;
+    save_png(&pix, &st).map_err(io(&st))?;
+    Ok([side, st])
+}
+
+/// `fraccloth look`: measure a cache read from disk.
+fn look_command(a: &LookArgs) -> Result<(), String> {
+    let up = parse_up(&a.up)?;
+    let mesh = read_obj(&a.rest).map_err(io(&a.rest))?;
+    let cache = read_cache(&a.cache).map_err(io(&a.cache))?;
+    if cache.vertex_count != mesh.positions.len() {
+        return Err(format!(
+            "{} has {} vertices, the rest mesh {} has {}",
+            a.cache.display(),
+            cache.vertex_count,
+            a.rest.display(),
+            mesh.positions.len()
+        ));
+    }
+    let frames = cache.frames.len();
+    let times = match (a.fps, cache.times) {
+        (Some(fps), _) if fps.is_finite() && fps > 0.0 => (0..frames).map(|k| k as f64 / fps).collect(),
+        (Some(fps), _) => return Err(format!("--fps must be positive, got {fps}")),
+        (None, Some(t)) => t,
+        (None, None) => return Err("a PC2 cache does not store its frame rate: give --fps".into()),
+    };
+    let look = measure(&mesh.positions, &mesh.triangles, &cache.frames, &times, up)
+        .map_err(|e| format!("{}: {e}", a.cache.display()))?;
+    if a.json {
+        println!("{}", look.to_json());
+    } else {
+        print!("{}", look.summary());
+    }
+    if let Some(prefix) = &a.pictures {
+        let title = a.cache.file_name().and_then(|s| s.to_str()).unwrap_or("cache");
+        let [side, st] = write_look_pictures(&look, title, prefix)?;
+        if !a.json {
+            println!("pictures           {}, {}", side.display(), st.display());
+        }
+    }
+    Ok(())
+}
+
 fn bake(args: &Args) -> Result<(), String> {
     let variant = Variant::from_name(&args.variant).ok_or_else(|| {
         format!(
@@ -218,6 +321,8 @@ fn bake(args: &Args) -> Result<(), String> {
     let sheet_frames: Vec<u64> = (0..8).map(|k| (k * frames) / 7).collect();
     let mut sheet_cells = vec![];
     let mut render_time = 0.0;
+    // The frames, for the look meter.
+    let mut recorded: Vec<Vec<Vec3>> = Vec::with_capacity(frames as usize + 1);
     let bar = progress(args.quiet, frames, format!("baking {stem}"))?;
     let started = Instant::now();
     for f in 0..=frames {
@@ -230,6 +335,7 @@ fn bake(args: &Args) -> Result<(), String> {
         for (cache, p) in caches.iter_mut() {
             cache.write_frame(scene.cloth.positions()).map_err(io(p))?;
         }
+        recorded.push(scene.cloth.positions().to_vec());
         let t0 = Instant::now();
         if let Some(g) = gif.as_mut() {
             if f % gif_every == 0 {
@@ -294,19 +400,76 @@ fn bake(args: &Args) -> Result<(), String> {
             gif_path.display()
         );
     }
+    let times: Vec<f64> = (0..recorded.len()).map(|k| k as f64 / args.fps).collect();
+    match measure(
+        &topo.rest_positions,
+        &topo.triangles,
+        &recorded,
+        &times,
+        Vec3::y(),
+    ) {
+        Ok(look) => {
+            let json = path("-look.json");
+            std::fs::write(&json, look.to_json() + "\n").map_err(io(&json))?;
+            let _ = write!(
+                summary,
+                "look (centre column, `fraccloth look`), {}:\n{}",
+                json.display(),
+                look.summary()
+            );
+            if preview {
+                let [side, st] = write_look_pictures(&look, &stem, &args.out.join(&stem))?;
+                let _ = writeln!(summary, "look pictures {}, {}", side.display(), st.display());
+            }
+        }
+        Err(e) => {
+            let _ = writeln!(summary, "look         not measured: {e}");
+        }
+    }
     print!("{summary}");
     let txt = path(".txt");
     std::fs::write(&txt, summary).map_err(io(&txt))?;
     Ok(())
 }
 
-/// Centre-column out-of-plane displacement from the top edge, per row.
-fn centre_profile(scene: &Scene) -> Vec<f64> {
-    let (w, h) = (scene.spec.width as usize, scene.spec.height as usize);
-    let x = scene.cloth.positions();
-    let i = w / 2;
-    let top = x[i].z;
-    (0..h).map(|j| x[j * w + i].z - top).collect()
+/// Stacks pictures top to bottom on the sheet's dark background.
+fn stack(pictures: &[Pixmap]) -> Result<Pixmap, String> {
+    let w = pictures.iter().map(Pixmap::width).max().unwrap_or(1);
+    let h = pictures.iter().map(Pixmap::height).sum::<u32>().max(1);
+    let mut out = Pixmap::new(w, h).ok_or("bad sheet size")?;
+    out.fill(tiny_skia::Color::from_rgba8(12, 16, 24, 255));
+    let mut y = 0;
+    for p in pictures {
+        out.draw_pixmap(
+            0,
+            y as i32,
+            p.as_ref(),
+            &tiny_skia::PixmapPaint::default(),
+            tiny_skia::Transform::identity(),
+            None,
+        );
+        y += p.height();
+    }
+    Ok(out)
+}
+
+/// The look table's header and one row.
+const LOOK_HEADER: &str = "| model | half-waves | travel speed (m/s) | half-amplitude depth (m) | mid / bottom ratio | zigzag | bulges | hang depth (m) |\n|---|---|---|---|---|---|---|---|\n";
+
+fn look_row(name: &str, look: &Look) -> String {
+    let d = &look.descriptors;
+    let opt = |v: Option<f64>, none: &str| v.map_or(none.to_string(), |x| format!("{x:.3}"));
+    format!(
+        "| {name} | {:.2} | {} | {} | {:.2} / {:.2} | {} | {:.2} | {:.3} |\n",
+        d.half_waves,
+        opt(d.travel_speed, "none"),
+        opt(d.half_amplitude_depth, "never"),
+        d.mid_ratio,
+        d.bottom_ratio,
+        opt(d.zigzag, "n/a"),
+        d.bulges,
+        d.hang_depth
+    )
 }
 
 fn compare(args: &Args) -> Result<(), String> {
@@ -331,7 +494,8 @@ fn compare(args: &Args) -> Result<(), String> {
         .map(|k| args.seconds * (0.25 + 0.75 * k as f64 / (rows_out - 1) as f64))
         .collect();
     let mut columns: Vec<Vec<Pixmap>> = vec![];
-    let mut looks: Vec<(String, Look)> = vec![];
+    let (mut sides, mut spacetimes) = (vec![], vec![]);
+    let mut table = String::new();
     let bar = progress(
         args.quiet,
         models.len() as u64,
@@ -342,25 +506,36 @@ fn compare(args: &Args) -> Result<(), String> {
         let mut scene = spec.build().map_err(|e| e.to_string())?;
         let camera = camera_for(&scene, 280, 210);
         let mut cells = vec![];
-        let mut field = vec![];
         let frames = (args.seconds * args.fps).round() as u64;
+        let mut recorded = vec![scene.cloth.positions().to_vec()];
         let mut next = 0;
         for f in 1..=frames {
             let t = f as f64 / args.fps;
             scene.run_until(t).map_err(|e| format!("{name}, t = {t}: {e}"))?;
-            if t >= 0.5 * args.seconds {
-                field.push(centre_profile(&scene));
-            }
+            recorded.push(scene.cloth.positions().to_vec());
             while next < times.len() && times[next] <= t + 1e-9 {
                 cells.push(picture(&scene, &camera)?);
                 next += 1;
             }
         }
-        let frame_dt = 1.0 / args.fps;
-        looks.push((
-            name.to_string(),
-            describe(&field, spec.spacing(), frame_dt, 0.002),
-        ));
+        let topo = scene.cloth.topology();
+        let frame_times: Vec<f64> = (0..recorded.len()).map(|k| k as f64 / args.fps).collect();
+        match measure(
+            &topo.rest_positions,
+            &topo.triangles,
+            &recorded,
+            &frame_times,
+            Vec3::y(),
+        ) {
+            Ok(look) => {
+                table += &look_row(name, &look);
+                sides.push(side_view(&look, name, 280, 380).ok_or("cannot draw a side view")?);
+                spacetimes.push(space_time(&look, name, 280, 220).ok_or("cannot draw a space-time plot")?);
+            }
+            Err(e) => {
+                table += &format!("| {name} | not measured: {e} |||||||\n");
+            }
+        }
         columns.push(cells);
         bar.inc(1);
     }
@@ -370,24 +545,32 @@ fn compare(args: &Args) -> Result<(), String> {
         .collect();
     let col_labels: Vec<String> = models.iter().map(|m| m.0.to_string()).collect();
     let row_labels: Vec<String> = times.iter().map(|t| format!("{t:.1}s")).collect();
-    let sheet = contact_sheet(&rows, &col_labels, &row_labels).ok_or("empty sheet")?;
+    let mut parts = vec![contact_sheet(&rows, &col_labels, &row_labels).ok_or("empty sheet")?];
+    // The side views and space-time plots under the 3D frames, column for column.
+    let left = 8 * 2 * row_labels.iter().map(String::len).max().unwrap_or(0) as u32 + 8;
+    for plots in [&sides, &spacetimes] {
+        if plots.len() == columns.len() {
+            let sheet = contact_sheet(&[plots.to_vec()], &[], &[]).ok_or("empty sheet")?;
+            let mut shifted = Pixmap::new(left + sheet.width(), sheet.height()).ok_or("bad sheet size")?;
+            shifted.fill(tiny_skia::Color::from_rgba8(12, 16, 24, 255));
+            shifted.draw_pixmap(
+                left as i32,
+                0,
+                sheet.as_ref(),
+                &tiny_skia::PixmapPaint::default(),
+                tiny_skia::Transform::identity(),
+                None,
+            );
+            parts.push(shifted);
+        }
+    }
+    let sheet = stack(&parts)?;
     let sheet_path = args.out.join(format!("compare-{}.png", args.scene));
     save_png(&sheet, &sheet_path).map_err(io(&sheet_path))?;
-    let mut table = format!(
-        "Look of `{}` ({}, {} s, dt {} s, explicit Euler), second half of the bake, centre column:\n\n| model | bumps (mean) | half-amplitude distance (m) | travel speed (m/s) | largest displacement from the top edge (m) |\n|---|---|---|---|---|\n",
-        args.scene, args.size, args.seconds, args.dt
+    let table = format!(
+        "Look of `{}` ({}, {} s, dt {} s, {} integrator), measured by `fraccloth look` on the centre column over whole drive periods of the second half:\n\n{LOOK_HEADER}{table}",
+        args.scene, args.size, args.seconds, args.dt, args.integrator
     );
-    for (name, l) in &looks {
-        let opt = |v: Option<f64>, none: &str| v.map_or(none.to_string(), |x| format!("{x:.3}"));
-        let _ = writeln!(
-            table,
-            "| {name} | {:.2} | {} | {} | {:.4} |",
-            l.mean_bumps,
-            opt(l.half_amplitude_distance, "never halves"),
-            opt(l.travel_speed, "no correlation"),
-            l.max_displacement
-        );
-    }
     let table_path = args.out.join(format!("look-{}.md", args.scene));
     std::fs::write(&table_path, &table).map_err(io(&table_path))?;
     print!(
@@ -399,8 +582,12 @@ fn compare(args: &Args) -> Result<(), String> {
 }
 
 fn main() {
-    let args = Args::parse();
-    let result = if args.compare { compare(&args) } else { bake(&args) };
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Some(Command::Look(a)) => look_command(a),
+        None if cli.bake.compare => compare(&cli.bake),
+        None => bake(&cli.bake),
+    };
     if let Err(e) = result {
         eprintln!("fraccloth: {e}");
         std::process::exit(1);

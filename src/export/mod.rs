@@ -4,11 +4,13 @@ mod cache;
 mod mdd;
 mod obj;
 mod pc2;
+mod read;
 
 pub use cache::{sequence_path, CacheFormat, CacheWriter};
 pub use mdd::MddWriter;
 pub use obj::write_obj;
 pub use pc2::Pc2Writer;
+pub use read::{parse_mdd, parse_obj, parse_pc2, read_cache, read_obj, CacheFrames, ObjMesh};
 
 /// One frame as f32 triples, little- or big-endian (the caches' only difference in encoding).
 pub(crate) fn encode_frame(positions: &[crate::Vec3], big_endian: bool) -> Vec<u8> {

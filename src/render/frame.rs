@@ -1,10 +1,8 @@
 //! One picture of the cloth and its colliders.
 
-use tiny_skia::{
-    Color, FillRule, GradientStop, LinearGradient, Paint, PathBuilder, Pixmap, Point, RadialGradient, Shader,
-    SpreadMode, Transform,
-};
+use tiny_skia::{Color, GradientStop, LinearGradient, Paint, Pixmap, Point, SpreadMode, Transform};
 
+use super::raster::{vertex_normals, ZBuffer};
 use super::Camera;
 use crate::forces::{Collider, Sphere};
 use crate::Vec3;
@@ -54,89 +52,50 @@ fn backdrop(pix: &mut Pixmap) {
     }
 }
 
-enum Item {
-    Triangle([(f32, f32); 3], Color),
-    Sphere(f32, f32, f32),
+/// Supersampling per axis.
+const SUPERSAMPLE: usize = 2;
+
+fn shade(base: [f32; 3], brightness: f32) -> [f32; 3] {
+    base.map(|c| c * brightness)
 }
 
-/// Renders one frame into `pix` (cleared first).
+/// Renders one frame into `pix` (cleared first): the cloth smooth-shaded from its vertex
+/// normals (both sides, lit from above), spheres shaded, everything depth-tested.
 pub fn render_frame(scene: &Scene3d<'_>, camera: &Camera, pix: &mut Pixmap) {
     backdrop(pix);
     let light = Vec3::new(LIGHT[0], LIGHT[1], LIGHT[2]).normalize();
-    let mut items: Vec<(f64, Item)> = Vec::with_capacity(scene.triangles.len() + scene.spheres.len());
+    let normals = vertex_normals(scene.positions, scene.triangles);
+    let mut z = ZBuffer::new(pix.width(), pix.height(), SUPERSAMPLE);
     for t in scene.triangles {
-        let [a, b, c] = t.map(|i| scene.positions[i as usize]);
-        let n = (b - a).cross(&(c - a));
-        let len = n.norm();
-        if len == 0.0 {
+        let idx = t.map(|i| i as usize);
+        if idx.iter().any(|&i| i >= scene.positions.len()) {
             continue;
         }
-        let n = n / len;
+        let [a, b, c] = idx.map(|i| scene.positions[i]);
         let centre = (a + b + c) / 3.0;
-        let facing = n.dot(&camera.towards_eye(&centre)) >= 0.0;
-        let n = if facing { n } else { -n };
-        let lambert = n.dot(&light).max(0.0) as f32;
-        let shade = 0.30 + 0.70 * lambert;
-        let base = if facing { FRONT } else { BACK };
-        let color =
-            Color::from_rgba(base[0] * shade, base[1] * shade, base[2] * shade, 1.0).unwrap_or(Color::WHITE);
-        let pa = camera.project(&a);
-        let pb = camera.project(&b);
-        let pc = camera.project(&c);
-        let depth = (pa.2 + pb.2 + pc.2) / 3.0;
-        items.push((
-            depth,
-            Item::Triangle([(pa.0, pa.1), (pb.0, pb.1), (pc.0, pc.1)], color),
-        ));
+        let eye = camera.towards_eye(&centre);
+        let v = [a, b, c].map(|p| {
+            let (x, y, d) = camera.project(&p);
+            (x, y, d as f32)
+        });
+        z.triangle(v, idx.map(|i| normals[i]), |n| {
+            // The side facing the camera is lit; its colour says which side it is.
+            let facing = n.dot(&eye) >= 0.0;
+            let n = if facing { n } else { -n };
+            let n = n.try_normalize(0.0).unwrap_or(eye);
+            let lambert = n.dot(&light).max(0.0) as f32;
+            shade(if facing { FRONT } else { BACK }, 0.30 + 0.70 * lambert)
+        });
     }
+    // Light in camera space for the spheres: up, a little left, towards the viewer.
+    let l = [-0.35f32, 0.6, 0.72];
     for s in scene.spheres {
-        let (x, y, z) = camera.project(&s.center);
-        items.push((z, Item::Sphere(x, y, camera.pixel_radius(s.radius, z))));
+        let (x, y, d) = camera.project(&s.center);
+        let r = camera.pixel_radius(s.radius, d);
+        z.sphere((x, y, d as f32), r, s.radius as f32, |n| {
+            let lambert = (n[0] * l[0] + n[1] * l[1] + n[2] * l[2]).max(0.0);
+            shade([0.86, 0.87, 0.9], 0.3 + 0.7 * lambert)
+        });
     }
-    // Painter's algorithm: far to near.
-    items.sort_by(|a, b| b.0.total_cmp(&a.0));
-    let mut paint = Paint {
-        anti_alias: true,
-        ..Paint::default()
-    };
-    for (_, item) in items {
-        match item {
-            Item::Triangle(p, color) => {
-                let mut pb = PathBuilder::new();
-                pb.move_to(p[0].0, p[0].1);
-                pb.line_to(p[1].0, p[1].1);
-                pb.line_to(p[2].0, p[2].1);
-                pb.close();
-                if let Some(path) = pb.finish() {
-                    paint.shader = Shader::SolidColor(color);
-                    pix.fill_path(&path, &paint, FillRule::Winding, Transform::identity(), None);
-                    // A hairline of the same colour closes the anti-aliasing seams between triangles.
-                    let stroke = tiny_skia::Stroke {
-                        width: 0.6,
-                        ..Default::default()
-                    };
-                    pix.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
-                }
-            }
-            Item::Sphere(x, y, r) => {
-                if let Some(circle) = PathBuilder::from_circle(x, y, r.max(1.0)) {
-                    let shader = RadialGradient::new(
-                        Point::from_xy(x - 0.35 * r, y - 0.35 * r),
-                        0.0,
-                        Point::from_xy(x, y),
-                        r * 1.1,
-                        vec![
-                            GradientStop::new(0.0, Color::from_rgba8(235, 235, 240, 255)),
-                            GradientStop::new(1.0, Color::from_rgba8(80, 85, 100, 255)),
-                        ],
-                        SpreadMode::Pad,
-                        Transform::identity(),
-                    );
-                    paint.shader =
-                        shader.unwrap_or(Shader::SolidColor(Color::from_rgba8(150, 150, 160, 255)));
-                    pix.fill_path(&circle, &paint, FillRule::Winding, Transform::identity(), None);
-                }
-            }
-        }
-    }
+    z.composite(pix);
 }

@@ -1,0 +1,15 @@
+//! The look meter: what a swinging cloth's centre column does at the drive frequency
+//! (half-waves, travel speed, depth of the motion, roughness, bulges), measured in absolute
+//! coordinates from any point cache. Definitions and their checks: `docs/look.md`,
+//! `tests/look.rs`.
+
+mod descriptors;
+mod harmonic;
+mod meter;
+
+pub use descriptors::{
+    describe, extrema_with_hysteresis, straight_line_residual, unwrapped_lags, zigzag, ColumnMotion,
+    Descriptors, RowHarmonic, BULGE_HYSTERESIS, MAX_STRAIGHT_RESIDUAL, MIN_TRAVEL_LAG, VISIBLE_FRACTION,
+};
+pub use harmonic::{complex_amplitude, dominant_frequency};
+pub use meter::{measure, Look};
