@@ -53,6 +53,14 @@ typedef enum {
    * A file could not be created, written or completed (cache writers); the message has the operating system's reason.
    */
   FC_ERROR_IO = 6,
+  /**
+   * Memory for the request could not be allocated; nothing was changed (the process is never aborted for it).
+   */
+  FC_ERROR_OUT_OF_MEMORY = 7,
+  /**
+   * An implicit step's solver stopped at `solver_max_iterations` above `solver_tolerance`; the cloth is unchanged. Raise the cap, loosen the tolerance, shorten dt, or accept such steps with `fc_cloth_set_solver_accept_unconverged`.
+   */
+  FC_ERROR_NOT_CONVERGED = 8,
 } FcStatus;
 
 /**
@@ -532,6 +540,17 @@ FcStatus fc_cloth_get_solver_stats(const FcCloth *cloth,
                                    double *residual);
 
 /**
+ * Whether an implicit step whose solver stops at `solver_max_iterations` above
+ * `solver_tolerance` is accepted (`accept` non-zero: the step returns `FC_OK`; read
+ * `fc_cloth_get_solver_stats`) or refused (0, the default: `FC_ERROR_NOT_CONVERGED`, the
+ * cloth unchanged).
+ *
+ * # Safety
+ * `cloth` NULL or live.
+ */
+FcStatus fc_cloth_set_solver_accept_unconverged(FcCloth *cloth, int32_t accept);
+
+/**
  * Adds a sphere collider (centre in m, radius in m > 0; velocity in m/s, NULL for
  * resting) and writes its id to `*out_id` (only on success).
  *
@@ -684,7 +703,7 @@ FcStatus fc_cloth_create_mesh(const FcClothDesc *desc,
 
 /**
  * Bytes `fc_cloth_save_snapshot` needs now (it grows with the history for `FC_HISTORY_FULL`;
- * constant otherwise). 0 for NULL.
+ * constant otherwise), counted without building the snapshot. 0 for NULL.
  *
  * # Safety
  * `cloth` NULL or live.
@@ -696,7 +715,9 @@ size_t fc_cloth_snapshot_size(const FcCloth *cloth);
  * friction, current, solver settings, time, and the fractional history) into `buffer`:
  * a versioned, CRC-32-checked binary snapshot. `capacity` is the buffer size in bytes; the
  * size written goes to `*out_written` (may be NULL). A buffer smaller than
- * `fc_cloth_snapshot_size` gives `FC_ERROR_INVALID_ARGUMENT` and writes nothing.
+ * `fc_cloth_snapshot_size` gives `FC_ERROR_INVALID_ARGUMENT` and writes nothing;
+ * `FC_ERROR_OUT_OF_MEMORY` when the snapshot cannot be assembled. The bytes depend only on
+ * the cloth's state: after a refused step they equal the bytes saved before it.
  *
  * # Safety
  * `cloth` NULL or live; `buffer` NULL or `capacity` writable bytes; `out_written` NULL or writable.
@@ -710,7 +731,10 @@ FcStatus fc_cloth_save_snapshot(const FcCloth *cloth,
  * Restores a snapshot saved from a cloth of the same mesh and history settings. Stepping on
  * gives bitwise the same results as the saved cloth would have. A truncated, corrupted or
  * foreign snapshot gives `FC_ERROR_INVALID_ARGUMENT` (the message says why) and leaves the
- * cloth exactly as it was.
+ * cloth exactly as it was. Beyond the checksum, the contents are checked for meaning: every
+ * number finite and within the float range, speeds within this cloth's `max_speed`, history
+ * times ordered and not after the cloth's time, step sizes positive; a snapshot that loads
+ * can always be stepped, and the message names the field that was refused.
  *
  * # Safety
  * `cloth` NULL or live; `data` NULL or `size` readable bytes.

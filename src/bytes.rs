@@ -3,24 +3,63 @@
 use crate::error::Error;
 use crate::Vec3;
 
-/// Appends little-endian values to a byte vector.
+/// Appends little-endian values to a byte vector, or only counts them (to size a snapshot
+/// without building it).
 #[derive(Default)]
 pub struct ByteWriter {
     pub buf: Vec<u8>,
+    counting: bool,
+    count: usize,
 }
 
 impl ByteWriter {
+    /// A writer that only counts the bytes it is given.
+    pub fn counter() -> Self {
+        Self {
+            counting: true,
+            ..Self::default()
+        }
+    }
+    /// A writer whose buffer already holds room for `bytes` (fallibly).
+    pub fn with_room(bytes: usize) -> Result<Self, Error> {
+        let mut buf = Vec::new();
+        buf.try_reserve_exact(bytes)
+            .map_err(|_| Error::out_of_memory(format!("a snapshot of {bytes} bytes cannot be allocated")))?;
+        Ok(Self {
+            buf,
+            ..Self::default()
+        })
+    }
+    /// True for a writer that only counts.
+    pub fn is_counting(&self) -> bool {
+        self.counting
+    }
+    /// Bytes written (or counted) so far.
+    pub fn len(&self) -> usize {
+        if self.counting {
+            self.count
+        } else {
+            self.buf.len()
+        }
+    }
+    pub fn put(&mut self, bytes: &[u8]) {
+        if self.counting {
+            self.count += bytes.len();
+        } else {
+            self.buf.extend_from_slice(bytes);
+        }
+    }
     pub fn u8(&mut self, v: u8) {
-        self.buf.push(v);
+        self.put(&[v]);
     }
     pub fn u32(&mut self, v: u32) {
-        self.buf.extend_from_slice(&v.to_le_bytes());
+        self.put(&v.to_le_bytes());
     }
     pub fn u64(&mut self, v: u64) {
-        self.buf.extend_from_slice(&v.to_le_bytes());
+        self.put(&v.to_le_bytes());
     }
     pub fn f64(&mut self, v: f64) {
-        self.buf.extend_from_slice(&v.to_le_bytes());
+        self.put(&v.to_le_bytes());
     }
     pub fn vec3(&mut self, v: &Vec3) {
         for c in v.iter() {

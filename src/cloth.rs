@@ -36,7 +36,20 @@ pub struct ClothConfig {
     pub max_substep: f64,
     /// Implicit solver settings.
     pub solver: SolverSettings,
+    /// Accept an implicit step whose solver stopped at its iteration cap above its tolerance
+    /// (the step then returns `Ok`; read [`Cloth::solver_stats`]). Default false: such a step
+    /// is refused with [`crate::ErrorKind::NotConverged`] and changes nothing.
+    pub accept_unconverged: bool,
 }
+
+/// Largest coordinate or speed a cloth may reach: beyond it a value no longer fits the
+/// `float` the C ABI hands out. A step that would go past it is refused as unstable.
+pub const MAX_COORDINATE: f64 = f32::MAX as f64;
+
+/// A step that may move a particle farther than this (m: `dt * max_speed`) also checks every
+/// position against [`MAX_COORDINATE`]. Shorter steps cannot get there: at 1 km a step it
+/// would take 3e35 steps.
+const FAR_STEP: f64 = 1.0e3;
 
 /// Particles per tile of the pass before the forces (its arrays for a tile fit in L1).
 const PASS_TILE: usize = 256;
@@ -73,6 +86,7 @@ impl Default for ClothConfig {
             scheme: Scheme::DEFAULT,
             integrator: Integrator::default(),
             max_speed: 100.0,
+            accept_unconverged: false,
             max_substep: 0.0,
             solver: SolverSettings::default(),
         }
@@ -158,6 +172,12 @@ impl Cloth {
     pub fn new(topology: Topology, config: ClothConfig) -> Result<Self, Error> {
         config.model.validate()?;
         check_positive("max_speed", config.max_speed)?;
+        if config.max_speed >= MAX_COORDINATE {
+            return Err(Error::invalid(format!(
+                "max_speed must be below {MAX_COORDINATE:e} m/s (the float range), got {}",
+                config.max_speed
+            )));
+        }
         config.scheme.validate()?;
         check_solver(&config.solver)?;
         if !(config.max_substep.is_finite() && config.max_substep >= 0.0) {
@@ -172,6 +192,17 @@ impl Cloth {
         } else {
             Scheme::Off
         };
+        // Room for the state, scratch and rollback copies and the history, checked up front.
+        let history_bytes = match scheme {
+            Scheme::Truncated { u } => 24 * u64::from(u),
+            Scheme::Full => 0, // grows step by step, each step's room reserved fallibly
+            Scheme::SumOfExponentials { .. } => 24 * 64,
+            Scheme::Off => 0,
+        };
+        crate::memory::ensure_available(
+            (n as u64).saturating_mul(crate::memory::STATE_BYTES_PER_PARTICLE + 2 * history_bytes),
+            &format!("a cloth of {n} particles"),
+        )?;
         let x = topology.rest_positions.clone();
         Ok(Self {
             v: vec![Vec3::zeros(); n],
@@ -522,6 +553,12 @@ impl Cloth {
         self.solver_stats
     }
 
+    /// Whether an implicit step whose solver stopped above its tolerance is accepted
+    /// ([`ClothConfig::accept_unconverged`]).
+    pub fn set_accept_unconverged(&mut self, accept: bool) {
+        self.config.accept_unconverged = accept;
+    }
+
     /// Sets the implicit solver's tolerance and iteration cap.
     pub fn set_solver(&mut self, settings: SolverSettings) -> Result<(), Error> {
         check_solver(&settings)?;
@@ -741,6 +778,13 @@ impl Cloth {
                         settings: self.config.solver,
                     };
                     self.solver_stats = implicit_euler(&inp, &mut s.implicit, &mut s.v_new);
+                    let st = self.solver_stats;
+                    if st.residual > self.config.solver.tolerance && !self.config.accept_unconverged {
+                        return Err(Error::not_converged(format!(
+                            "the implicit solver stopped after {} iterations at relative residual {:.3e}, above its tolerance {:e}; state left unchanged: raise solver_max_iterations, loosen solver_tolerance, shorten dt, or accept such steps",
+                            st.iterations, st.residual, self.config.solver.tolerance
+                        )));
+                    }
                     for i in 0..n {
                         s.x_new[i] = self.x[i] + h * s.v_new[i];
                     }
@@ -776,6 +820,9 @@ impl Cloth {
         if !(integrated_sound == Some(true) && pins_sound()) {
             self.check_sound(h)?;
         }
+        if h * self.config.max_speed > FAR_STEP {
+            self.check_in_range(h)?;
+        }
         let s = &mut self.scratch;
         std::mem::swap(&mut self.x, &mut s.x_new);
         std::mem::swap(&mut self.v, &mut s.v_new);
@@ -806,6 +853,18 @@ impl Cloth {
                 self.steps,
                 v[i].norm(),
                 self.config.max_speed
+            ))),
+        }
+    }
+
+    /// Refuses a step whose positions leave the float range (see [`FAR_STEP`]).
+    fn check_in_range(&self, dt: f64) -> Result<(), Error> {
+        match self.scratch.x_new.iter().position(|x| x.amax() >= MAX_COORDINATE) {
+            None => Ok(()),
+            Some(i) => Err(Error::unstable(format!(
+                "{} with dt = {dt} s would move vertex {i} beyond the float range ({:.3e} m); state left unchanged, retry with a smaller dt",
+                self.config.integrator.name(),
+                self.scratch.x_new[i].amax()
             ))),
         }
     }

@@ -11,6 +11,11 @@ pub enum ErrorKind {
     OutOfRange,
     /// The step would leave a non-finite or exploding state; nothing was changed.
     Unstable,
+    /// Memory for the request could not be had; nothing was changed.
+    OutOfMemory,
+    /// The implicit solver stopped at its iteration cap above its tolerance; nothing was
+    /// changed.
+    NotConverged,
 }
 
 /// An error with a message for humans.
@@ -30,6 +35,18 @@ impl Error {
     pub fn out_of_range(message: impl Into<String>) -> Self {
         Self {
             kind: ErrorKind::OutOfRange,
+            message: message.into(),
+        }
+    }
+    pub fn out_of_memory(message: impl Into<String>) -> Self {
+        Self {
+            kind: ErrorKind::OutOfMemory,
+            message: message.into(),
+        }
+    }
+    pub fn not_converged(message: impl Into<String>) -> Self {
+        Self {
+            kind: ErrorKind::NotConverged,
             message: message.into(),
         }
     }

@@ -39,6 +39,7 @@ pub mod forces;
 pub mod history;
 pub mod integrate;
 pub mod look;
+pub mod memory;
 pub mod model;
 pub mod oscillator;
 pub mod parallel;

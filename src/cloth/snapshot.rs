@@ -24,6 +24,7 @@
 
 use super::{check_weight, checked_collider, Cloth};
 use crate::bytes::{ByteReader, ByteWriter};
+use crate::cloth::MAX_COORDINATE;
 use crate::error::{check_finite_vec, Error};
 use crate::forces::{Capsule, Collider, Plane, Sphere};
 use crate::history::{History, Scheme};
@@ -133,10 +134,22 @@ fn read_collider(r: &mut ByteReader<'_>) -> Result<Collider, Error> {
 }
 
 impl Cloth {
-    /// The cloth's complete state as a snapshot (see the module docs for the format).
-    pub fn save_snapshot(&self) -> Vec<u8> {
-        let mut w = ByteWriter::default();
-        w.buf.extend_from_slice(MAGIC);
+    /// The cloth's complete state as a snapshot (see the module docs for the format), or an
+    /// out-of-memory error. The bytes depend only on the cloth's logical state: a cloth whose
+    /// step was refused saves the same bytes as before the attempt.
+    pub fn save_snapshot(&self) -> Result<Vec<u8>, Error> {
+        let mut w = ByteWriter::with_room(self.snapshot_size())?;
+        self.write_snapshot(&mut w)?;
+        let payload = (w.buf.len() - HEADER) as u64;
+        w.buf[16..24].copy_from_slice(&payload.to_le_bytes());
+        let crc = crc32fast::hash(&w.buf);
+        w.u32(crc);
+        Ok(w.buf)
+    }
+
+    /// Writes (or counts) everything but the checksum, with a zero payload length.
+    fn write_snapshot(&self, w: &mut ByteWriter) -> Result<(), Error> {
+        w.put(MAGIC);
         w.u32(SNAPSHOT_VERSION);
         w.u32(0);
         w.u64(0); // payload length, patched below
@@ -166,17 +179,12 @@ impl Cloth {
                 None => w.u8(0),
                 Some((c, friction)) => {
                     w.u8(1);
-                    write_collider(&mut w, c);
+                    write_collider(w, c);
                     w.f64(*friction);
                 }
             }
         }
-        self.history.write_state(&mut w);
-        let payload = (w.buf.len() - HEADER) as u64;
-        w.buf[16..24].copy_from_slice(&payload.to_le_bytes());
-        let crc = crc32fast::hash(&w.buf);
-        w.u32(crc);
-        w.buf
+        self.history.write_state(w)
     }
 
     /// Restores a state saved by [`Cloth::save_snapshot`] from a cloth of the same topology and
@@ -277,7 +285,20 @@ impl Cloth {
         super::check_solver(&solver)?;
         for (what, vs) in [("position", &x), ("velocity", &v), ("pin target", &targets)] {
             vs.iter().try_for_each(|p| check_finite_vec(what, p))?;
+            if let Some(i) = vs.iter().position(|p| p.amax() >= MAX_COORDINATE) {
+                return Err(Error::invalid(format!(
+                    "snapshot: {what} of vertex {i} is beyond the float range the ABI hands out"
+                )));
+            }
         }
+        let limit = self.config.max_speed;
+        if let Some(i) = v.iter().position(|p| p.norm() > limit) {
+            return Err(Error::invalid(format!(
+                "snapshot: vertex {i} moves at {:.3e} m/s, above this cloth's max_speed {limit} m/s",
+                v[i].norm()
+            )));
+        }
+        history.check_state(time)?;
         for (i, &w) in weights.iter().enumerate() {
             check_weight(i, w)?;
         }
@@ -313,9 +334,12 @@ impl Cloth {
         Ok(())
     }
 
-    /// Size in bytes of [`Cloth::save_snapshot`]'s result now.
+    /// Size in bytes of [`Cloth::save_snapshot`]'s result now, counted without building it.
     pub fn snapshot_size(&self) -> usize {
-        self.save_snapshot().len()
+        let mut w = ByteWriter::counter();
+        // A counting writer allocates nothing and cannot fail.
+        let _ = self.write_snapshot(&mut w);
+        w.len() + 4
     }
 }
 
@@ -364,7 +388,7 @@ mod tests {
             for _ in 0..50 {
                 a.step(5e-4).unwrap();
             }
-            let snap = a.save_snapshot();
+            let snap = a.save_snapshot().unwrap();
             assert_eq!(snap.len(), a.snapshot_size());
             let mut b = cloth(scheme);
             b.load_snapshot(&snap).unwrap();

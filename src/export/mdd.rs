@@ -8,14 +8,18 @@
 //! blocks), so a long bake never sits in memory either way.
 
 use std::fs::{File, OpenOptions};
-use std::io::{self, BufWriter, Read, Seek, SeekFrom, Write};
+use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::path::Path;
 
 use crate::Vec3;
 
+/// At most this many frames may be announced: the frame times come first, and are written
+/// when the file is opened (4 bytes each: 4 MB here).
+pub const MAX_MDD_FRAMES: u32 = 1_000_000;
+
 /// Streaming MDD writer to a file.
 pub struct MddWriter {
-    out: BufWriter<File>,
+    out: File,
     vertex_count: usize,
     expected: u32,
     written: u32,
@@ -26,15 +30,32 @@ fn too_many(what: &str) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, format!("too many {what} for MDD"))
 }
 
-fn header(out: &mut impl Write, frames: u32, vertex_count: usize, fps: f64) -> io::Result<()> {
+/// The header and frame times, in one buffer.
+fn header(frames: u32, vertex_count: usize, fps: f64) -> io::Result<Vec<u8>> {
+    if frames > MAX_MDD_FRAMES {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("an MDD cache holds at most {MAX_MDD_FRAMES} frames, {frames} were announced"),
+        ));
+    }
     let frames_i = i32::try_from(frames).map_err(|_| too_many("frames"))?;
     let verts = i32::try_from(vertex_count).map_err(|_| too_many("vertices"))?;
-    out.write_all(&frames_i.to_be_bytes())?;
-    out.write_all(&verts.to_be_bytes())?;
+    let mut out = Vec::new();
+    out.try_reserve_exact(8 + 4 * frames as usize)
+        .map_err(|e| io::Error::new(io::ErrorKind::OutOfMemory, e.to_string()))?;
+    out.extend_from_slice(&frames_i.to_be_bytes());
+    out.extend_from_slice(&verts.to_be_bytes());
     for k in 0..frames {
-        out.write_all(&((f64::from(k) / fps) as f32).to_be_bytes())?;
+        let t = (f64::from(k) / fps) as f32;
+        if !t.is_finite() {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("frame {k} at {fps} fps has no finite time in seconds"),
+            ));
+        }
+        out.extend_from_slice(&t.to_be_bytes());
     }
-    Ok(())
+    Ok(out)
 }
 
 impl MddWriter {
@@ -51,8 +72,9 @@ impl MddWriter {
             .create(true)
             .truncate(true)
             .open(path)?;
-        let mut out = BufWriter::new(file);
-        header(&mut out, expected_frames, vertex_count, fps)?;
+        let head = header(expected_frames, vertex_count, fps)?;
+        let mut out = file;
+        out.write_all(&head)?;
         Ok(Self {
             out,
             vertex_count,
@@ -73,15 +95,28 @@ impl MddWriter {
                 format!("the MDD cache was opened for {} frames", self.expected),
             ));
         }
-        self.out.write_all(&super::encode_frame(positions, true))?;
+        self.out.write_all(&super::encode_frame(positions, true)?)?;
         self.written += 1;
         Ok(())
+    }
+
+    /// Frames completely written so far.
+    pub fn frames_written(&self) -> u32 {
+        self.written
+    }
+
+    /// After a failed write: cuts a partial frame off the end, then completes the file with
+    /// the frames that were written whole (as [`MddWriter::finish`] does).
+    pub fn finish_truncated(self) -> io::Result<()> {
+        let end = 8 + 4 * u64::from(self.expected) + 12 * self.vertex_count as u64 * u64::from(self.written);
+        self.out.set_len(end)?;
+        self.finish()
     }
 
     /// Flushes; if fewer frames than announced were written, compacts the file so its header
     /// tells the truth.
     pub fn finish(self) -> io::Result<()> {
-        let mut file = self.out.into_inner().map_err(|e| e.into_error())?;
+        let mut file = self.out;
         if self.written < self.expected {
             let frame_bytes = 12 * self.vertex_count as u64;
             let old_start = 8 + 4 * u64::from(self.expected);
@@ -98,9 +133,7 @@ impl MddWriter {
                 moved += n as u64;
             }
             file.seek(SeekFrom::Start(0))?;
-            let mut head = Vec::new();
-            header(&mut head, self.written, self.vertex_count, self.fps)?;
-            file.write_all(&head)?;
+            file.write_all(&header(self.written, self.vertex_count, self.fps)?)?;
             file.set_len(new_start + total)?;
         }
         file.flush()?;

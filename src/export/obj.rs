@@ -4,7 +4,8 @@ use std::io::{self, Write};
 
 use crate::Vec3;
 
-/// Writes `v x y z` lines then 1-based `f a b c` lines.
+/// Writes `v x y z` lines then 1-based `f a b c` lines, and flushes: a write that fails only
+/// when the buffer drains (a full disk) is an error, not a silently short file.
 pub fn write_obj<W: Write>(mut out: W, positions: &[Vec3], triangles: &[[u32; 3]]) -> io::Result<()> {
     writeln!(
         out,
@@ -18,5 +19,5 @@ pub fn write_obj<W: Write>(mut out: W, positions: &[Vec3], triangles: &[[u32; 3]
     for t in triangles {
         writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
     }
-    Ok(())
+    out.flush()
 }

@@ -42,9 +42,19 @@ impl<W: Write + Seek> Pc2Writer<W> {
         if positions.len() != self.vertex_count {
             return Err(io::Error::new(io::ErrorKind::InvalidInput, "wrong vertex count"));
         }
-        self.out.write_all(&super::encode_frame(positions, false))?;
+        self.out.write_all(&super::encode_frame(positions, false)?)?;
         self.samples += 1;
         Ok(())
+    }
+
+    /// Frames completely written so far.
+    pub fn frames_written(&self) -> u32 {
+        self.samples
+    }
+
+    /// Bytes of the header and of the frames completely written so far.
+    pub fn complete_len(&self) -> u64 {
+        SAMPLE_COUNT_OFFSET + 4 + 12 * self.vertex_count as u64 * u64::from(self.samples)
     }
 
     /// Patches the sample count and returns the writer.

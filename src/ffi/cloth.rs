@@ -46,19 +46,23 @@ pub(crate) unsafe fn handle_mut<'a>(cloth: *mut FcCloth) -> Result<&'a mut Cloth
 
 /// Converts float xyz triples to vectors, rejecting NaN and infinities.
 pub(crate) fn triples(xyz: &[f32], what: &str) -> Result<Vec<Vec3>, FfiError> {
-    xyz.chunks_exact(3)
-        .enumerate()
-        .map(|(k, c)| {
-            if c.iter().all(|v| v.is_finite()) {
-                Ok(Vec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])))
-            } else {
-                Err(FfiError::invalid(format!(
-                    "{what} {k} is not finite: ({}, {}, {})",
-                    c[0], c[1], c[2]
-                )))
-            }
-        })
-        .collect()
+    let mut out = Vec::new();
+    out.try_reserve_exact(xyz.len() / 3).map_err(|_| {
+        FfiError::from(crate::Error::out_of_memory(format!(
+            "no memory for {} {what}s",
+            xyz.len() / 3
+        )))
+    })?;
+    for (k, c) in xyz.chunks_exact(3).enumerate() {
+        if !c.iter().all(|v| v.is_finite()) {
+            return Err(FfiError::invalid(format!(
+                "{what} {k} is not finite: ({}, {}, {})",
+                c[0], c[1], c[2]
+            )));
+        }
+        out.push(Vec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])));
+    }
+    Ok(out)
 }
 
 fn check_float_count(cloth: &Cloth, float_count: usize) -> Result<(), FfiError> {
@@ -180,6 +184,13 @@ pub unsafe extern "C" fn fc_cloth_set_pin_weights(
     guard(|| {
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { handle_mut(cloth) }?;
+        // The length is checked before anything is read.
+        if count != cloth.vertex_count() {
+            return Err(FfiError::invalid(format!(
+                "count must be vertex_count = {}, got {count}",
+                cloth.vertex_count()
+            )));
+        }
         let weights = unsafe { slice_in(weights, count, "weights") }?;
         let w: Vec<f64> = weights.iter().map(|&w| f64::from(w)).collect();
         Ok(cloth.set_pin_weights(&w)?)
@@ -425,6 +436,26 @@ pub unsafe extern "C" fn fc_cloth_get_solver_stats(
                 *r = stats.residual;
             }
         }
+        Ok(())
+    })
+}
+
+/// Whether an implicit step whose solver stops at `solver_max_iterations` above
+/// `solver_tolerance` is accepted (`accept` non-zero: the step returns `FC_OK`; read
+/// `fc_cloth_get_solver_stats`) or refused (0, the default: `FC_ERROR_NOT_CONVERGED`, the
+/// cloth unchanged).
+///
+/// # Safety
+/// `cloth` NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_solver_accept_unconverged(
+    cloth: *mut FcCloth,
+    accept: i32,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        cloth.set_accept_unconverged(accept != 0);
         Ok(())
     })
 }

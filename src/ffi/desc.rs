@@ -289,6 +289,7 @@ impl FcClothDesc {
                 tolerance: self.solver_tolerance,
                 max_iterations: self.solver_max_iterations,
             },
+            accept_unconverged: false,
         })
     }
 }

@@ -6,7 +6,7 @@ use super::cloth::{handle, handle_mut, slice_in, FcCloth};
 use super::status::{guard, guard_value, FcStatus, FfiError};
 
 /// Bytes `fc_cloth_save_snapshot` needs now (it grows with the history for `FC_HISTORY_FULL`;
-/// constant otherwise). 0 for NULL.
+/// constant otherwise), counted without building the snapshot. 0 for NULL.
 ///
 /// # Safety
 /// `cloth` NULL or live.
@@ -20,7 +20,9 @@ pub unsafe extern "C" fn fc_cloth_snapshot_size(cloth: *const FcCloth) -> usize 
 /// friction, current, solver settings, time, and the fractional history) into `buffer`:
 /// a versioned, CRC-32-checked binary snapshot. `capacity` is the buffer size in bytes; the
 /// size written goes to `*out_written` (may be NULL). A buffer smaller than
-/// `fc_cloth_snapshot_size` gives `FC_ERROR_INVALID_ARGUMENT` and writes nothing.
+/// `fc_cloth_snapshot_size` gives `FC_ERROR_INVALID_ARGUMENT` and writes nothing;
+/// `FC_ERROR_OUT_OF_MEMORY` when the snapshot cannot be assembled. The bytes depend only on
+/// the cloth's state: after a refused step they equal the bytes saved before it.
 ///
 /// # Safety
 /// `cloth` NULL or live; `buffer` NULL or `capacity` writable bytes; `out_written` NULL or writable.
@@ -37,13 +39,13 @@ pub unsafe extern "C" fn fc_cloth_save_snapshot(
         if buffer.is_null() {
             return Err(FfiError::null("buffer"));
         }
-        let bytes = cloth.save_snapshot();
-        if bytes.len() > capacity {
+        let size = cloth.snapshot_size();
+        if size > capacity {
             return Err(FfiError::invalid(format!(
-                "snapshot needs {} bytes, buffer has {capacity}",
-                bytes.len()
+                "snapshot needs {size} bytes, buffer has {capacity}"
             )));
         }
+        let bytes = cloth.save_snapshot()?;
         // SAFETY: non-NULL; the caller promises `capacity` >= bytes.len() writable bytes.
         unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), buffer.cast::<u8>(), bytes.len()) };
         if !out_written.is_null() {
@@ -57,7 +59,10 @@ pub unsafe extern "C" fn fc_cloth_save_snapshot(
 /// Restores a snapshot saved from a cloth of the same mesh and history settings. Stepping on
 /// gives bitwise the same results as the saved cloth would have. A truncated, corrupted or
 /// foreign snapshot gives `FC_ERROR_INVALID_ARGUMENT` (the message says why) and leaves the
-/// cloth exactly as it was.
+/// cloth exactly as it was. Beyond the checksum, the contents are checked for meaning: every
+/// number finite and within the float range, speeds within this cloth's `max_speed`, history
+/// times ordered and not after the cloth's time, step sizes positive; a snapshot that loads
+/// can always be stepped, and the message names the field that was refused.
 ///
 /// # Safety
 /// `cloth` NULL or live; `data` NULL or `size` readable bytes.

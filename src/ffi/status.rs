@@ -24,6 +24,10 @@ pub enum FcStatus {
     FC_ERROR_PANIC = 5,
     /// A file could not be created, written or completed (cache writers); the message has the operating system's reason.
     FC_ERROR_IO = 6,
+    /// Memory for the request could not be allocated; nothing was changed (the process is never aborted for it).
+    FC_ERROR_OUT_OF_MEMORY = 7,
+    /// An implicit step's solver stopped at `solver_max_iterations` above `solver_tolerance`; the cloth is unchanged. Raise the cap, loosen the tolerance, shorten dt, or accept such steps with `fc_cloth_set_solver_accept_unconverged`.
+    FC_ERROR_NOT_CONVERGED = 8,
 }
 
 thread_local! {
@@ -51,10 +55,10 @@ impl FfiError {
         }
     }
     pub fn io(what: &str, e: &std::io::Error) -> Self {
-        let status = if e.kind() == std::io::ErrorKind::InvalidInput {
-            FcStatus::FC_ERROR_INVALID_ARGUMENT
-        } else {
-            FcStatus::FC_ERROR_IO
+        let status = match e.kind() {
+            std::io::ErrorKind::InvalidInput => FcStatus::FC_ERROR_INVALID_ARGUMENT,
+            std::io::ErrorKind::OutOfMemory => FcStatus::FC_ERROR_OUT_OF_MEMORY,
+            _ => FcStatus::FC_ERROR_IO,
         };
         Self {
             status,
@@ -69,6 +73,8 @@ impl From<Error> for FfiError {
             ErrorKind::InvalidArgument => FcStatus::FC_ERROR_INVALID_ARGUMENT,
             ErrorKind::OutOfRange => FcStatus::FC_ERROR_OUT_OF_RANGE,
             ErrorKind::Unstable => FcStatus::FC_ERROR_UNSTABLE,
+            ErrorKind::OutOfMemory => FcStatus::FC_ERROR_OUT_OF_MEMORY,
+            ErrorKind::NotConverged => FcStatus::FC_ERROR_NOT_CONVERGED,
         };
         Self {
             status,
@@ -133,6 +139,8 @@ pub extern "C" fn fc_status_string(status: i32) -> *const c_char {
         4 => c"unstable",
         5 => c"internal error",
         6 => c"i/o error",
+        7 => c"out of memory",
+        8 => c"solver did not converge",
         _ => c"unknown status",
     };
     s.as_ptr()

@@ -97,6 +97,36 @@ impl Full {
         w.f64(self.now);
     }
 
+    /// Checks a state read from a snapshot: times finite, increasing, not after `now_cloth`;
+    /// every sample finite.
+    pub(crate) fn check_state(&self, now_cloth: f64) -> Result<(), crate::Error> {
+        let bad = |m: String| Err(crate::Error::invalid(format!("snapshot: full history {m}")));
+        let slack = 1e-9 * now_cloth.abs().max(1.0);
+        if let Some(k) = self
+            .times
+            .iter()
+            .position(|t| !t.is_finite() || *t < 0.0 || *t > now_cloth + slack)
+        {
+            return bad(format!(
+                "time {k} ({}) is not within [0, {now_cloth}]",
+                self.times[k]
+            ));
+        }
+        if let Some(k) = self.times.windows(2).position(|w| w[1] <= w[0]) {
+            return bad(format!("times {k} and {} are not increasing", k + 1));
+        }
+        if !(self.now.is_finite() && self.now <= now_cloth + slack) {
+            return bad(format!(
+                "time now {} is not finite or is after the cloth's {now_cloth}",
+                self.now
+            ));
+        }
+        if let Some(p) = self.samples.iter().position(|v| !v.iter().all(|c| c.is_finite())) {
+            return bad(format!("sample {p} is not finite"));
+        }
+        Ok(())
+    }
+
     /// Reads what `write_state` wrote, for the same particle count.
     pub(crate) fn read_state(&mut self, r: &mut crate::bytes::ByteReader<'_>) -> Result<(), crate::Error> {
         r.f64s_into(None, &mut self.times)?;

@@ -225,17 +225,42 @@ impl History {
         }
     }
 
-    /// Writes the state (see each scheme's `write_state`).
-    pub(crate) fn write_state(&self, w: &mut crate::bytes::ByteWriter) {
+    /// Writes the state (see each scheme's `write_state`). The bytes are canonical: a
+    /// recorded sample that the next step would fold into the SOE modes is folded into the
+    /// written state (in a copy), so the bytes do not depend on whether a refused step
+    /// already folded it. Folding early or in the step gives the same bits.
+    pub(crate) fn write_state(&self, w: &mut crate::bytes::ByteWriter) -> Result<(), Error> {
         match self {
             History::Off => {}
             History::Truncated(s) => s.write_state(w),
             History::Full(s) => s.write_state(w),
+            History::SumOfExponentials(s) if s.has_pending_fold() && !w.is_counting() => {
+                crate::memory::ensure_available(
+                    s.bytes_per_particle() as u64 * s.particle_count() as u64,
+                    "a snapshot of the SOE history",
+                )?;
+                let mut copy = s.clone();
+                copy.fold_pending();
+                copy.write_state(w);
+            }
             History::SumOfExponentials(s) => s.write_state(w),
+        }
+        Ok(())
+    }
+
+    /// Checks a state read from a snapshot for meaning: every number finite, step sizes
+    /// positive, sample times ordered and not after the cloth's time `now` (s).
+    pub(crate) fn check_state(&self, now: f64) -> Result<(), Error> {
+        match self {
+            History::Off => Ok(()),
+            History::Truncated(s) => s.check_state(),
+            History::Full(s) => s.check_state(now),
+            History::SumOfExponentials(s) => s.check_state(),
         }
     }
 
-    /// Reads a state written by `write_state` of a history of the same scheme and size.
+    /// Reads a state written by `write_state` of a history of the same scheme and size
+    /// (check its meaning with `check_state`).
     pub(crate) fn read_state(&mut self, r: &mut crate::bytes::ByteReader<'_>) -> Result<(), Error> {
         match self {
             History::Off => Ok(()),

@@ -388,6 +388,60 @@ impl SumOfExponentials {
         self.clock.recorded = Some(h);
     }
 
+    /// True when a recorded sample waits to be folded by the next step's pass.
+    pub(crate) fn has_pending_fold(&self) -> bool {
+        self.clock.recorded.is_some()
+    }
+
+    /// Particles.
+    pub(crate) fn particle_count(&self) -> usize {
+        self.n
+    }
+
+    /// Folds a recorded sample now, as the next step's pass would (the same bits).
+    pub(crate) fn fold_pending(&mut self) {
+        self.flush();
+    }
+
+    /// Checks a state read from a snapshot: every number finite, step sizes positive.
+    pub(crate) fn check_state(&self) -> Result<(), crate::Error> {
+        let k = self.kernel.len();
+        for p in 0..self.n {
+            for l in 0..k {
+                for d in 0..3 {
+                    let v = self.modes[self.mode_index(p, l, d)];
+                    if !v.is_finite() {
+                        return Err(crate::Error::invalid(format!(
+                            "snapshot: SOE history mode {l} of particle {p} is not finite ({v})"
+                        )));
+                    }
+                }
+            }
+        }
+        for (what, vs) in [("previous", &self.prev), ("recorded", &self.newest)] {
+            if let Some(p) = vs.iter().position(|v| !v.iter().all(|c| c.is_finite())) {
+                return Err(crate::Error::invalid(format!(
+                    "snapshot: SOE history {what} velocity of particle {p} is not finite"
+                )));
+            }
+        }
+        let c = &self.clock;
+        if c.has_prev && (c.gap.is_nan() || c.gap <= 0.0) {
+            return Err(crate::Error::invalid(format!(
+                "snapshot: SOE history step size {} is not > 0",
+                c.gap
+            )));
+        }
+        if let Some(h) = c.recorded {
+            if h.is_nan() || h <= 0.0 {
+                return Err(crate::Error::invalid(format!(
+                    "snapshot: SOE recorded step size {h} is not > 0"
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// Folds a recorded sample now (as a step's pass would).
     fn flush(&mut self) {
         if self.clock.recorded.is_none() {
@@ -781,7 +835,7 @@ mod tests {
         for k in 0..30 {
             a.push(&v(k), steps(k));
         }
-        let mut w = crate::bytes::ByteWriter { buf: vec![] };
+        let mut w = crate::bytes::ByteWriter::default();
         a.write_state(&mut w);
         let mut b = SumOfExponentials::new(kernel, N);
         b.read_state(&mut crate::bytes::ByteReader::new(&w.buf)).unwrap();

@@ -120,6 +120,23 @@ impl Truncated {
         w.f64(self.h);
     }
 
+    /// Checks a state read from a snapshot: every sample finite, the step size positive once
+    /// a sample was taken.
+    pub(crate) fn check_state(&self) -> Result<(), crate::Error> {
+        if let Some(p) = self.slots.iter().position(|v| !v.iter().all(|c| c.is_finite())) {
+            return Err(crate::Error::invalid(format!(
+                "snapshot: truncated history sample {p} is not finite"
+            )));
+        }
+        if !self.h.is_finite() || self.h < 0.0 || (self.pushed > 0 && self.h == 0.0) {
+            return Err(crate::Error::invalid(format!(
+                "snapshot: truncated history step size {} is not > 0",
+                self.h
+            )));
+        }
+        Ok(())
+    }
+
     /// Reads what `write_state` wrote, for the same u and particle count.
     pub(crate) fn read_state(&mut self, r: &mut crate::bytes::ByteReader<'_>) -> Result<(), crate::Error> {
         r.vec3s_into(Some(self.u * self.n), &mut self.slots)?;

@@ -55,6 +55,10 @@ impl GridSpec {
             )));
         }
         let n = (w * h) as usize;
+        crate::memory::ensure_available(
+            n as u64 * crate::memory::TOPOLOGY_BYTES_PER_PARTICLE,
+            &format!("a {w} x {h} grid"),
+        )?;
         let s = self.spacing;
         let x0 = -0.5 * s * f64::from(w - 1);
         let mut rest_positions = Vec::with_capacity(n);

@@ -68,6 +68,11 @@ impl MeshSpec<'_> {
                 self.indices.len()
             )));
         }
+        crate::memory::ensure_available(
+            (n as u64 * crate::memory::TOPOLOGY_BYTES_PER_PARTICLE)
+                .saturating_add(self.indices.len() as u64 * 64),
+            &format!("a mesh of {n} vertices and {} indices", self.indices.len()),
+        )?;
         if let Some(i) = self
             .positions
             .iter()
