@@ -119,7 +119,21 @@ struct Snapshot {
 }
 
 impl Snapshot {
-    fn save(&mut self, c: &Cloth) {
+    /// Copies the state, or fails with an out-of-memory error when the copy of a history
+    /// that grew (the full history) cannot be allocated.
+    fn save(&mut self, c: &Cloth) -> Result<(), Error> {
+        use crate::history::HalfDerivative;
+        let need = c.history.bytes_per_particle() as u64 * c.x.len() as u64;
+        let have = self
+            .history
+            .as_ref()
+            .map_or(0, |h| h.bytes_per_particle() as u64 * c.x.len() as u64);
+        if need > have {
+            crate::memory::ensure_available(
+                2 * (need - have),
+                "the copy that makes a multi-substep call atomic",
+            )?;
+        }
         self.x.clone_from(&c.x);
         self.v.clone_from(&c.v);
         match &mut self.history {
@@ -128,6 +142,7 @@ impl Snapshot {
         }
         self.time = c.time;
         self.steps = c.steps;
+        Ok(())
     }
 
     fn restore(&mut self, c: &mut Cloth) {
@@ -530,7 +545,10 @@ impl Cloth {
         }
         let h = dt / f64::from(substeps);
         let mut snap = std::mem::take(&mut self.snapshot);
-        snap.save(self);
+        if let Err(e) = snap.save(self) {
+            self.snapshot = snap;
+            return Err(e);
+        }
         self.scratch.pin_start.clear();
         self.scratch
             .pin_start

@@ -111,6 +111,7 @@ fuzz_target!(|data: &[u8]| {
     let dir = std::env::temp_dir().join("fraccloth-fuzz");
     let _ = std::fs::create_dir_all(&dir);
     let cache_path = CString::new(dir.join("c.pc2").to_str().unwrap_or("c.pc2")).unwrap_or_default();
+    let full_path = CString::new("/dev/full").unwrap_or_default();
     let mut snapshot: Vec<u8> = vec![];
     while !b.done() && cloths.len() <= 3 {
         let op = b.u8();
@@ -270,12 +271,22 @@ fuzz_target!(|data: &[u8]| {
                     if !s.is_empty() && pick % 2 == 0 {
                         let at = usize::from(b.u8()) * 7 % s.len();
                         s[at] ^= b.u8();
+                        // Half the time the checksum is made right again, so the mutation
+                        // reaches the checks of meaning behind it.
+                        if pick % 4 == 0 && s.len() > 28 {
+                            let end = s.len() - 4;
+                            let crc = crc32fast::hash(&s[..end]);
+                            s[end..].copy_from_slice(&crc.to_le_bytes());
+                        }
                     }
                     if pick % 3 == 0 {
                         s = (0..usize::from(b.u8())).map(|_| b.u8()).collect();
                     }
                     let len = b.len(s.len()).min(s.len());
-                    let _ = fc_cloth_load_snapshot(c, s.as_ptr().cast::<c_void>(), len);
+                    if fc_cloth_load_snapshot(c, s.as_ptr().cast::<c_void>(), len) == FcStatus::FC_OK {
+                        // A snapshot that loads can be stepped: never a panic.
+                        assert_ne!(fc_cloth_step(c, 1e-4), FcStatus::FC_ERROR_PANIC);
+                    }
                 }
                 19 => {
                     let _ = fc_cloth_set_solver(c, b.f64(), u32::from(b.u8()));
@@ -285,9 +296,11 @@ fuzz_target!(|data: &[u8]| {
                 20 => {
                     let mut cache = null_mut();
                     let format = u32::from(b.u8() % 4);
+                    // Half the caches go to a device where every write fails part-way.
+                    let path = if pick % 2 == 0 { &cache_path } else { &full_path };
                     if format != 2
                         && fc_cache_open(
-                            cache_path.as_ptr(),
+                            path.as_ptr(),
                             format,
                             c,
                             b.f64(),
@@ -296,10 +309,15 @@ fuzz_target!(|data: &[u8]| {
                             &mut cache,
                         ) == FcStatus::FC_OK
                     {
+                        let mut failed = false;
                         for _ in 0..b.u8() % 6 {
-                            let _ = fc_cache_write_frame(cache, c);
+                            let s = fc_cache_write_frame(cache, c);
+                            // Once a frame failed, every later one fails too.
+                            assert!(!failed || s != FcStatus::FC_OK);
+                            failed |= s == FcStatus::FC_ERROR_IO;
                         }
-                        let _ = fc_cache_close(cache);
+                        let s = fc_cache_close(cache);
+                        assert!(!failed || s != FcStatus::FC_OK, "a failed cache closed with FC_OK");
                     }
                 }
                 21 => {

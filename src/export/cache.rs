@@ -66,6 +66,14 @@ pub fn sequence_path(path: &Path, frame: i64) -> PathBuf {
     PathBuf::from(name)
 }
 
+/// Removes a cache file that cannot be repaired; only a regular file (never a device such as
+/// `/dev/full` that a host may write to).
+fn discard(path: &Path) {
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
+        let _ = std::fs::remove_file(path);
+    }
+}
+
 fn invalid(msg: String) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, msg)
 }
@@ -74,7 +82,7 @@ fn invalid(msg: String) -> io::Error {
 fn obj_file(path: &Path, positions: &[Vec3], triangles: &[[u32; 3]]) -> io::Result<()> {
     let result = File::create(path).and_then(|f| write_obj(BufWriter::new(f), positions, triangles));
     if result.is_err() {
-        let _ = std::fs::remove_file(path);
+        discard(path);
     }
     result
 }
@@ -155,12 +163,12 @@ impl CacheWriter {
                     f.sync_all()
                 };
                 if writer.finish().and_then(repair).is_err() {
-                    let _ = std::fs::remove_file(&path);
+                    discard(&path);
                 }
             }
             Inner::Mdd { writer, path } => {
                 if writer.finish_truncated().is_err() {
-                    let _ = std::fs::remove_file(&path);
+                    discard(&path);
                 }
             }
             Inner::Obj { .. } | Inner::Failed(..) => {}
@@ -204,10 +212,10 @@ impl CacheWriter {
             Inner::Failed(io::ErrorKind::Other, String::new()),
         ) {
             Inner::Pc2 { writer, path } => writer.finish().and_then(|f| f.sync_all()).inspect_err(|_| {
-                let _ = std::fs::remove_file(&path);
+                discard(&path);
             }),
             Inner::Mdd { writer, path } => writer.finish().inspect_err(|_| {
-                let _ = std::fs::remove_file(&path);
+                discard(&path);
             }),
             Inner::Obj { .. } | Inner::Failed(..) => Ok(()),
         }

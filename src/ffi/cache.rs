@@ -47,7 +47,9 @@ unsafe fn path_in(path: *const c_char) -> Result<PathBuf, FfiError> {
 /// rate (MDD stores times in seconds); `expected_frames`: how many frames will be written
 /// (MDD only; ignored otherwise). Write frames with `fc_cache_write_frame`; finish with
 /// `fc_cache_close`. Errors: `FC_ERROR_IO` if the file cannot be created,
-/// `FC_ERROR_INVALID_ARGUMENT` for a bad format or rate.
+/// `FC_ERROR_INVALID_ARGUMENT` for a bad format, |start_frame| > 1e9, a rate outside
+/// [1e-3, 1e6] frames per second, or more than 1000000 expected frames for MDD (whose frame
+/// times are written when it opens).
 ///
 /// # Safety
 /// `path` NULL or a NUL-terminated string; `cloth` NULL or live; `out_cache` NULL or writable.
@@ -99,7 +101,10 @@ pub unsafe extern "C" fn fc_cache_open(
 }
 
 /// Appends the current positions of `cloth` (which must have the vertex count the cache was
-/// opened for) as the next frame.
+/// opened for) as the next frame. A frame that cannot be written whole (`FC_ERROR_IO`: a full
+/// disk, a file-size limit) poisons the cache: the file is cut back to its complete frames with
+/// a header that counts them (or removed if that fails too), and every later frame and
+/// `fc_cache_close` return the first error.
 ///
 /// # Safety
 /// `cache` NULL or live (not closed); `cloth` NULL or live.
@@ -121,8 +126,9 @@ pub unsafe extern "C" fn fc_cache_write_frame(cache: *mut FcCache, cloth: *const
     })
 }
 
-/// Completes the cache file (patches its frame count) and frees the handle, also when
-/// completing fails (the status then says why). NULL is fine.
+/// Completes the cache file (patches its frame count, flushes it to disk) and frees the handle,
+/// also when completing fails (the status then says why). A cache that failed earlier returns
+/// that first error. NULL is fine.
 ///
 /// # Safety
 /// `cache` NULL or a live handle from `fc_cache_open`; not used afterwards.
@@ -144,7 +150,8 @@ pub unsafe extern "C" fn fc_cache_close(cache: *mut FcCache) -> FcStatus {
 }
 
 /// Writes the current positions of `cloth` as one OBJ mesh (vertices and triangles) at
-/// `path` (UTF-8). Errors: `FC_ERROR_IO` when the file cannot be written.
+/// `path` (UTF-8). Errors: `FC_ERROR_IO` when the file cannot be written whole (every byte is
+/// flushed and checked).
 ///
 /// # Safety
 /// `cloth` NULL or live; `path` NULL or a NUL-terminated string.

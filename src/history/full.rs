@@ -84,7 +84,7 @@ impl Full {
                 self.times.len()
             )));
         }
-        let room = |e| crate::Error::invalid(format!("out of memory for the full history: {e}"));
+        let room = |e| crate::Error::out_of_memory(format!("out of memory for the full history: {e}"));
         self.samples.try_reserve(self.n).map_err(room)?;
         self.times.try_reserve(1).map_err(room)?;
         Ok(())

@@ -1,0 +1,127 @@
+//! Running out of memory is an error, never an abort: under an address-space limit (as
+//! `ulimit -v` or a container sets), requests too large for it return
+//! `FC_ERROR_OUT_OF_MEMORY` and the process goes on.
+//!
+//! One test in its own binary: the limit applies to the whole process.
+
+use std::ptr::null_mut;
+
+use fraccloth::ffi::FcStatus::*;
+use fraccloth::ffi::*;
+
+fn vm_size() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmSize:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+fn set_address_space_limit(bytes: u64) -> libc::rlimit {
+    let mut old = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    unsafe {
+        assert_eq!(libc::getrlimit(libc::RLIMIT_AS, &mut old), 0);
+        let new = libc::rlimit {
+            rlim_cur: bytes as libc::rlim_t,
+            rlim_max: old.rlim_max,
+        };
+        assert_eq!(libc::setrlimit(libc::RLIMIT_AS, &new), 0);
+    }
+    old
+}
+
+fn create(width: u32, height: u32, scheme: u32, u: u32) -> (FcStatus, *mut FcCloth) {
+    let mut desc = fc_cloth_desc_default();
+    desc.width = width;
+    desc.height = height;
+    desc.history_scheme = scheme;
+    desc.history_u = u;
+    desc.integrator = 1; // symplectic: stable at 1 ms
+    let mut c = null_mut();
+    (unsafe { fc_cloth_create_grid(&desc, &mut c) }, c)
+}
+
+#[test]
+fn requests_too_large_for_memory_are_refused_not_aborted() {
+    let Some(vm) = vm_size() else {
+        eprintln!("no /proc/self/status: skipped");
+        return;
+    };
+    // Before the limit: a cloth with a long full history (about 120 MB) and a host buffer
+    // for its snapshot.
+    let (s, full) = create(101, 84, 2 /* FC_HISTORY_FULL */, 3);
+    assert_eq!(s, FC_OK);
+    let top: Vec<u32> = (0..101).collect();
+    unsafe {
+        assert_eq!(fc_cloth_set_pinned(full, top.as_ptr(), top.len()), FC_OK);
+        for _ in 0..500 {
+            assert_eq!(fc_cloth_step(full, 1e-3), FC_OK);
+        }
+    }
+    let size = unsafe { fc_cloth_snapshot_size(full) };
+    assert!(size > 100_000_000, "{size}");
+    let mut buffer = vec![0u8; size];
+    let mesh_xyz: Vec<f32> = (0..6_000_000).map(|k| (k % 1000) as f32 * 1e-3).collect();
+
+    let old = set_address_space_limit(vm + 32 * 1024 * 1024 + size as u64);
+
+    // Sizing the snapshot allocates nothing; assembling it needs its size again: refused.
+    assert_eq!(unsafe { fc_cloth_snapshot_size(full) }, size);
+    let mut written = 0;
+    let s = unsafe { fc_cloth_save_snapshot(full, buffer.as_mut_ptr().cast(), size, &mut written) };
+    assert!(s == FC_ERROR_OUT_OF_MEMORY || s == FC_OK, "{s:?}");
+    // A call of several substeps keeps a copy of the state to stay atomic: with a history
+    // this long the copy does not fit, and the call is refused, not aborted.
+    assert_eq!(
+        unsafe { fc_cloth_step_substeps(full, 0.01, 10) },
+        FC_ERROR_OUT_OF_MEMORY
+    );
+    // Single steps grow the full history until it no longer fits: refused, not aborted.
+    let mut refused = FC_OK;
+    for _ in 0..400 {
+        refused = unsafe { fc_cloth_step(full, 1e-3) };
+        if refused != FC_OK {
+            break;
+        }
+    }
+    assert_eq!(refused, FC_ERROR_OUT_OF_MEMORY);
+    unsafe { fc_cloth_destroy(full) };
+
+    // Grids far beyond the limit: the documented largest, and 1024 x 1024.
+    for (w, h) in [(4096, 4096), (1024, 1024)] {
+        let (s, c) = create(w, h, 0, 3);
+        assert_eq!(s, FC_ERROR_OUT_OF_MEMORY, "{w} x {h}");
+        assert!(c.is_null());
+    }
+    // A truncated history with a very large u.
+    let (s, c) = create(100, 100, 1 /* FC_HISTORY_TRUNCATED */, 20_000);
+    assert_eq!(s, FC_ERROR_OUT_OF_MEMORY);
+    assert!(c.is_null());
+    // A mesh of two million vertices (the host's arrays exist; the cloth would not fit).
+    let desc = fc_cloth_desc_default();
+    let indices = [0u32, 1, 2];
+    let mut m = null_mut();
+    let s = unsafe {
+        fc_cloth_create_mesh(
+            &desc,
+            mesh_xyz.as_ptr(),
+            mesh_xyz.len() / 3,
+            indices.as_ptr(),
+            3,
+            3,
+            &mut m,
+        )
+    };
+    assert_eq!(s, FC_ERROR_OUT_OF_MEMORY);
+    assert!(m.is_null());
+    // What fits still works under the limit.
+    let (s, c) = create(61, 41, 0, 3);
+    assert_eq!(s, FC_OK);
+    unsafe {
+        assert_eq!(fc_cloth_step(c, 1e-3), FC_OK);
+        fc_cloth_destroy(c);
+    }
+    unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
+}
