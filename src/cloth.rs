@@ -8,20 +8,19 @@
 
 mod prepass;
 mod snapshot;
+mod step;
+
+use step::{Rollback, StepScratch};
 
 pub use snapshot::SNAPSHOT_VERSION;
 
 use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
-use crate::forces::{self, Collider, ForceInput, ForceScratch, Plane, Sphere};
+use crate::forces::{self, Collider, Plane, Sphere};
 use crate::history::{History, Scheme};
-use crate::integrate::{
-    self, implicit_euler, ImplicitInput, ImplicitScratch, Integrator, SolverSettings, SolverStats,
-};
+use crate::integrate::{Integrator, SolverSettings, SolverStats};
 use crate::model::Model;
-use crate::parallel;
 use crate::topology::Topology;
 use crate::Vec3;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Everything that configures a cloth besides its topology.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,10 +50,8 @@ pub const MAX_COORDINATE: f64 = f32::MAX as f64;
 /// would take 3e35 steps.
 const FAR_STEP: f64 = 1.0e3;
 
-/// Particles per tile of the pass before the forces (its arrays for a tile fit in L1).
-const PASS_TILE: usize = 256;
 // The history's pass needs ranges on its blocks (`History::begin_step`).
-const _: () = assert!(PASS_TILE % crate::history::SOE_BLOCK == 0 && parallel::CHUNK % PASS_TILE == 0);
+const _: () = assert!(crate::parallel::TILE % crate::history::SOE_BLOCK == 0);
 
 /// Most substeps one call may take.
 pub const MAX_SUBSTEPS: u32 = 1_000_000;
@@ -93,69 +90,6 @@ impl Default for ClothConfig {
     }
 }
 
-#[derive(Clone, Debug, Default)]
-struct Scratch {
-    v_step: Vec<Vec3>,
-    v_rel: Vec<Vec3>,
-    half: Vec<Vec3>,
-    force: Vec<Vec3>,
-    x_new: Vec<Vec3>,
-    v_new: Vec<Vec3>,
-    goal: Vec<Vec3>,
-    pin_start: Vec<Vec3>,
-    hard_pins: Vec<u32>,
-    forces: ForceScratch,
-    implicit: ImplicitScratch,
-}
-
-/// State saved before a multi-substep call, restored if a substep fails.
-#[derive(Clone, Debug, Default)]
-struct Snapshot {
-    x: Vec<Vec3>,
-    v: Vec<Vec3>,
-    history: Option<History>,
-    time: f64,
-    steps: u64,
-}
-
-impl Snapshot {
-    /// Copies the state, or fails with an out-of-memory error when the copy of a history
-    /// that grew (the full history) cannot be allocated.
-    fn save(&mut self, c: &Cloth) -> Result<(), Error> {
-        use crate::history::HalfDerivative;
-        let need = c.history.bytes_per_particle() as u64 * c.x.len() as u64;
-        let have = self
-            .history
-            .as_ref()
-            .map_or(0, |h| h.bytes_per_particle() as u64 * c.x.len() as u64);
-        if need > have {
-            crate::memory::ensure_available(
-                2 * (need - have),
-                "the copy that makes a multi-substep call atomic",
-            )?;
-        }
-        self.x.clone_from(&c.x);
-        self.v.clone_from(&c.v);
-        match &mut self.history {
-            Some(h) => h.clone_from(&c.history),
-            None => self.history = Some(c.history.clone()),
-        }
-        self.time = c.time;
-        self.steps = c.steps;
-        Ok(())
-    }
-
-    fn restore(&mut self, c: &mut Cloth) {
-        std::mem::swap(&mut c.x, &mut self.x);
-        std::mem::swap(&mut c.v, &mut self.v);
-        if let Some(h) = &mut self.history {
-            std::mem::swap(&mut c.history, h);
-        }
-        c.time = self.time;
-        c.steps = self.steps;
-    }
-}
-
 /// One cloth: topology, configuration and state.
 #[derive(Clone, Debug)]
 pub struct Cloth {
@@ -177,8 +111,8 @@ pub struct Cloth {
     history: History,
     time: f64,
     steps: u64,
-    scratch: Scratch,
-    snapshot: Snapshot,
+    scratch: StepScratch,
+    rollback: Rollback,
     solver_stats: SolverStats,
 }
 
@@ -232,8 +166,8 @@ impl Cloth {
             history: History::new(scheme, n)?,
             time: 0.0,
             steps: 0,
-            scratch: Scratch::default(),
-            snapshot: Snapshot::default(),
+            scratch: StepScratch::default(),
+            rollback: Rollback::default(),
             solver_stats: SolverStats::default(),
             topology,
             config,
@@ -544,9 +478,9 @@ impl Cloth {
             return self.advance(dt, None);
         }
         let h = dt / f64::from(substeps);
-        let mut snap = std::mem::take(&mut self.snapshot);
+        let mut snap = std::mem::take(&mut self.rollback);
         if let Err(e) = snap.save(self) {
-            self.snapshot = snap;
+            self.rollback = snap;
             return Err(e);
         }
         self.scratch.pin_start.clear();
@@ -557,12 +491,12 @@ impl Cloth {
             let goal = (k < substeps).then_some(f64::from(k) / f64::from(substeps));
             if let Err(mut e) = self.advance(h, goal) {
                 snap.restore(self);
-                self.snapshot = snap;
+                self.rollback = snap;
                 e.message = format!("substep {k} of {substeps}: {}", e.message);
                 return Err(e);
             }
         }
-        self.snapshot = snap;
+        self.rollback = snap;
         Ok(())
     }
 
@@ -582,309 +516,6 @@ impl Cloth {
         check_solver(&settings)?;
         self.config.solver = settings;
         Ok(())
-    }
-
-    /// One step of size `h`. Pins go to `pin_start + fraction (target - pin_start)`, or to
-    /// their targets when `fraction` is None.
-    fn advance(&mut self, h: f64, fraction: Option<f64>) -> Result<(), Error> {
-        self.history.reserve_step()?;
-        let n = self.vertex_count();
-        let s = &mut self.scratch;
-        for buf in [
-            &mut s.v_step,
-            &mut s.v_rel,
-            &mut s.half,
-            &mut s.force,
-            &mut s.x_new,
-            &mut s.v_new,
-            &mut s.goal,
-        ] {
-            buf.resize(n, Vec3::zeros());
-        }
-        // Pins move in a straight line to their goals over the step; that is their velocity.
-        for (k, &i) in self.pin_list.iter().enumerate() {
-            let i = i as usize;
-            s.goal[i] = match fraction {
-                Some(f) => s.pin_start[k] + f * (self.pin_target[i] - s.pin_start[k]),
-                None => self.pin_target[i],
-            };
-        }
-        // One pass over the particles: the step's velocities (pins' from their goals), the
-        // velocity relative to the water, D^{1/2}x_n = w0 v_n + H_n of it, and the component
-        // arrays the spring pass reads (positions and damping rate).
-        let par = parallel::worth_it(n);
-        let with_history = !self.history.is_off();
-        // The history folds the last accepted step in during this pass (SOE).
-        let past = with_history.then(|| self.history.begin_step());
-        let w0 = past.as_ref().map_or(0.0, |p| p.current_weight());
-        // Fully pinned particles, ascending, to find those of a tile by bisection.
-        s.hard_pins.clear();
-        s.hard_pins
-            .extend(self.pin_list.iter().filter(|&&i| self.pinned[i as usize]));
-        s.hard_pins.sort_unstable();
-        let hard_pins = &s.hard_pins;
-        let rate = forces::spring_rate(&self.config.model);
-        let current = self.config.model.current;
-        // A tile walk transposes its own spring inputs; only other topologies need them here.
-        let arrays = !forces::tiled(&self.topology);
-        let (sx, sq) = s.forces.spring_arrays(if arrays { n } else { 0 });
-        // This chunk's part of a component array, or nothing when the arrays are not kept.
-        fn part<'a>(a: &parallel::Disjoint<'a, f64>, r: std::ops::Range<usize>) -> &'a mut [f64] {
-            if a.is_empty() {
-                return &mut [];
-            }
-            // SAFETY: every task borrows only its own chunk `r` of each array.
-            unsafe { a.range(r) }
-        }
-        let (x, v, goal) = (&self.x, &self.v, &s.goal);
-        let (v_step, v_rel, half) = (
-            parallel::Disjoint::new(&mut s.v_step),
-            parallel::Disjoint::new(&mut s.v_rel),
-            parallel::Disjoint::new(&mut s.half),
-        );
-        let [sx, sy, sz] = sx.slices_mut().map(parallel::Disjoint::new);
-        let [qx, qy, qz] = sq.slices_mut().map(parallel::Disjoint::new);
-        parallel::for_chunks(par, n, parallel::CHUNK, |first, len| {
-            let r = first..first + len;
-            // SAFETY: every task borrows only its own chunk `r` of each array.
-            let (v_step, v_rel, half) = unsafe {
-                (
-                    v_step.range(r.clone()),
-                    v_rel.range(r.clone()),
-                    half.range(r.clone()),
-                )
-            };
-            let (sx, sy, sz) = (part(&sx, r.clone()), part(&sy, r.clone()), part(&sz, r.clone()));
-            let (qx, qy, qz) = (part(&qx, r.clone()), part(&qy, r.clone()), part(&qz, r.clone()));
-            let (x, v) = (&x[r.clone()], &v[r.clone()]);
-            // Tile by tile, so that the loops below find the tile's numbers in L1.
-            for t0 in (0..len).step_by(PASS_TILE) {
-                let t = t0..(t0 + PASS_TILE).min(len);
-                // The tile in the component arrays: nothing when they are not kept.
-                let ts = if arrays { t.clone() } else { 0..0 };
-                prepass::velocities_and_positions(
-                    &x[t.clone()],
-                    &v[t.clone()],
-                    current,
-                    &mut v_step[t.clone()],
-                    &mut v_rel[t.clone()],
-                    [&mut sx[ts.clone()], &mut sy[ts.clone()], &mut sz[ts.clone()]],
-                );
-                // Fully pinned particles move to their goals: that is their velocity.
-                let (lo, hi) = (first + t.start, first + t.end);
-                let pins = &hard_pins[hard_pins.partition_point(|&i| (i as usize) < lo)..];
-                for &i in pins.iter().take_while(|&&i| (i as usize) < hi) {
-                    let (p, k) = (i as usize, i as usize - first);
-                    v_step[k] = (goal[p] - x[k]) / h;
-                    v_rel[k] = v_step[k] - current;
-                }
-                if let Some(past) = &past {
-                    // SAFETY: every particle once; tiles start on multiples of PASS_TILE and
-                    // end on one or at the last particle, so on blocks of 16.
-                    unsafe { past.past_range(lo, &mut half[t.clone()]) };
-                }
-                // The damping rate's component arrays: none for undamped springs.
-                let (rate, q): (Option<&[Vec3]>, [&mut [f64]; 3]) = match rate {
-                    forces::SpringRate::None if !with_history => continue,
-                    forces::SpringRate::None => (None, [&mut [], &mut [], &mut []]),
-                    forces::SpringRate::HalfDerivative => (
-                        None,
-                        [&mut qx[ts.clone()], &mut qy[ts.clone()], &mut qz[ts.clone()]],
-                    ),
-                    forces::SpringRate::Velocity => (
-                        Some(&v_step[t.clone()]),
-                        [&mut qx[ts.clone()], &mut qy[ts.clone()], &mut qz[ts.clone()]],
-                    ),
-                };
-                prepass::add_current_and_split(
-                    with_history.then_some(w0),
-                    &v_rel[t.clone()],
-                    &mut half[t.clone()],
-                    rate,
-                    q,
-                );
-            }
-        });
-        if with_history {
-            self.history.end_step();
-        }
-        let input = ForceInput {
-            model: &self.config.model,
-            topology: &self.topology,
-            x: &self.x,
-            v: &s.v_step,
-            half_derivative: &s.half,
-            colliders: &self.colliders,
-        };
-        let masses = &self.topology.masses;
-        let explicit = self.config.integrator.explicit_step();
-        let friction = forces::friction_active(&self.colliders, &self.friction);
-        // Whether every particle the integrator wrote (before pins) was sound; None when the
-        // check is left to `check_sound`.
-        let mut integrated_sound = None;
-        if let (Some(step), false) = (explicit, friction) {
-            // Integrate each tile as soon as its forces are known, and check it there: no
-            // force array is written and read back, no separate pass checks the result.
-            let vmax2 = self.config.max_speed * self.config.max_speed;
-            let all_sound = AtomicBool::new(true);
-            let (x_new, v_new) = (
-                parallel::Disjoint::new(&mut s.x_new),
-                parallel::Disjoint::new(&mut s.v_new),
-            );
-            let v_step = &s.v_step;
-            let soa_step = self.config.integrator.explicit_step_soa();
-            if let (Some(step), true) = (soa_step, forces::soa_applies(&input)) {
-                // The same, on the component arrays the tile walk has in cache.
-                forces::accumulate_tiles_soa(&input, &mut s.forces, |tile| {
-                    let r = tile.p0..tile.p0 + tile.force[0].len();
-                    // SAFETY: each tile is handed over once and tiles are disjoint.
-                    let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
-                    let input = integrate::SoaStepInput {
-                        h,
-                        x: tile.x,
-                        v: tile.v,
-                        force: tile.force,
-                        masses: &masses[r],
-                        max_speed2: vmax2,
-                    };
-                    if !step(&input, xn, vn) {
-                        all_sound.store(false, Ordering::Relaxed);
-                    }
-                });
-            } else {
-                forces::accumulate_tiles(&input, &mut s.forces, |p0, f| {
-                    let r = p0..p0 + f.len();
-                    // SAFETY: each tile is handed over once and tiles are disjoint.
-                    let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
-                    let input = integrate::StepInput {
-                        h,
-                        x: &x[r.clone()],
-                        v: &v_step[r.clone()],
-                        force: f,
-                        masses: &masses[r],
-                    };
-                    step(&input, xn, vn);
-                    if !integrate::sound(xn, vn, vmax2) {
-                        all_sound.store(false, Ordering::Relaxed);
-                    }
-                });
-            }
-            integrated_sound = Some(all_sound.into_inner());
-        } else {
-            forces::accumulate_filled(&input, &mut s.forces, &mut s.force);
-            match explicit {
-                Some(step) => {
-                    let input = integrate::StepInput {
-                        h,
-                        x: &self.x,
-                        v: &s.v_step,
-                        force: &s.force,
-                        masses,
-                    };
-                    integrate::step_all(step, &input, &mut s.x_new, &mut s.v_new)
-                }
-                None => {
-                    forces::linearise(&input, w0, s.forces.normals(), &mut s.implicit.lin);
-                    let inp = ImplicitInput {
-                        h,
-                        x: &self.x,
-                        v: &s.v_step,
-                        force: &s.force,
-                        masses,
-                        topology: &self.topology,
-                        pinned: &self.pinned,
-                        settings: self.config.solver,
-                    };
-                    self.solver_stats = implicit_euler(&inp, &mut s.implicit, &mut s.v_new);
-                    let st = self.solver_stats;
-                    if st.residual > self.config.solver.tolerance && !self.config.accept_unconverged {
-                        return Err(Error::not_converged(format!(
-                            "the implicit solver stopped after {} iterations at relative residual {:.3e}, above its tolerance {:e}; state left unchanged: raise solver_max_iterations, loosen solver_tolerance, shorten dt, or accept such steps",
-                            st.iterations, st.residual, self.config.solver.tolerance
-                        )));
-                    }
-                    for i in 0..n {
-                        s.x_new[i] = self.x[i] + h * s.v_new[i];
-                    }
-                }
-            }
-        }
-        forces::apply_friction(
-            &self.config.model,
-            &self.colliders,
-            &self.friction,
-            h,
-            &self.x,
-            masses,
-            &self.pinned,
-            &mut s.v_new,
-        );
-        for &i in &self.pin_list {
-            let i = i as usize;
-            let w = self.pin_weight[i];
-            if self.pinned[i] {
-                s.x_new[i] = s.goal[i];
-                s.v_new[i] = s.v_step[i];
-            } else {
-                // Soft pin: the fraction w of the way onto the target and its velocity.
-                let v_goal = (s.goal[i] - self.x[i]) / h;
-                let (x_free, v_free) = (s.x_new[i], s.v_new[i]);
-                s.x_new[i] = x_free + w * (s.goal[i] - x_free);
-                s.v_new[i] = v_free + w * (v_goal - v_free);
-            }
-        }
-        // Only pins changed particles after a sound integration: check just them then.
-        let pins_sound = || self.pin_list.iter().all(|&i| !self.unsound(i as usize));
-        if !(integrated_sound == Some(true) && pins_sound()) {
-            self.check_sound(h)?;
-        }
-        if h * self.config.max_speed > FAR_STEP {
-            self.check_in_range(h)?;
-        }
-        let s = &mut self.scratch;
-        std::mem::swap(&mut self.x, &mut s.x_new);
-        std::mem::swap(&mut self.v, &mut s.v_new);
-        self.history.record(&mut s.v_rel, h);
-        self.time += h;
-        self.steps += 1;
-        Ok(())
-    }
-
-    /// Whether the step's result for particle `i` is not finite or faster than `max_speed`.
-    fn unsound(&self, i: usize) -> bool {
-        let (x, v) = (&self.scratch.x_new[i], &self.scratch.v_new[i]);
-        let vmax = self.config.max_speed;
-        !x.iter().chain(v.iter()).all(|c| c.is_finite()) || v.norm_squared() > vmax * vmax
-    }
-
-    fn check_sound(&self, dt: f64) -> Result<(), Error> {
-        let s = &self.scratch;
-        let vmax2 = self.config.max_speed * self.config.max_speed;
-        let (x, v) = (&s.x_new, &s.v_new);
-        let bad = |i: usize| self.unsound(i);
-        let clean = |r: std::ops::Range<usize>| integrate::sound(&x[r.clone()], &v[r], vmax2);
-        match parallel::first_failing(parallel::worth_it(x.len()), x.len(), clean, bad) {
-            None => Ok(()),
-            Some(i) => Err(Error::unstable(format!(
-                "{} with dt = {dt} s is unstable at step {}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s); state left unchanged, retry with a smaller dt",
-                self.config.integrator.name(),
-                self.steps,
-                v[i].norm(),
-                self.config.max_speed
-            ))),
-        }
-    }
-
-    /// Refuses a step whose positions leave the float range (see [`FAR_STEP`]).
-    fn check_in_range(&self, dt: f64) -> Result<(), Error> {
-        match self.scratch.x_new.iter().position(|x| x.amax() >= MAX_COORDINATE) {
-            None => Ok(()),
-            Some(i) => Err(Error::unstable(format!(
-                "{} with dt = {dt} s would move vertex {i} beyond the float range ({:.3e} m); state left unchanged, retry with a smaller dt",
-                self.config.integrator.name(),
-                self.scratch.x_new[i].amax()
-            ))),
-        }
     }
 
     /// Total mechanical energy (J): kinetic + spring + potential of the net weight in water.

@@ -15,6 +15,11 @@ use rayon::prelude::*;
 /// Elements per task. Fixed, so the split never depends on the thread count.
 pub const CHUNK: usize = 4096;
 
+/// Particles per tile: the unit the step's passes work in (their arrays for a tile fit in L1
+/// cache). A chunk is whole tiles.
+pub const TILE: usize = 256;
+const _: () = assert!(CHUNK % TILE == 0);
+
 /// Fewest particles for which a step uses more than one thread (measured with
 /// `cargo run --release --example throughput`; see docs/benchmarks.md).
 pub const MIN_PARALLEL: usize = 16_000;

@@ -65,7 +65,7 @@ where
 }
 
 /// Particles per tile of [`add_spring_forces`]: the tile's three sums stay in L1 cache.
-pub(super) const TILE: usize = 256;
+pub(super) use crate::parallel::TILE;
 
 /// Sets `acc[c][k]` to the sum of the forces of every spring touching particle `p0 + k`
 /// (`+f` at its `i` end, `-f` at its `j` end), for `k < len <= TILE`, from the per-spring

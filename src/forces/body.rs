@@ -13,29 +13,10 @@ pub fn body_acceleration(model: &Model) -> Vec3 {
     ((model.cloth_density - model.water_density) / model.cloth_density) * model.gravity
 }
 
-crate::simd_dispatch! { pub(super) fn add_weight_to_springs_widest(springs: [&[f64]; 3], masses: &[f64], gravity: Vec3, out: &mut [Vec3]) => add_weight_to_springs }
-
-/// `out[k] = (springs[0][k], springs[1][k], springs[2][k]) + masses[k] gravity`: a tile's spring
-/// sums (component arrays) plus the net weight, as `Vec3`s (`gravity` from
-/// [`body_acceleration`]).
-#[inline(always)]
-fn add_weight_to_springs(springs: [&[f64]; 3], masses: &[f64], gravity: Vec3, out: &mut [Vec3]) {
-    let len = out.len();
-    let (sx, sy, sz, masses) = (
-        &springs[0][..len],
-        &springs[1][..len],
-        &springs[2][..len],
-        &masses[..len],
-    );
-    for k in 0..len {
-        out[k] = Vec3::new(sx[k], sy[k], sz[k]) + masses[k] * gravity;
-    }
-}
-
 crate::simd_dispatch! { pub(super) fn add_weight_widest(forces: [&mut [f64]; 3], masses: &[f64], gravity: Vec3) => add_weight }
 
-/// `forces[c][k] += masses[k] gravity[c]`: a tile's spring sums (component arrays) plus the net
-/// weight, the same numbers as [`add_weight_to_springs`] writes as `Vec3`s.
+/// `forces[c][k] += masses[k] gravity[c]`: the net weight added to a tile's forces (component
+/// arrays; `gravity` from [`body_acceleration`]).
 #[inline(always)]
 fn add_weight(forces: [&mut [f64]; 3], masses: &[f64], gravity: Vec3) {
     for (c, f) in forces.into_iter().enumerate() {

@@ -86,9 +86,27 @@ impl Collider {
     }
 }
 
+/// Adds the contact forces on a tile's particles (component arrays) to `f`, particle by
+/// particle.
+pub(super) fn add_tile(
+    m: &Model,
+    colliders: &[Collider],
+    x: [&[f64]; 3],
+    v: [&[f64]; 3],
+    f: [&mut [f64]; 3],
+) {
+    let [fx, fy, fz] = f;
+    let at = |a: [&[f64]; 3], k: usize| Vec3::new(a[0][k], a[1][k], a[2][k]);
+    for k in 0..fx.len() {
+        let mut g = Vec3::new(fx[k], fy[k], fz[k]);
+        add(m, colliders, &at(x, k), &at(v, k), &mut g);
+        (fx[k], fy[k], fz[k]) = (g.x, g.y, g.z);
+    }
+}
+
 /// Adds the contact forces of every collider on a particle at `x` with velocity `v` to `f`.
 #[inline]
-pub(super) fn add(m: &Model, colliders: &[Collider], x: &Vec3, v: &Vec3, f: &mut Vec3) {
+fn add(m: &Model, colliders: &[Collider], x: &Vec3, v: &Vec3, f: &mut Vec3) {
     let (k, c, margin) = (m.collision_stiffness, m.collision_damping, m.collision_margin);
     for collider in colliders {
         let (d, n, vc) = collider.probe(x);

@@ -147,7 +147,7 @@ impl<'a> InputWindow<'a> {
     }
 }
 
-crate::simd_dispatch! { fn transpose_widest(src: &[Vec3], out: [&mut [f64]; 3]) => transpose }
+crate::simd_dispatch! { pub(super) fn transpose_widest(src: &[Vec3], out: [&mut [f64]; 3]) => transpose }
 
 /// `out[c][k] = src[k][c]`.
 #[inline(always)]

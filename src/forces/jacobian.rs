@@ -6,14 +6,16 @@
 //!   clamped at zero for compressed springs so the system stays positive definite) and a
 //!   damping `c_s l_hat l_hat^T`, with `c_s = k_d` for velocity damping and `c_s = k_d w0` for
 //!   fractional springs (H enters as a known force);
-//! - a particle contributes damping `k_vd I + k_hd w0 v_hat v_hat^T + k_nd n n^T` (+ contact
-//!   damping) and contact stiffness `k_c n n^T`.
+//! - a particle contributes what each of its terms gives (`terms.rs`): damping
+//!   `k_vd I + k_hd w0 v_hat v_hat^T + k_nd n n^T` (+ contact damping) and contact stiffness
+//!   `k_c n n^T`.
 //!
 //! Every block is symmetric positive semi-definite and enters `-df/dx` or `-df/dv`.
 
 use nalgebra::Matrix3;
 
-use super::{Collider, ForceInput};
+use super::terms::{self, Context, Particle};
+use super::{body_acceleration, ForceInput};
 use crate::model::SpringDamping;
 use crate::Vec3;
 
@@ -91,30 +93,22 @@ pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Li
         };
         out.spring_damping[k] = cd;
     }
-    let c = m.current;
+    // Every per-particle term's blocks, in the order of the list (`terms.rs`).
+    let context = Context {
+        model: m,
+        gravity: body_acceleration(m),
+        colliders: input.colliders,
+    };
+    let zero = Vec3::zeros();
     for i in 0..n {
-        let rel = input.v[i] - c;
-        let mut d = m.viscous_drag * Matrix3::identity();
-        if m.history_drag != 0.0 {
-            let speed = rel.norm();
-            if speed > 0.0 {
-                d += m.history_drag * w0 * outer(&(rel / speed));
-            }
-        }
-        if m.normal_drag != 0.0 {
-            d += m.normal_drag * outer(&normals[i]);
-        }
-        let mut k = Matrix3::zeros();
-        for collider in input.colliders {
-            let (dist, nrm, vc) = Collider::probe(collider, &input.x[i]);
-            if dist < m.collision_margin {
-                k += m.collision_stiffness * outer(&nrm);
-                if (input.v[i] - vc).dot(&nrm) < 0.0 {
-                    d += m.collision_damping * outer(&nrm);
-                }
-            }
-        }
-        out.damping[i] = d;
-        out.stiffness[i] = k;
+        let p = Particle {
+            x: &input.x[i],
+            v: &input.v[i],
+            normal: normals.get(i).unwrap_or(&zero),
+            w0,
+        };
+        let b = terms::linearise_all(&context, &p);
+        out.damping[i] = b.damping;
+        out.stiffness[i] = b.stiffness;
     }
 }

@@ -27,92 +27,21 @@
 
 use super::inputs::InputWindow;
 use super::springs::{run_uniform_widest, run_widest, Params};
-use crate::topology::{TileRuns, Topology};
+pub use crate::parallel::TILE;
+use crate::topology::{TileLayout as Layout, TileRuns, Topology, GATHER_RUNS};
 
-/// Particles per tile.
-pub const TILE: usize = 256;
-
-/// Largest run offset the tile path accepts: one [`crate::parallel::CHUNK`], so that a spring
-/// reaching into a group from before it ends in the group's first chunk (grids up to 2048
-/// columns). Beyond it, the per-spring buffer path is used.
-const MAX_OFFSET: usize = crate::parallel::CHUNK;
-
-/// How the tile path cuts a topology: groups of whole chunks, each walked by one task with one
-/// rolling window. Depends only on the topology, never on the thread count.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct Layout {
-    /// Numbers per component of the window: the largest offset plus whole tiles, at least as
-    /// many particles as the offset, so sliding it copies at most one number per particle.
-    pub window: usize,
-    /// Particles per group, a multiple of [`crate::parallel::CHUNK`].
-    pub group: usize,
-    /// Runs when the topology has at most [`GATHER_RUNS`] of them (a grid has eight; a few more
-    /// allow a grid with holes or a row-ordered mesh), and the
-    /// tiles are summed by [`spring_forces_gathered`]; 0 otherwise.
-    pub gather_runs: usize,
-    /// Entries before a tile in each force window of the gather path: the largest offset,
-    /// rounded up to whole cache lines so that a tile's entries start on one.
-    pub lead: usize,
-    /// Numbers per component of each force window: `lead` and [`GATHER_TILES`] tiles or more.
-    pub force_window: usize,
-    /// Particles in the window of inputs ([`InputWindow`]): what the springs from before a
-    /// group read (twice the largest offset) or what a tile's springs read (a tile and the
-    /// largest offset), and [`INPUT_TILES`] tiles more, so that it slides once every few tiles.
-    pub inputs: usize,
+/// Numbers of scratch one task of the walk needs: the window of sums, or the gather path's
+/// force windows (one per run) and a tile of sums; then its window of spring inputs.
+pub(super) fn scratch(l: &Layout) -> usize {
+    sums_scratch(l) + InputWindow::scratch(l.inputs)
 }
 
-/// Tiles a force window of the gather path holds after its lead: it slides (copies each run's
-/// last `offset` forces to its front) once every so many tiles.
-const GATHER_TILES: usize = 4;
-
-/// Tiles the window of inputs holds beyond what one tile reads: it slides once every so many
-/// tiles. 1, 2 and 4 measured the same at 61 x 41 (`step_cycles`, 28.3-28.9 ns); 2 keeps the
-/// window (nine component arrays) smaller than 4 and slides half as often as 1.
-const INPUT_TILES: usize = 2;
-
-/// Most runs [`spring_forces_gathered`] keeps force windows for.
-pub(super) const GATHER_RUNS: usize = 12;
-
-impl Layout {
-    /// The layout for `t`, or None when the tile path does not apply.
-    pub(super) fn of(t: &Topology) -> Option<Self> {
-        let tr = &t.tile_runs;
-        let long = tr.rest.len() >= 8 * tr.runs.len();
-        if !(long && tr.max_offset <= MAX_OFFSET) {
-            return None;
-        }
-        let chunk = crate::parallel::CHUNK;
-        let tiles = tr.max_offset.div_ceil(TILE).max(1);
-        Some(Self {
-            // Whole cache lines per component, so each component starts on one.
-            window: (tr.max_offset + tiles * TILE).next_multiple_of(8),
-            // At least 8 offsets long: the springs evaluated twice at a group's start (see
-            // the module's doc) are then a few percent of the group's.
-            group: (8 * tr.max_offset).div_ceil(chunk).max(1) * chunk,
-            gather_runs: if tr.runs.len() <= GATHER_RUNS {
-                tr.runs.len()
-            } else {
-                0
-            },
-            lead: tr.max_offset.next_multiple_of(8),
-            force_window: tr.max_offset.next_multiple_of(8) + tiles.max(GATHER_TILES) * TILE,
-            inputs: ((2 * tr.max_offset).max(tr.max_offset + TILE) + INPUT_TILES * TILE).next_multiple_of(8),
-        })
-    }
-
-    /// Numbers of scratch one task needs: the window of sums, or the gather path's force
-    /// windows (one per run) and a tile of sums; then its window of spring inputs.
-    pub(super) fn scratch(&self) -> usize {
-        self.sums_scratch() + InputWindow::scratch(self.inputs)
-    }
-
-    /// The part of [`Self::scratch`] before the window of spring inputs.
-    pub(super) fn sums_scratch(&self) -> usize {
-        if self.gather_runs > 0 {
-            3 * self.force_window * self.gather_runs + 3 * TILE
-        } else {
-            3 * self.window
-        }
+/// The part of [`scratch`] before the window of spring inputs.
+pub(super) fn sums_scratch(l: &Layout) -> usize {
+    if l.gather_runs > 0 {
+        3 * l.force_window * l.gather_runs + 3 * TILE
+    } else {
+        3 * l.window
     }
 }
 
@@ -550,7 +479,7 @@ fn add3(
 
 #[cfg(test)]
 mod tests {
-    use super::super::{accumulate, ForceInput, ForceScratch};
+    use super::super::{total_forces, ForceInput, ForceScratch};
     use crate::model::Model;
     use crate::topology::{GridSpec, Topology};
     use crate::Vec3;
@@ -582,10 +511,9 @@ mod tests {
         .build()
         .unwrap();
         let n = t.vertex_count();
-        assert!(super::Layout::of(&t).is_some());
+        assert!(t.tiled.is_some());
         let mut buffered = t.clone();
-        buffered.tile_runs.max_offset = usize::MAX;
-        assert!(super::Layout::of(&buffered).is_none());
+        buffered.tiled = None;
         // Deterministic pseudo-random displacements and rates.
         let mut rnd = crate::testing::numbers(12345);
         let x: Vec<Vec3> = t
@@ -624,7 +552,7 @@ mod tests {
         }
         .build()
         .unwrap();
-        let layout = super::Layout::of(&wide).unwrap();
+        let layout = wide.tiled.unwrap();
         assert!(layout.window > 4 * super::TILE && layout.group > crate::parallel::CHUNK);
         assert!(wide.vertex_count() > layout.group);
         let x_wide: Vec<Vec3> = wide
@@ -653,9 +581,9 @@ mod tests {
         // two runs of one family each covering part of a tile.
         let gap = keeping(&|s| !(s.j == s.i + 1 && (3000..3006).contains(&s.i)));
         assert_eq!(gap.tile_runs.runs.len(), t.tile_runs.runs.len() + 1);
-        let gathered = |t: &Topology| super::Layout::of(t).is_some_and(|l| l.gather_runs > 0);
+        let gathered = |t: &Topology| t.tiled.is_some_and(|l| l.gather_runs > 0);
         assert!(gathered(&gap));
-        assert!(super::Layout::of(&holes).is_some() && !gathered(&holes));
+        assert!(holes.tiled.is_some() && !gathered(&holes));
         assert!(gathered(&t) && gathered(&varied) && gathered(&wide));
         for (topology, x, q) in [
             (&t, &x, &q),
@@ -676,7 +604,7 @@ mod tests {
                 colliders: &[],
             };
             let mut f = vec![Vec3::zeros(); n];
-            accumulate(&input, &mut ForceScratch::default(), &mut f);
+            total_forces(&input, &mut ForceScratch::default(), &mut f);
             let scale = want.iter().map(|v| v.norm()).fold(0.0, f64::max);
             for (p, (a, b)) in f.iter().zip(&want).enumerate() {
                 assert!((a - b).norm() <= 1e-12 * scale, "particle {p}: {a} vs {b}");

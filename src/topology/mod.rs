@@ -9,12 +9,14 @@ mod grid;
 mod mesh;
 mod runs;
 mod spring;
+mod tiling;
 
 pub use adjacency::Adjacency;
 pub use grid::{grid_index, GridSpec};
 pub use mesh::{MeshMass, MeshSpec, MAX_MESH_VERTICES};
 pub use runs::{for_each_piece, SpringRun, TileRuns};
 pub use spring::{Spring, SpringKind};
+pub use tiling::{TileLayout, GATHER_RUNS};
 
 use crate::Vec3;
 
@@ -45,6 +47,9 @@ pub struct Topology {
     pub chunk_runs: Adjacency,
     /// The runs joined over small gaps, for the tiled force pass (see [`TileRuns`]).
     pub tile_runs: TileRuns,
+    /// How the force pass walks this topology: tile by tile (`Some`), or from a per-spring
+    /// buffer (`None`); decided here, once.
+    pub tiled: Option<TileLayout>,
 }
 
 impl Topology {
@@ -66,12 +71,13 @@ impl Topology {
         rest_positions.shrink_to_fit();
         let mut spring_runs = runs::order_into_runs(&mut springs);
         spring_runs.shrink_to_fit();
-        Self {
+        let mut t = Self {
             spring_rest: springs.iter().map(|s| s.rest).collect(),
             spring_kinds: springs.iter().map(|s| s.kind as u8).collect(),
             vertex_springs: Adjacency::springs(n, &springs),
             chunk_runs: Adjacency::chunk_runs(n, &spring_runs),
             tile_runs: TileRuns::new(n, &springs, &spring_runs),
+            tiled: None,
             spring_runs,
             vertex_triangles: Adjacency::triangles(n, &triangles),
             rest_positions,
@@ -79,7 +85,9 @@ impl Topology {
             springs,
             triangles,
             grid,
-        }
+        };
+        t.tiled = TileLayout::of(&t.tile_runs);
+        t
     }
 
     /// Number of particles.

@@ -1,0 +1,270 @@
+//! The force pass: every particle's total force, tile by tile.
+//!
+//! For each tile of [`TILE`] consecutive particles, the springs' sums are formed (by the tile
+//! walk of [`super::tiles`] on grids and row-ordered meshes, from per-spring forces otherwise;
+//! the strategy is fixed when the topology is built, [`crate::topology::Topology::tiled`]), then
+//! every per-particle term that is on ([`super::terms::TERMS`]) adds to them, and the tile's
+//! totals go to a sink while they are in L1 cache: an explicit integrator steps them there; the
+//! implicit one needs a whole force array, which [`total_forces`] writes from the tiles.
+
+use super::inputs::{InputWindow, Sources, TileState};
+use super::normals;
+use super::springs::{self, spring_rate, SpringRate};
+use super::terms::{self, Context, Tile};
+use super::tiles::{self, TILE};
+use super::{body_acceleration, Collider};
+use crate::model::Model;
+use crate::parallel;
+use crate::soa::Soa3;
+use crate::topology::Topology;
+use crate::Vec3;
+
+/// Everything the forces read at one instant.
+pub struct ForceInput<'a> {
+    pub model: &'a Model,
+    pub topology: &'a Topology,
+    /// Positions, m.
+    pub x: &'a [Vec3],
+    /// Velocities, m/s.
+    pub v: &'a [Vec3],
+    /// D^{1/2}x of every particle (of the displacement relative to the water), m s^{-1/2};
+    /// ignored when the model uses no fractional term.
+    pub half_derivative: &'a [Vec3],
+    /// Colliders present this step.
+    pub colliders: &'a [Collider],
+}
+
+/// Scratch buffers the force pass reuses (no allocation in a step).
+#[derive(Clone, Debug, Default)]
+pub struct ForceScratch {
+    normals: Vec<Vec3>,
+    faces: Vec<Vec3>,
+    springs: Soa3,
+    spring_inputs: springs::SpringScratch,
+    windows: crate::aligned::AlignedF64,
+}
+
+impl ForceScratch {
+    /// The component arrays the spring pass of an untiled topology reads, positions and damping
+    /// rate (see [`spring_rate`]), sized for `n` particles: for a caller that fills them in a
+    /// pass of its own ([`SpringInputs::Filled`]).
+    pub fn spring_arrays(&mut self, n: usize) -> (&mut Soa3, &mut Soa3) {
+        let s = &mut self.spring_inputs;
+        s.x.resize(n);
+        s.q.resize(n);
+        (&mut s.x, &mut s.q)
+    }
+
+    /// Vertex normals of the last pass (empty when no term read them).
+    pub fn normals(&self) -> &[Vec3] {
+        &self.normals
+    }
+}
+
+/// Who copies an untiled topology's spring inputs into component arrays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpringInputs {
+    /// The caller did ([`ForceScratch::spring_arrays`]; ignored on tiled topologies).
+    Filled,
+    /// The pass does.
+    Copy,
+}
+
+/// A tile's total forces and state as component arrays, each `[x, y, z]` of one length.
+pub struct TileTotals<'a> {
+    /// The tile's first particle.
+    pub p0: usize,
+    /// Total force (N).
+    pub force: [&'a [f64]; 3],
+    /// Positions (m) and velocities (m/s) of [`ForceInput`].
+    pub x: [&'a [f64]; 3],
+    pub v: [&'a [f64]; 3],
+}
+
+/// Writes the total force on every particle into `f` (N), copying the spring inputs itself.
+pub fn total_forces(input: &ForceInput<'_>, scratch: &mut ForceScratch, f: &mut [Vec3]) {
+    total_forces_with(input, scratch, SpringInputs::Copy, f);
+}
+
+/// [`total_forces`], saying who copied the spring inputs.
+pub fn total_forces_with(
+    input: &ForceInput<'_>,
+    scratch: &mut ForceScratch,
+    inputs: SpringInputs,
+    f: &mut [Vec3],
+) {
+    let out = parallel::Disjoint::new(f);
+    for_each_tile(input, scratch, inputs, |t| {
+        // SAFETY: tiles are disjoint, each is handed to this closure once.
+        let out = unsafe { out.range(t.p0..t.p0 + t.force[0].len()) };
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = Vec3::new(t.force[0][k], t.force[1][k], t.force[2][k]);
+        }
+    });
+}
+
+/// Evaluates the total force on every particle, tile by tile, and hands each tile's totals
+/// and state to `sink` once (at most [`TILE`] particles, all in one [`parallel::CHUNK`]).
+/// Tiles of different chunks may be handed over on different threads, in any order; the
+/// forces do not depend on the thread count.
+pub fn for_each_tile<S>(input: &ForceInput<'_>, scratch: &mut ForceScratch, inputs: SpringInputs, sink: S)
+where
+    S: Fn(TileTotals<'_>) + Sync,
+{
+    let m = input.model;
+    let reads = terms::reads(m, !input.colliders.is_empty());
+    if reads.normals {
+        update_normals(input, scratch);
+    }
+    let normals = reads.normals.then_some(&scratch.normals[..]);
+    let context = Context {
+        model: m,
+        gravity: body_acceleration(m),
+        colliders: input.colliders,
+    };
+    let masses = &input.topology.masses;
+    let half = (!input.half_derivative.is_empty()).then_some(input.half_derivative);
+    let finish = |p0: usize, s: [&mut [f64]; 3], state: &TileState<'_>| {
+        let len = s[0].len();
+        let Some(v) = state.v else {
+            unreachable!("the pass keeps every tile's velocities");
+        };
+        let tile = Tile {
+            p0,
+            x: state.x,
+            v,
+            half: state.half,
+            normals: normals.map(|n| &n[p0..p0 + len]),
+            masses: &masses[p0..p0 + len],
+        };
+        let [fx, fy, fz] = s;
+        terms::add_all(&context, &tile, [&mut *fx, &mut *fy, &mut *fz]);
+        sink(TileTotals {
+            p0,
+            force: [fx, fy, fz],
+            x: state.x,
+            v,
+        });
+    };
+    let sources = Sources {
+        x: input.x,
+        v: Some(input.v),
+        half: if reads.half_derivative || spring_rate(m) == SpringRate::HalfDerivative {
+            half
+        } else {
+            None
+        },
+        rate: spring_rate(m),
+    };
+    let ForceScratch {
+        spring_inputs,
+        springs,
+        windows,
+        ..
+    } = scratch;
+    spring_sums(input, spring_inputs, springs, windows, inputs, sources, finish);
+}
+
+/// Computes the vertex normals into `scratch`.
+fn update_normals(input: &ForceInput<'_>, scratch: &mut ForceScratch) {
+    let (t, n) = (input.topology, input.x.len());
+    scratch.normals.resize(n, Vec3::zeros());
+    scratch.faces.resize(t.triangles.len(), Vec3::zeros());
+    normals::vertex_normals_with(
+        input.x,
+        &t.triangles,
+        &t.vertex_triangles,
+        parallel::worth_it(n),
+        &mut scratch.faces,
+        &mut scratch.normals,
+    );
+}
+
+/// Walks the particles tile by tile: sums each tile's spring forces and calls
+/// `finish(p0, sums, state)` with them (component arrays, which the finisher adds to) and the
+/// tile's state as component arrays (`sources`, from the tile walk's window on a tiled topology,
+/// gathered from the step's arrays otherwise).
+#[allow(clippy::too_many_arguments)] // the pass's scratch buffers, borrowed apart from its normals
+fn spring_sums<T>(
+    input: &ForceInput<'_>,
+    spring_inputs: &mut springs::SpringScratch,
+    spring_buffer: &mut Soa3,
+    windows: &mut crate::aligned::AlignedF64,
+    inputs: SpringInputs,
+    sources: Sources<'_>,
+    finish: T,
+) where
+    T: Fn(usize, [&mut [f64]; 3], &TileState<'_>) + Sync,
+{
+    let t = input.topology;
+    let n = input.x.len();
+    let par = parallel::worth_it(n);
+    let layout = t.tiled.as_ref();
+    let fill = inputs == SpringInputs::Copy && layout.is_none();
+    let params = springs::params(input, par, spring_inputs, fill);
+    assert!(
+        sources.rate != SpringRate::HalfDerivative || sources.half.is_some(),
+        "fractional spring damping needs the half-derivatives (ForceInput::half_derivative)"
+    );
+    if let Some(layout) = layout {
+        // One window per task; task k walks groups k, k + tasks, ... (which task walks a group
+        // does not change its sums).
+        let groups = n.div_ceil(layout.group);
+        let tasks = if par {
+            groups.min(2 * rayon::current_num_threads())
+        } else {
+            1
+        };
+        let w = tiles::scratch(layout);
+        windows.resize(w * tasks);
+        parallel::chunks(par, &mut windows[..w * tasks], w, |first, window| {
+            let (sums, buf) = window.split_at_mut(tiles::sums_scratch(layout));
+            for g in (first / w..groups).step_by(tasks) {
+                let c0 = g * layout.group;
+                let len = layout.group.min(n - c0);
+                let finish = |p0: usize, sums: [&mut [f64]; 3], w: &InputWindow<'_>| {
+                    let len = sums[0].len();
+                    finish(p0, sums, &w.tile(p0, p0 + len))
+                };
+                let start = c0.saturating_sub(t.tile_runs.max_offset);
+                let mut window = InputWindow::new(sources, buf, start);
+                if layout.gather_runs > 0 {
+                    tiles::spring_forces_gathered(&params, t, layout, c0, len, sums, &mut window, finish);
+                } else {
+                    tiles::spring_forces(&params, t, c0, len, sums, &mut window, finish);
+                }
+            }
+        });
+    } else {
+        springs::compute(&params, &t.spring_runs, par, spring_buffer);
+        let spring_force = spring_buffer.slices();
+        parallel::for_chunks(par, n, parallel::CHUNK, |first, len| {
+            let mut acc = [[0.0; TILE]; 3];
+            let mut state = [[0.0; TILE]; 9];
+            for p0 in (first..first + len).step_by(TILE) {
+                let m = TILE.min(first + len - p0);
+                super::assemble::add_spring_forces(t, p0, m, spring_force, &mut acc);
+                let gathered = gather(&sources, p0, m, &mut state);
+                let [ax, ay, az] = &mut acc;
+                finish(p0, [&mut ax[..m], &mut ay[..m], &mut az[..m]], &gathered);
+            }
+        });
+    }
+}
+
+/// The state of particles `p0 .. p0 + m` as component arrays, copied into `buf`.
+fn gather<'b>(s: &Sources<'_>, p0: usize, m: usize, buf: &'b mut [[f64; TILE]; 9]) -> TileState<'b> {
+    let [x0, x1, x2, v0, v1, v2, h0, h1, h2] = buf;
+    super::inputs::transpose_widest(&s.x[p0..p0 + m], [&mut x0[..m], &mut x1[..m], &mut x2[..m]]);
+    if let Some(v) = s.v {
+        super::inputs::transpose_widest(&v[p0..p0 + m], [&mut v0[..m], &mut v1[..m], &mut v2[..m]]);
+    }
+    if let Some(h) = s.half {
+        super::inputs::transpose_widest(&h[p0..p0 + m], [&mut h0[..m], &mut h1[..m], &mut h2[..m]]);
+    }
+    TileState {
+        x: [&x0[..m], &x1[..m], &x2[..m]],
+        v: s.v.map(|_| [&v0[..m], &v1[..m], &v2[..m]]),
+        half: s.half.map(|_| [&h0[..m], &h1[..m], &h2[..m]]),
+    }
+}

@@ -1,0 +1,75 @@
+//! How the force pass cuts a topology into tiles, decided once when the topology is built
+//! (as Jolt's `SoftBodySharedSettings::Optimize` does): a topology whose springs form long runs
+//! with short offsets (grids, row-ordered meshes) is walked tile by tile by
+//! `forces::tiles`; any other sums its springs from a per-spring buffer.
+
+use super::TileRuns;
+use crate::parallel::TILE;
+
+/// Largest run offset the tile path accepts: one [`crate::parallel::CHUNK`], so that a spring
+/// reaching into a group from before it ends in the group's first chunk (grids up to 2048
+/// columns). Beyond it, the per-spring buffer path is used.
+const MAX_OFFSET: usize = crate::parallel::CHUNK;
+
+/// How the tile path cuts a topology: groups of whole chunks, each walked by one task with one
+/// rolling window. Depends only on the topology, never on the thread count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TileLayout {
+    /// Numbers per component of the window: the largest offset plus whole tiles, at least as
+    /// many particles as the offset, so sliding it copies at most one number per particle.
+    pub window: usize,
+    /// Particles per group, a multiple of [`crate::parallel::CHUNK`].
+    pub group: usize,
+    /// Runs when the topology has at most [`GATHER_RUNS`] of them (a grid has eight; a few more
+    /// allow a grid with holes or a row-ordered mesh), and the
+    /// tiles are summed by the gathered tile walk; 0 otherwise.
+    pub gather_runs: usize,
+    /// Entries before a tile in each force window of the gather path: the largest offset,
+    /// rounded up to whole cache lines so that a tile's entries start on one.
+    pub lead: usize,
+    /// Numbers per component of each force window: `lead` and [`GATHER_TILES`] tiles or more.
+    pub force_window: usize,
+    /// Particles in the window of inputs (`forces::inputs::InputWindow`): what the springs from before a
+    /// group read (twice the largest offset) or what a tile's springs read (a tile and the
+    /// largest offset), and [`INPUT_TILES`] tiles more, so that it slides once every few tiles.
+    pub inputs: usize,
+}
+
+/// Tiles a force window of the gather path holds after its lead: it slides (copies each run's
+/// last `offset` forces to its front) once every so many tiles.
+const GATHER_TILES: usize = 4;
+
+/// Tiles the window of inputs holds beyond what one tile reads: it slides once every so many
+/// tiles. 1, 2 and 4 measured the same at 61 x 41 (`step_cycles`, 28.3-28.9 ns); 2 keeps the
+/// window (nine component arrays) smaller than 4 and slides half as often as 1.
+const INPUT_TILES: usize = 2;
+
+/// Most runs the gathered tile walk keeps force windows for.
+pub const GATHER_RUNS: usize = 12;
+
+impl TileLayout {
+    /// The layout for `t`, or None when the tile path does not apply.
+    pub(crate) fn of(tr: &TileRuns) -> Option<Self> {
+        let long = tr.rest.len() >= 8 * tr.runs.len();
+        if !(long && tr.max_offset <= MAX_OFFSET) {
+            return None;
+        }
+        let chunk = crate::parallel::CHUNK;
+        let tiles = tr.max_offset.div_ceil(TILE).max(1);
+        Some(Self {
+            // Whole cache lines per component, so each component starts on one.
+            window: (tr.max_offset + tiles * TILE).next_multiple_of(8),
+            // At least 8 offsets long: the springs evaluated twice at a group's start (see
+            // the module's doc) are then a few percent of the group's.
+            group: (8 * tr.max_offset).div_ceil(chunk).max(1) * chunk,
+            gather_runs: if tr.runs.len() <= GATHER_RUNS {
+                tr.runs.len()
+            } else {
+                0
+            },
+            lead: tr.max_offset.next_multiple_of(8),
+            force_window: tr.max_offset.next_multiple_of(8) + tiles.max(GATHER_TILES) * TILE,
+            inputs: ((2 * tr.max_offset).max(tr.max_offset + TILE) + INPUT_TILES * TILE).next_multiple_of(8),
+        })
+    }
+}
