@@ -1,14 +1,15 @@
 //! Steps the 61 x 41 throughput cloth in blocks of 1000 steps and prints the fastest block in
 //! ns per particle-step: the least noisy figure on a shared machine, for comparing two builds
 //! while optimising (the benchmark of record is `examples/throughput.rs`, which reports medians).
-//! `cargo run --release --example step_cycles -- [fractional|regular|memoryless] [blocks] [WxH]`
-//! (default 61x41; blocks of 1000 steps, fewer for big cloths). `memoryless` is the fractional
+//! `cargo run --release --example step_cycles -- [fractional|regular|memoryless] [blocks] [WxH] [shuffled]`
+//! (default 61x41; blocks of 1000 steps, fewer for big cloths; `shuffled` builds the grid as a
+//! quad mesh with its vertices in a scrambled order, so the force pass cannot walk it in tiles). `memoryless` is the fractional
 //! model with the history switched off (`Scheme::Off`): the same step without the fractional
 //! memory's work and bytes, to tell what the history costs at a size from what the rest does.
 
 use fraccloth::history::Scheme;
 use fraccloth::scenes::Variant;
-use fraccloth::topology::grid_index;
+use fraccloth::topology::{grid_index, MeshMass, MeshSpec};
 use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, RegularDrag, Vec3};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -27,15 +28,46 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         None => (61, 41),
     };
+    let shuffled = args.get(4).is_some_and(|a| a == "shuffled");
     let steps_per_block = (2_500_000 / (w as u64 * h as u64)).clamp(1, 1000);
-    let topology = GridSpec {
+    // The same mass per particle at every size, so the same dt is stable.
+    let total_mass = 0.24 * (w * h) as f64 / (61.0 * 41.0);
+    let grid = GridSpec {
         width: w,
         height: h,
         spacing: 0.01,
-        // The same mass per particle at every size, so the same dt is stable.
-        total_mass: 0.24 * (w * h) as f64 / (61.0 * 41.0),
+        total_mass,
     }
     .build()?;
+    // Vertex k of the mesh is grid vertex perm[k] (a stride coprime with n scrambles them).
+    let n = (w * h) as usize;
+    let stride = (1..).map(|s| 7919 + 2 * s).find(|s| gcd(*s, n) == 1).unwrap_or(1);
+    let perm: Vec<usize> = (0..n)
+        .map(|k| if shuffled { (k * stride) % n } else { k })
+        .collect();
+    let mut inv = vec![0u32; n];
+    for (new, &old) in perm.iter().enumerate() {
+        inv[old] = new as u32;
+    }
+    let topology = if shuffled {
+        let positions: Vec<Vec3> = perm.iter().map(|&o| grid.rest_positions[o]).collect();
+        let mut indices = vec![];
+        for j in 0..h - 1 {
+            for i in 0..w - 1 {
+                let quad = [j * w + i, j * w + i + 1, (j + 1) * w + i + 1, (j + 1) * w + i];
+                indices.extend(quad.iter().map(|&v| inv[v as usize]));
+            }
+        }
+        MeshSpec {
+            positions: &positions,
+            indices: &indices,
+            face_size: 4,
+            mass: MeshMass::Total(total_mass),
+        }
+        .build()?
+    } else {
+        grid
+    };
     let variant = if regular {
         Variant::Regular(RegularDrag::Normal)
     } else {
@@ -54,7 +86,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..ClothConfig::default()
     };
     let mut cloth = Cloth::new(topology, config)?;
-    let top: Vec<u32> = (0..w).map(|i| grid_index(w, i, 0)).collect();
+    let top: Vec<u32> = (0..w).map(|i| inv[grid_index(w, i, 0) as usize]).collect();
     cloth.set_pinned(&top)?;
     let mut best = f64::INFINITY;
     for _ in 0..blocks {
@@ -71,4 +103,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         1e-6 / best
     );
     Ok(())
+}
+
+fn gcd(a: usize, b: usize) -> usize {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
 }

@@ -229,7 +229,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         Path::new("docs")
     };
     let mut rows = vec![];
-    println!("vector loops compiled for: {}", fraccloth::simd::level());
+    println!("vector loops compiled for: {}", fraccloth::simd_level());
     println!(
         "{:<36} {:>9} {:>14} {:>14} {:>8}",
         "configuration", "particles", "1 thread M/s", "2 threads M/s", "speedup"

@@ -29,8 +29,6 @@
 // Physics loops walk several per-particle arrays with one index; that reads better than zips.
 #![allow(clippy::needless_range_loop)]
 
-pub mod aligned;
-mod bytes;
 pub mod cloth;
 pub mod error;
 pub mod export;
@@ -39,14 +37,10 @@ pub mod forces;
 pub mod history;
 pub mod integrate;
 pub mod look;
-pub mod memory;
 pub mod model;
 pub mod oscillator;
-pub mod parallel;
-pub mod render;
+mod plumbing;
 pub mod scenes;
-pub mod simd;
-pub mod soa;
 #[cfg(test)]
 mod testing;
 pub mod topology;
@@ -54,9 +48,15 @@ pub mod topology;
 /// 3-vector of f64, the core's only vector type.
 pub type Vec3 = nalgebra::Vector3<f64>;
 
+pub(crate) use plumbing::{aligned, bytes, memory, parallel, soa};
+
 pub use cloth::{Cloth, ClothConfig};
 pub use error::{Error, ErrorKind};
 pub use history::{HalfDerivative, History, Scheme};
 pub use integrate::Integrator;
 pub use model::{Model, RegularDrag, SpringDamping};
+/// Fewest particles for which a step uses more than one thread.
+pub use plumbing::parallel::MIN_PARALLEL;
+/// The vector width the loops run at on this machine ("avx512", "avx2" or "scalar").
+pub use plumbing::simd::level as simd_level;
 pub use topology::{GridSpec, Topology};

@@ -105,7 +105,7 @@ fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
 
 #[test]
 fn committed_hashes_for_every_scene_and_thread_count() {
-    const { assert!(131 * 129 >= fraccloth::parallel::MIN_PARALLEL) };
+    const { assert!(131 * 129 >= fraccloth::MIN_PARALLEL) };
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/determinism_hashes.txt");
     let mut got = BTreeMap::new();
     for (name, run) in cases() {

@@ -52,7 +52,7 @@ static GLOBAL: Counting = Counting;
 #[test]
 fn steps_do_not_allocate() {
     COUNTED.with(|c| c.set(true));
-    const { assert!(15 * 11 < fraccloth::parallel::MIN_PARALLEL) };
+    const { assert!(15 * 11 < fraccloth::MIN_PARALLEL) };
     // One test function: the counter is global, so nothing else may run at the same time.
     let schemes = [
         Scheme::Off,

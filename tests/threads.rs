@@ -71,7 +71,7 @@ fn run(threads: usize, variant: Variant, scheme: Scheme, integrator: Integrator)
 
 #[test]
 fn bitwise_identical_for_1_2_and_8_threads() {
-    const { assert!((W * H) as usize >= fraccloth::parallel::MIN_PARALLEL) };
+    const { assert!((W * H) as usize >= fraccloth::MIN_PARALLEL) };
     let cases = [
         (Variant::Fractional, Scheme::DEFAULT, Integrator::SymplecticEuler),
         (Variant::Fractional, Scheme::PAPER, Integrator::ExplicitEuler),

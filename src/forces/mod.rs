@@ -21,7 +21,7 @@ mod jacobian;
 mod normals;
 mod pass;
 mod springs;
-pub mod terms;
+pub(crate) mod terms;
 mod tiles;
 
 pub use assemble::add_spring_values;

@@ -130,7 +130,6 @@ where
             unreachable!("the pass keeps every tile's velocities");
         };
         let tile = Tile {
-            p0,
             x: state.x,
             v,
             half: state.half,

@@ -22,8 +22,6 @@ use crate::Vec3;
 /// A tile of consecutive particles `p0 ..` as the terms read it: component arrays of one
 /// length, `[x, y, z]`.
 pub struct Tile<'b> {
-    /// First particle.
-    pub p0: usize,
     /// Positions, m.
     pub x: [&'b [f64]; 3],
     /// Velocities of the step, m/s.
@@ -91,6 +89,8 @@ pub struct Blocks {
 
 /// A per-particle force term.
 pub struct Term {
+    /// What it is, for people reading the list.
+    #[allow(dead_code)]
     pub name: &'static str,
     /// Whether the term is on for this model (with or without colliders present).
     pub on: fn(&Model, bool) -> bool,

@@ -5,11 +5,16 @@
 //! current velocity and `H_n` depends only on velocities already pushed. The split is
 //! what lets an implicit integrator treat `w0` as damping and `H_n` as a known force.
 //!
-//! Protocol, once per step:
-//! 1. [`HalfDerivative::prepare`] (the scheme knows its own clock from the steps pushed);
-//! 2. [`HalfDerivative::current_weight`] and [`HalfDerivative::past`] as often as needed;
-//! 3. after the step of size h is accepted, [`HalfDerivative::push`] the velocities v_n the
-//!    step started from, with h.
+//! How a step uses it (`src/cloth/step.rs`):
+//! 1. [`History::begin_step`] readies the step's weights (each scheme keeps its own clock) and
+//!    returns a [`StepPast`] that fills `H_n` range by range inside the step's pass over the
+//!    particles; the SOE history folds the last accepted step into its modes during that same
+//!    walk; then [`History::end_step`];
+//! 2. after the step is accepted, [`History::record`] takes the velocities the step started
+//!    from (relative to the water) and the step size.
+//!
+//! [`HalfDerivative`] (`prepare`, `current_weight`, `past`, `push`) is the same protocol one
+//! scheme at a time, for tests and the reference computations.
 //!
 //! Schemes, one file each: [`Truncated`] (the paper's Eq. 6), [`Full`] (exact product
 //! integration over all history, the reference), [`SumOfExponentials`] (full memory at

@@ -1,7 +1,7 @@
 //! The preview renderer: requested size, a plausible cloth area, motion between frames, and
 //! colliders in the picture.
 
-use fraccloth::render::{render_frame, Camera, Scene3d};
+use crate::render::{render_frame, Camera, Scene3d};
 use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
 use tiny_skia::Pixmap;
 

@@ -1,6 +1,6 @@
 //! A pinhole camera that frames a box of the scene.
 
-use crate::Vec3;
+use fraccloth::Vec3;
 
 /// Perspective camera; `project` maps world points to pixels (y down) and a depth.
 #[derive(Clone, Copy, Debug)]

@@ -31,19 +31,6 @@ pub fn ensure_available(bytes: u64, what: &str) -> Result<(), Error> {
     Ok(())
 }
 
-/// A `Vec` of `len` copies of `value`, or an out-of-memory error naming `what`.
-pub fn try_filled<T: Clone>(len: usize, value: T, what: &str) -> Result<Vec<T>, Error> {
-    let mut v = Vec::new();
-    v.try_reserve_exact(len).map_err(|_| {
-        Error::out_of_memory(format!(
-            "{what}: {len} elements of {} bytes cannot be allocated",
-            std::mem::size_of::<T>()
-        ))
-    })?;
-    v.resize(len, value);
-    Ok(v)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -54,7 +41,5 @@ mod tests {
         assert_eq!(e.kind, crate::ErrorKind::OutOfMemory);
         assert!(e.message.contains("a test"), "{}", e.message);
         assert!(ensure_available(1 << 20, "a megabyte").is_ok());
-        assert!(try_filled(usize::MAX / 16, 0u64, "a test").is_err());
-        assert_eq!(try_filled(3, 7u8, "x").unwrap(), vec![7, 7, 7]);
     }
 }

@@ -13,9 +13,11 @@ mod label;
 mod plots;
 mod raster;
 mod sheet;
+#[cfg(test)]
+mod tests;
 
 pub use camera::Camera;
 pub use frame::{render_frame, Scene3d};
-pub use label::{draw_label, draw_text, text_width};
-pub use plots::{diverging_colour, phase_colour, side_view, space_time};
+pub use label::draw_label;
+pub use plots::{side_view, space_time};
 pub use sheet::{contact_sheet, save_png, GifWriter};

@@ -4,8 +4,8 @@ use tiny_skia::{Color, GradientStop, LinearGradient, Paint, Pixmap, Point, Sprea
 
 use super::raster::{vertex_normals, ZBuffer};
 use super::Camera;
-use crate::forces::{Collider, Sphere};
-use crate::Vec3;
+use fraccloth::forces::{Collider, Sphere};
+use fraccloth::Vec3;
 
 /// What one frame shows.
 pub struct Scene3d<'a> {

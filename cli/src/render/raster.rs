@@ -6,7 +6,7 @@
 
 use tiny_skia::{Pixmap, PremultipliedColorU8};
 
-use crate::Vec3;
+use fraccloth::Vec3;
 
 /// Colour samples with depth, `ss x ss` per output pixel.
 pub(super) struct ZBuffer {
