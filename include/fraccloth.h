@@ -300,6 +300,33 @@ typedef struct {
    * Speed above which a step is declared unstable, m/s (> 0). Default 100.
    */
   double max_speed;
+  /**
+   * Added mass for motion normal to the cloth, kg/m^2 per unit area (0 = off). About
+   * `water_density * wavelength / pi` for ripples of that wavelength: 30-80 for a towel.
+   * Default 0 (`FC_PRESET_UNDERWATER`: see docs/underwater.md).
+   */
+  double added_mass;
+  /**
+   * Form-drag coefficient C_d of the velocity normal to the cloth (dimensionless, 0 = off):
+   * `-1/2 water_density C_d area |v_n| v_n n`. Default 0.
+   */
+  double form_drag;
+  /**
+   * Skin drag on the tangential velocity, N s/m^3 per unit area (0 = off). Default 0.
+   */
+  double skin_drag;
+  /**
+   * Viscous drag per unit area, N s/m^3, added to `viscous_drag` times a particle's area. Default 0.
+   */
+  double viscous_drag_per_area;
+  /**
+   * History drag per unit area, N s^(1/2)/m^3, added to `history_drag` times the area. Default 0.
+   */
+  double history_drag_per_area;
+  /**
+   * Normal drag per unit area, N s/m^3, added to `normal_drag` times the area. Default 0.
+   */
+  double normal_drag_per_area;
 } FcClothDesc;
 
 #ifdef __cplusplus

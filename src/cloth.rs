@@ -518,12 +518,20 @@ impl Cloth {
         Ok(())
     }
 
-    /// Total mechanical energy (J): kinetic + spring + potential of the net weight in water.
+    /// Total mechanical energy (J): kinetic (with the water's added mass for normal motion,
+    /// `1/2 m_a (v . n)^2`) + spring + potential of the net weight in water.
     pub fn energy(&self) -> f64 {
         let m = &self.config.model;
         let mut e = 0.0;
         for ((x, v), &mass) in self.x.iter().zip(&self.v).zip(&self.topology.masses) {
             e += 0.5 * mass * v.norm_squared() - forces::body_force(m, mass).dot(x);
+        }
+        if m.water.added_mass != 0.0 {
+            let mut normals = vec![Vec3::zeros(); self.x.len()];
+            forces::vertex_normals(&self.x, &self.topology.triangles, &mut normals);
+            for ((v, n), &area) in self.v.iter().zip(&normals).zip(&self.topology.areas) {
+                e += 0.5 * forces::added_mass(m, area) * v.dot(n).powi(2);
+            }
         }
         for s in &self.topology.springs {
             let k = m.stiffness(s.kind);

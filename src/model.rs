@@ -52,12 +52,38 @@ pub struct Model {
     pub collision_damping: f64,
     /// Distance from a collider surface below which the repulsion acts, m.
     pub collision_margin: f64,
+    /// The water's terms given per unit area of cloth (zero switches each off).
+    pub water: Water,
+}
+
+/// Terms of the water given per unit area of cloth: each multiplies a particle's lumped area
+/// ([`crate::Topology::areas`]), so one description gives the same motion at any resolution.
+/// Zero switches a term off (and it costs nothing). See `docs/underwater.md`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Water {
+    /// Added mass for motion normal to the cloth, kg/m^2: a particle's mass matrix becomes
+    /// `m I + m_a n n^T`, `m_a = added_mass * area`. For a sheet rippled with wavelength
+    /// lambda, about `rho_w lambda / pi` (both sides): tens of kg/m^2.
+    pub added_mass: f64,
+    /// Form-drag coefficient C_d (dimensionless) of the velocity normal to the cloth relative
+    /// to the water: `-1/2 rho_w C_d area |v_n| v_n n`.
+    pub form_drag: f64,
+    /// Skin (tangential) drag on the velocity along the cloth relative to the water, N s/m^3:
+    /// `-skin_drag area (v_rel - (v_rel . n) n)`.
+    pub skin_drag: f64,
+    /// Viscous drag per unit area, N s/m^3 (adds to [`Model::viscous_drag`] times the area).
+    pub viscous_drag: f64,
+    /// History drag per unit area, N s^{1/2}/m^3 (adds to [`Model::history_drag`] times the area).
+    pub history_drag: f64,
+    /// Normal drag per unit area, N s/m^3 (adds to [`Model::normal_drag`] times the area).
+    pub normal_drag: f64,
 }
 
 impl Model {
     /// True when some term needs D^{1/2}x, so a history must be kept.
     pub fn uses_half_derivative(&self) -> bool {
         self.history_drag != 0.0
+            || self.water.history_drag != 0.0
             || (self.spring_damping_mode == SpringDamping::Fractional && self.spring_damping != 0.0)
     }
 
@@ -86,6 +112,13 @@ impl Model {
         check_non_negative("collision_stiffness", self.collision_stiffness)?;
         check_non_negative("collision_damping", self.collision_damping)?;
         check_non_negative("collision_margin", self.collision_margin)?;
+        let w = &self.water;
+        check_non_negative("added_mass", w.added_mass)?;
+        check_non_negative("form_drag", w.form_drag)?;
+        check_non_negative("skin_drag", w.skin_drag)?;
+        check_non_negative("viscous_drag_per_area", w.viscous_drag)?;
+        check_non_negative("history_drag_per_area", w.history_drag)?;
+        check_non_negative("normal_drag_per_area", w.normal_drag)?;
         Ok(())
     }
 
@@ -110,6 +143,7 @@ impl Model {
             collision_stiffness: 50.0,
             collision_damping: 0.05,
             collision_margin: 0.01,
+            water: Water::default(),
         }
     }
 

@@ -60,6 +60,8 @@ pub(super) struct StepScratch {
     pub pin_start: Vec<Vec3>,
     /// Fully pinned particles, ascending.
     pub hard_pins: Vec<u32>,
+    /// Vertex normals of the proposed state (with added mass only).
+    pub normals_new: Vec<Vec3>,
     pub force_pass: ForceScratch,
     pub implicit: ImplicitScratch,
 }
@@ -124,6 +126,7 @@ impl Cloth {
             Route::Implicit => self.forces_and_implicit_step(h, w0)?,
         };
         let friction = self.friction(h);
+        self.added_mass_energy();
         self.pins(h);
         self.check(h, integrated_sound && !friction)?;
         self.commit(h);
@@ -279,7 +282,8 @@ impl Cloth {
             half_derivative: &s.half,
             colliders: &self.colliders,
         };
-        let masses = &self.topology.masses;
+        let (masses, areas) = (&self.topology.masses, &self.topology.areas);
+        let model = &self.config.model;
         let max_speed2 = self.config.max_speed * self.config.max_speed;
         let all_sound = AtomicBool::new(true);
         let (x_new, v_new) = (
@@ -290,11 +294,30 @@ impl Cloth {
             let r = tile.p0..tile.p0 + tile.force[0].len();
             // SAFETY: each tile is handed over once and tiles are disjoint.
             let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
+            // With added mass the step needs M^{-1} f: the effective force of `added_mass.rs`.
+            let mut effective;
+            let force = match (model.water.added_mass != 0.0, tile.normals) {
+                (true, Some(n)) => {
+                    let len = r.len();
+                    effective = [[0.0; TILE]; 3];
+                    forces::effective_forces(
+                        model,
+                        &masses[r.clone()],
+                        &areas[r.clone()],
+                        n,
+                        tile.force,
+                        &mut effective,
+                    );
+                    let [a, b, c] = &effective;
+                    [&a[..len], &b[..len], &c[..len]]
+                }
+                _ => tile.force,
+            };
             let input = integrate::StepInput {
                 h,
                 x: tile.x,
                 v: tile.v,
-                force: tile.force,
+                force,
                 masses: &masses[r],
                 max_speed2,
             };
@@ -365,6 +388,31 @@ impl Cloth {
             &mut self.scratch.v_new,
         );
         on
+    }
+
+    /// With added mass, the normal turning over the step must not create kinetic energy: a
+    /// particle whose kinetic energy `1/2 (m |v|^2 + m_a (v . n)^2)` is larger with the new
+    /// normal than with the step's is slowed to the step's (never sped up). The water's added
+    /// mass depends on the normal, and solving `M(n) a = f` alone does not conserve energy as n
+    /// turns (`forces/added_mass.rs`).
+    fn added_mass_energy(&mut self) {
+        let m = &self.config.model;
+        if m.water.added_mass == 0.0 {
+            return;
+        }
+        let s = &mut self.scratch;
+        s.normals_new.resize(s.x_new.len(), Vec3::zeros());
+        forces::vertex_normals(&s.x_new, &self.topology.triangles, &mut s.normals_new);
+        let old = s.force_pass.normals();
+        for i in 0..s.v_new.len() {
+            let (v, mass) = (s.v_new[i], self.topology.masses[i]);
+            let ma = forces::added_mass(m, self.topology.areas[i]);
+            let t_old = mass * v.norm_squared() + ma * v.dot(&old[i]).powi(2);
+            let t_new = mass * v.norm_squared() + ma * v.dot(&s.normals_new[i]).powi(2);
+            if t_new > t_old && t_new > 0.0 {
+                s.v_new[i] = v * (t_old / t_new).sqrt();
+            }
+        }
     }
 
     /// Pinned particles onto their goals (moving with their step velocity); soft pins pulled

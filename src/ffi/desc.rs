@@ -135,6 +135,21 @@ pub struct FcClothDesc {
     pub collision_margin: f64,
     /// Speed above which a step is declared unstable, m/s (> 0). Default 100.
     pub max_speed: f64,
+    /// Added mass for motion normal to the cloth, kg/m^2 per unit area (0 = off). About
+    /// `water_density * wavelength / pi` for ripples of that wavelength: 30-80 for a towel.
+    /// Default 0 (`FC_PRESET_UNDERWATER`: see docs/underwater.md).
+    pub added_mass: f64,
+    /// Form-drag coefficient C_d of the velocity normal to the cloth (dimensionless, 0 = off):
+    /// `-1/2 water_density C_d area |v_n| v_n n`. Default 0.
+    pub form_drag: f64,
+    /// Skin drag on the tangential velocity, N s/m^3 per unit area (0 = off). Default 0.
+    pub skin_drag: f64,
+    /// Viscous drag per unit area, N s/m^3, added to `viscous_drag` times a particle's area. Default 0.
+    pub viscous_drag_per_area: f64,
+    /// History drag per unit area, N s^(1/2)/m^3, added to `history_drag` times the area. Default 0.
+    pub history_drag_per_area: f64,
+    /// Normal drag per unit area, N s/m^3, added to `normal_drag` times the area. Default 0.
+    pub normal_drag_per_area: f64,
 }
 
 fn v3(a: [f64; 3]) -> Vec3 {
@@ -198,6 +213,12 @@ impl FcClothDesc {
             collision_damping: model.collision_damping,
             collision_margin: model.collision_margin,
             max_speed: config.max_speed,
+            added_mass: model.water.added_mass,
+            form_drag: model.water.form_drag,
+            skin_drag: model.water.skin_drag,
+            viscous_drag_per_area: model.water.viscous_drag,
+            history_drag_per_area: model.water.history_drag,
+            normal_drag_per_area: model.water.normal_drag,
         }
     }
 
@@ -280,6 +301,14 @@ impl FcClothDesc {
                 collision_stiffness: self.collision_stiffness,
                 collision_damping: self.collision_damping,
                 collision_margin: self.collision_margin,
+                water: crate::model::Water {
+                    added_mass: self.added_mass,
+                    form_drag: self.form_drag,
+                    skin_drag: self.skin_drag,
+                    viscous_drag: self.viscous_drag_per_area,
+                    history_drag: self.history_drag_per_area,
+                    normal_drag: self.normal_drag_per_area,
+                },
             },
             scheme,
             integrator,

@@ -54,6 +54,9 @@ pub struct Linearisation {
     pub damping: Vec<Matrix3<f64>>,
     /// Per-particle `-df/dx`.
     pub stiffness: Vec<Matrix3<f64>>,
+    /// Per-particle added mass for normal motion and the unit normal it acts along (empty when
+    /// the model has none): the mass matrix is `m I + m_a n n^T`.
+    pub added_mass: Vec<(f64, Vec3)>,
 }
 
 fn outer(a: &Vec3) -> Matrix3<f64> {
@@ -106,9 +109,15 @@ pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Li
             v: &input.v[i],
             normal: normals.get(i).unwrap_or(&zero),
             w0,
+            area: input.topology.areas[i],
         };
         let b = terms::linearise_all(&context, &p);
         out.damping[i] = b.damping;
         out.stiffness[i] = b.stiffness;
+    }
+    out.added_mass.clear();
+    if m.water.added_mass != 0.0 {
+        out.added_mass
+            .extend((0..n).map(|i| (super::added_mass(m, input.topology.areas[i]), normals[i])));
     }
 }

@@ -7,11 +7,13 @@
 //! | `body.rs` | Eq. 2 gravity and buoyancy |
 //! | `drag.rs` | Eq. 3 viscous, Eq. 4 history, and normal drag |
 //! | `contact.rs` | collider contacts and friction |
+//! | `added_mass.rs` | the water's added mass for normal motion (an inertia: Sherman-Morrison) |
 //! | `terms.rs` | the list of per-particle terms, what each reads, its Jacobian block |
 //! | `jacobian.rs` | the linearised forces of the implicit integrator |
 //! | `pass.rs` | the force pass: spring sums plus terms, tile by tile |
 //! | `tiles.rs`, `inputs.rs`, `assemble.rs`, `normals.rs` | how the pass sums springs and reads its inputs |
 
+mod added_mass;
 mod assemble;
 mod body;
 mod contact;
@@ -24,6 +26,7 @@ mod springs;
 pub(crate) mod terms;
 mod tiles;
 
+pub use added_mass::{added_mass, effective_forces};
 pub use assemble::add_spring_values;
 pub use body::{body_acceleration, body_force};
 pub use contact::{apply_friction, friction_active, Capsule, Collider, Plane, Sphere};

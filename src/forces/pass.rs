@@ -79,6 +79,8 @@ pub struct TileTotals<'a> {
     /// Positions (m) and velocities (m/s) of [`ForceInput`].
     pub x: [&'a [f64]; 3],
     pub v: [&'a [f64]; 3],
+    /// Unit vertex normals, when some term or the added mass reads them.
+    pub normals: Option<&'a [Vec3]>,
 }
 
 /// Writes the total force on every particle into `f` (N), copying the spring inputs itself.
@@ -122,7 +124,7 @@ where
         gravity: body_acceleration(m),
         colliders: input.colliders,
     };
-    let masses = &input.topology.masses;
+    let (masses, areas) = (&input.topology.masses, &input.topology.areas);
     let half = (!input.half_derivative.is_empty()).then_some(input.half_derivative);
     let finish = |p0: usize, s: [&mut [f64]; 3], state: &TileState<'_>| {
         let len = s[0].len();
@@ -135,6 +137,7 @@ where
             half: state.half,
             normals: normals.map(|n| &n[p0..p0 + len]),
             masses: &masses[p0..p0 + len],
+            areas: &areas[p0..p0 + len],
         };
         let [fx, fy, fz] = s;
         terms::add_all(&context, &tile, [&mut *fx, &mut *fy, &mut *fz]);
@@ -143,6 +146,7 @@ where
             force: [fx, fy, fz],
             x: state.x,
             v,
+            normals: tile.normals,
         });
     };
     let sources = Sources {

@@ -32,6 +32,8 @@ pub struct Tile<'b> {
     pub normals: Option<&'b [Vec3]>,
     /// Masses, kg.
     pub masses: &'b [f64],
+    /// Lumped areas, m^2 (what per-unit-area coefficients multiply).
+    pub areas: &'b [f64],
 }
 
 /// What the terms read at one step besides a tile.
@@ -61,6 +63,11 @@ impl Reads {
         half_derivative: false,
         normals: false,
     };
+    const NORMALS: Reads = Reads {
+        velocity: true,
+        half_derivative: false,
+        normals: true,
+    };
 
     fn or(self, o: Reads) -> Reads {
         Reads {
@@ -79,6 +86,8 @@ pub struct Particle<'a> {
     pub normal: &'a Vec3,
     /// Current-velocity weight of D^{1/2} over the step.
     pub w0: f64,
+    /// Lumped area, m^2.
+    pub area: f64,
 }
 
 /// Blocks of `-df/dv` (damping) and `-df/dx` (stiffness) of one particle.
@@ -102,7 +111,15 @@ pub struct Term {
 }
 
 /// Every per-particle term, in the order it is added.
-pub const TERMS: [Term; 5] = [WEIGHT, VISCOUS_DRAG, HISTORY_DRAG, NORMAL_DRAG, CONTACTS];
+pub const TERMS: [Term; 7] = [
+    WEIGHT,
+    VISCOUS_DRAG,
+    HISTORY_DRAG,
+    NORMAL_DRAG,
+    FORM_DRAG,
+    SKIN_DRAG,
+    CONTACTS,
+];
 
 /// Net weight in water, Eq. 2.
 const WEIGHT: Term = Term {
@@ -116,16 +133,30 @@ const WEIGHT: Term = Term {
 /// Viscous drag on the velocity relative to the water, Eq. 3.
 const VISCOUS_DRAG: Term = Term {
     name: "viscous drag",
-    on: |m, _| m.viscous_drag != 0.0,
+    on: |m, _| m.viscous_drag != 0.0 || m.water.viscous_drag != 0.0,
     reads: Reads::VELOCITY,
-    add: |c, t, f| drag::add_viscous(c.model, t.v, f),
-    linearise: Some(|c, _, b| b.damping += c.model.viscous_drag * Matrix3::identity()),
+    add: |c, t, f| drag::add_viscous(c.model, t.v, t.areas, f),
+    linearise: Some(|c, p, b| {
+        let m = c.model;
+        b.damping += per_particle(m.viscous_drag, m.water.viscous_drag, p.area) * Matrix3::identity()
+    }),
 };
+
+/// A per-particle coefficient plus a per-area one times the particle's area. The sum is `k`
+/// exactly when the per-area one is zero, so models without it keep their bits.
+#[inline(always)]
+pub fn per_particle(k: f64, k_area: f64, area: f64) -> f64 {
+    if k_area == 0.0 {
+        k
+    } else {
+        k + k_area * area
+    }
+}
 
 /// History (Basset) drag, Eq. 4.
 const HISTORY_DRAG: Term = Term {
     name: "history drag",
-    on: |m, _| m.history_drag != 0.0,
+    on: |m, _| m.history_drag != 0.0 || m.water.history_drag != 0.0,
     reads: Reads {
         velocity: true,
         half_derivative: true,
@@ -133,7 +164,7 @@ const HISTORY_DRAG: Term = Term {
     },
     add: |c, t, f| {
         if let Some(d) = t.half {
-            drag::add_history(c.model, t.v, d, f);
+            drag::add_history(c.model, t.v, d, t.areas, f);
         }
     },
     linearise: Some(|c, p, b| {
@@ -142,7 +173,8 @@ const HISTORY_DRAG: Term = Term {
         let speed = rel.norm();
         if speed > 0.0 {
             let u = rel / speed;
-            b.damping += m.history_drag * p.w0 * (u * u.transpose());
+            let k = per_particle(m.history_drag, m.water.history_drag, p.area);
+            b.damping += k * p.w0 * (u * u.transpose());
         }
     }),
 };
@@ -150,18 +182,54 @@ const HISTORY_DRAG: Term = Term {
 /// Drag on the normal velocity (the paper's regular models, Fig. 7).
 const NORMAL_DRAG: Term = Term {
     name: "normal drag",
-    on: |m, _| m.normal_drag != 0.0,
-    reads: Reads {
-        velocity: true,
-        half_derivative: false,
-        normals: true,
-    },
+    on: |m, _| m.normal_drag != 0.0 || m.water.normal_drag != 0.0,
+    reads: Reads::NORMALS,
     add: |c, t, f| {
         if let Some(n) = t.normals {
-            drag::add_normal(c.model, t.v, n, f);
+            drag::add_normal(c.model, t.v, n, t.areas, f);
         }
     },
-    linearise: Some(|c, p, b| b.damping += c.model.normal_drag * (p.normal * p.normal.transpose())),
+    linearise: Some(|c, p, b| {
+        let m = c.model;
+        b.damping +=
+            per_particle(m.normal_drag, m.water.normal_drag, p.area) * (p.normal * p.normal.transpose())
+    }),
+};
+
+/// Form drag on the velocity normal to the cloth relative to the water, quadratic:
+/// `-1/2 rho_w C_d A |v_n| v_n n` (it dominates at a swung towel's Reynolds numbers, 1e3-1e4).
+const FORM_DRAG: Term = Term {
+    name: "form drag",
+    on: |m, _| m.water.form_drag != 0.0,
+    reads: Reads::NORMALS,
+    add: |c, t, f| {
+        if let Some(n) = t.normals {
+            drag::add_form(c.model, t.v, n, t.areas, f);
+        }
+    },
+    linearise: Some(|c, p, b| {
+        // d/dv of -1/2 rho C A |v_n| v_n n is -rho C A |v_n| n n^T.
+        let m = c.model;
+        let vn = (p.v - m.current).dot(p.normal);
+        let k = m.water_density * m.water.form_drag * p.area * vn.abs();
+        b.damping += k * (p.normal * p.normal.transpose());
+    }),
+};
+
+/// Skin drag on the velocity along the cloth relative to the water, linear.
+const SKIN_DRAG: Term = Term {
+    name: "skin drag",
+    on: |m, _| m.water.skin_drag != 0.0,
+    reads: Reads::NORMALS,
+    add: |c, t, f| {
+        if let Some(n) = t.normals {
+            drag::add_skin(c.model, t.v, n, t.areas, f);
+        }
+    },
+    linearise: Some(|c, p, b| {
+        let k = c.model.water.skin_drag * p.area;
+        b.damping += k * (Matrix3::identity() - p.normal * p.normal.transpose());
+    }),
 };
 
 /// Penalty contacts with the colliders.
@@ -184,12 +252,17 @@ const CONTACTS: Term = Term {
     }),
 };
 
-/// What the terms that are on read, together.
+/// What the terms that are on read, together (the added mass, an inertia rather than a
+/// force, reads the normals too).
 pub fn reads(m: &Model, colliders: bool) -> Reads {
+    let mass = Reads {
+        normals: m.water.added_mass != 0.0,
+        ..Reads::NONE
+    };
     TERMS
         .iter()
         .filter(|t| (t.on)(m, colliders))
-        .fold(Reads::NONE, |r, t| r.or(t.reads))
+        .fold(mass, |r, t| r.or(t.reads))
 }
 
 /// Adds every term that is on to a tile's spring sums `f`.

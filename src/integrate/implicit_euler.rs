@@ -6,7 +6,8 @@
 //! `D^{1/2}x = w0 v + H`: `w0` enters `C` as damping, `H` (the past, lagged by one step)
 //! stays in `f_n` as a known force. Pinned particles are filtered out of the solve (their
 //! velocity is prescribed). The system is solved matrix-free by block-Jacobi
-//! preconditioned CG ([`super::cg`]).
+//! preconditioned CG ([`super::cg`]). The water's added mass for normal motion enters `M` as
+//! `m_a n n^T` per particle (`forces/added_mass.rs`), in the product and the preconditioner.
 //!
 //! Unconditionally stable for the linearised cloth; first order in time.
 
@@ -80,6 +81,9 @@ fn apply_system(
         for (k, o) in chunk.iter_mut().enumerate() {
             let i = first + k;
             *o = inp.masses[i] * p[i] + h * (lin.damping[i] * p[i]) + h * h * (lin.stiffness[i] * p[i]);
+            if let Some((ma, n)) = lin.added_mass.get(i) {
+                *o += (ma * n.dot(&p[i])) * n;
+            }
         }
         add_spring_values(inp.topology, first, values, -1.0, chunk);
     });
@@ -151,6 +155,9 @@ pub fn implicit_euler(
         for (k, m) in chunk.iter_mut().enumerate() {
             let i = first + k;
             *m = inp.masses[i] * Matrix3::identity() + h * lin.damping[i] + h * h * lin.stiffness[i];
+            if let Some((ma, n)) = lin.added_mass.get(i) {
+                *m += *ma * (n * n.transpose());
+            }
         }
         add_spring_values(t, first, matrices, 1.0, chunk);
         for (k, m) in chunk.iter_mut().enumerate() {

@@ -110,13 +110,22 @@ impl GridSpec {
                 triangles.push([b, c, d]);
             }
         }
-        Ok(Topology::new(
+        let mut t = Topology::new(
             rest_positions,
             vec![self.total_mass / n as f64; n],
             springs,
             triangles,
             Some((w, h)),
-        ))
+        );
+        // Each cell gives a quarter of its area to each corner: s^2 inside, half on an edge,
+        // a quarter at a corner.
+        for j in 0..h {
+            for i in 0..w {
+                let edges = u32::from(i == 0 || i == w - 1) + u32::from(j == 0 || j == h - 1);
+                t.areas[(j * w + i) as usize] = s * s / f64::from(1u32 << edges);
+            }
+        }
+        Ok(t)
     }
 }
 

@@ -205,7 +205,10 @@ impl MeshSpec<'_> {
         // A spring listed twice (e.g. a quad diagonal that is also a bend) is kept once.
         springs.sort_by_key(|s| (s.i, s.j, s.kind as u8));
         springs.dedup_by(|a, b| a.i == b.i && a.j == b.j && a.kind == b.kind);
-        Ok(Topology::new(x.to_vec(), masses, springs, triangles, None))
+        let mut t = Topology::new(x.to_vec(), masses, springs, triangles, None);
+        // The same lumping as the masses: each face gives area / corners to each corner.
+        t.areas = area;
+        Ok(t)
     }
 }
 

@@ -27,6 +27,10 @@ pub struct Topology {
     pub rest_positions: Vec<Vec3>,
     /// Lumped particle masses, kilograms.
     pub masses: Vec<f64>,
+    /// Lumped particle areas, m^2: what per-unit-area coefficients multiply, so the motion
+    /// does not change with resolution. Each face gives its area over its corner count to every
+    /// corner (grids: a quarter of each cell; meshes: as their masses are lumped).
+    pub areas: Vec<f64>,
     /// Every spring once (i < j), ordered into [`SpringRun`]s.
     pub springs: Vec<Spring>,
     /// The springs as runs of consecutive vertices (see [`SpringRun`]).
@@ -71,7 +75,19 @@ impl Topology {
         rest_positions.shrink_to_fit();
         let mut spring_runs = runs::order_into_runs(&mut springs);
         spring_runs.shrink_to_fit();
+        let mut areas = vec![0.0; n];
+        for tri in &triangles {
+            let [a, b, c] = tri.map(|i| i as usize);
+            let third = (rest_positions[b] - rest_positions[a])
+                .cross(&(rest_positions[c] - rest_positions[a]))
+                .norm()
+                / 6.0;
+            for i in [a, b, c] {
+                areas[i] += third;
+            }
+        }
         let mut t = Self {
+            areas,
             spring_rest: springs.iter().map(|s| s.rest).collect(),
             spring_kinds: springs.iter().map(|s| s.kind as u8).collect(),
             vertex_springs: Adjacency::springs(n, &springs),
