@@ -526,6 +526,11 @@ impl Cloth {
         for ((x, v), &mass) in self.x.iter().zip(&self.v).zip(&self.topology.masses) {
             e += 0.5 * mass * v.norm_squared() - forces::body_force(m, mass).dot(x);
         }
+        for (v, &area) in self.v.iter().zip(&self.topology.areas) {
+            if m.water.entrained_mass != 0.0 {
+                e += 0.5 * forces::entrained_mass(m, area) * v.norm_squared();
+            }
+        }
         if m.water.added_mass != 0.0 {
             let mut normals = vec![Vec3::zeros(); self.x.len()];
             forces::vertex_normals(&self.x, &self.topology.triangles, &mut normals);

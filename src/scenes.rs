@@ -10,8 +10,9 @@
 //! - `sphere`: a sphere of radius [`SPHERE_RADIUS`] moves through the hanging cloth
 //!   along +z at [`SPHERE_SPEED`], starting behind it at z = [`SPHERE_START_Z`].
 //!
-//! Each comes in a `fractional` variant (the paper's model) and `regular` variants
-//! (damped springs, no half-derivative) with every other parameter the same.
+//! Each comes in a `fractional` variant (the paper's model), `regular` variants (damped
+//! springs, no half-derivative) with every other parameter the same, and the `underwater`
+//! preset (the water's physics per unit area, [`Model::underwater`]; its swing is 4 cm).
 //!
 //! Drag coefficients are per particle, so they are given here per unit area and
 //! scaled by the area a particle represents; spring constants of a square lattice
@@ -30,8 +31,10 @@ use crate::Vec3;
 pub const CLOTH_WIDTH: f64 = 0.6;
 /// Cloth mass, kg.
 pub const CLOTH_MASS: f64 = 0.24;
-/// Swing amplitude, m.
+/// Swing amplitude, m (the paper's models).
 pub const SWING_AMPLITUDE: f64 = 0.08;
+/// Swing amplitude of the underwater preset, m: a towel swung in a tank by hand.
+pub const UNDERWATER_SWING_AMPLITUDE: f64 = 0.04;
 /// Swing frequency, Hz.
 pub const SWING_FREQUENCY: f64 = 0.5;
 /// Sway amplitude, m.
@@ -74,18 +77,22 @@ pub enum Variant {
     Fractional,
     /// A regular damped-spring cloth with the given drags (Fig. 7).
     Regular(RegularDrag),
+    /// The underwater preset: the water's physics per unit area ([`Model::underwater`]).
+    Underwater,
 }
 
 impl Variant {
-    pub const ALL: [Variant; 4] = [
+    pub const ALL: [Variant; 5] = [
         Variant::Regular(RegularDrag::ViscousAndNormal),
         Variant::Regular(RegularDrag::Viscous),
         Variant::Regular(RegularDrag::Normal),
         Variant::Fractional,
+        Variant::Underwater,
     ];
     pub fn name(&self) -> &'static str {
         match self {
             Variant::Fractional => "fractional",
+            Variant::Underwater => "underwater",
             Variant::Regular(RegularDrag::ViscousAndNormal) => "regular-viscous-normal",
             Variant::Regular(RegularDrag::Viscous) => "regular-viscous",
             Variant::Regular(RegularDrag::Normal) => "regular",
@@ -96,11 +103,12 @@ impl Variant {
     }
     /// The model for a cloth whose particles are `spacing` apart.
     pub fn model(&self, spacing: f64) -> Model {
-        let base = match self {
-            Variant::Fractional => Model::fractional(),
-            Variant::Regular(d) => Model::regular(*d),
-        };
-        scale_drags(base, spacing)
+        match self {
+            Variant::Fractional => scale_drags(Model::fractional(), spacing),
+            Variant::Regular(d) => scale_drags(Model::regular(*d), spacing),
+            // Per unit area already: the same at any spacing.
+            Variant::Underwater => Model::underwater(),
+        }
     }
 }
 
@@ -192,14 +200,30 @@ impl SceneSpec {
     }
 }
 
-/// Step of the built-in scenes, s.
+/// Step of the built-in scenes at 61 x 41 (1 cm spacing), s.
 pub const DEFAULT_DT: f64 = 5.0e-4;
 
-/// Offset of the top edge from its rest position at time `t` (s).
-pub fn top_offset(kind: SceneKind, t: f64) -> Vec3 {
+/// A stable step for a built-in scene at `spacing` (m) with `integrator`: [`DEFAULT_DT`] at
+/// 1 cm and below, shrinking with the spacing for the explicit integrators (their bound is
+/// `~2/omega`, and omega grows as 1/spacing at a fixed cloth mass: `docs/stability.md`), and
+/// one frame at 30 fps for the implicit one (stable at any step).
+pub fn stable_dt(spacing: f64, integrator: Integrator) -> f64 {
+    match integrator {
+        Integrator::ImplicitEuler => 1.0 / 30.0,
+        _ => DEFAULT_DT * (spacing / REFERENCE_SPACING).min(1.0),
+    }
+}
+
+/// Offset of the top edge from its rest position at time `t` (s) for a variant.
+pub fn top_offset(kind: SceneKind, variant: Variant, t: f64) -> Vec3 {
     use std::f64::consts::TAU;
+    let swing = if variant == Variant::Underwater {
+        UNDERWATER_SWING_AMPLITUDE
+    } else {
+        SWING_AMPLITUDE
+    };
     match kind {
-        SceneKind::Swing => Vec3::new(0.0, 0.0, SWING_AMPLITUDE * (TAU * SWING_FREQUENCY * t).sin()),
+        SceneKind::Swing => Vec3::new(0.0, 0.0, swing * (TAU * SWING_FREQUENCY * t).sin()),
         SceneKind::Sway => Vec3::new(SWAY_AMPLITUDE * (TAU * SWAY_FREQUENCY * t).sin(), 0.0, 0.0),
         SceneKind::Sphere => Vec3::zeros(),
     }
@@ -231,7 +255,7 @@ impl Scene {
     pub fn step(&mut self) -> Result<(), Error> {
         let dt = self.spec.dt;
         let t_end = self.cloth.time() + dt;
-        let off = top_offset(self.spec.kind, t_end);
+        let off = top_offset(self.spec.kind, self.spec.variant, t_end);
         self.targets.clear();
         self.targets.extend(self.top_rest.iter().map(|p| p + off));
         self.cloth.set_pin_targets(&self.top, &self.targets)?;

@@ -75,7 +75,7 @@ fn pinned_vertices_sit_exactly_on_their_targets_after_every_step() {
     for _ in 0..400 {
         scene.step().unwrap();
         let t = scene.cloth.time();
-        let off = fraccloth::scenes::top_offset(SceneKind::Swing, t);
+        let off = fraccloth::scenes::top_offset(SceneKind::Swing, Variant::Fractional, t);
         for (k, &i) in top.iter().enumerate() {
             assert_eq!(scene.cloth.positions()[i as usize], rest[k] + off, "t = {t}");
         }

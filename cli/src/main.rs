@@ -23,7 +23,7 @@ use fraccloth::export::{read_cache, read_obj};
 use fraccloth::export::{write_obj, CacheFormat, CacheWriter};
 use fraccloth::history::Scheme;
 use fraccloth::look::{measure, Look};
-use fraccloth::scenes::{Scene, SceneKind, SceneSpec, Variant, DEFAULT_DT};
+use fraccloth::scenes::{stable_dt, Scene, SceneKind, SceneSpec, Variant, DEFAULT_DT};
 use fraccloth::{HalfDerivative, Integrator, RegularDrag, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use render::{contact_sheet, render_frame, save_png, side_view, space_time, Camera, GifWriter, Scene3d};
@@ -75,24 +75,27 @@ struct Args {
     /// Scene: swing, sway or sphere.
     #[arg(long, default_value = "swing")]
     scene: String,
-    /// Model: fractional, regular (normal drag), regular-viscous, regular-viscous-normal.
-    #[arg(long, default_value = "fractional")]
+    /// Model: underwater (the water's physics per unit area; the default), fractional (the
+    /// paper's), regular (normal drag), regular-viscous, regular-viscous-normal.
+    #[arg(long, default_value = "underwater")]
     variant: String,
     /// Grid size as COLUMNSxROWS (the paper uses 61x41 and 31x21).
     #[arg(long, default_value = "61x41")]
     size: String,
     /// Simulated seconds.
-    #[arg(long, default_value_t = 8.0)]
+    #[arg(long, default_value_t = 12.0)]
     seconds: f64,
     /// Frames per second written to the cache.
     #[arg(long, default_value_t = 30.0)]
     fps: f64,
-    /// Time step, seconds.
-    #[arg(long, default_value_t = DEFAULT_DT)]
-    dt: f64,
+    /// Time step, seconds (default: a stable step for the size and integrator: 0.5 ms at
+    /// 1 cm spacing, shrinking with the spacing for the explicit integrators; 1/30 s implicit).
+    #[arg(long)]
+    dt: Option<f64>,
     /// Integrator: explicit (the paper's Eq. 7), symplectic, implicit (stable at frame rate).
-    #[arg(long, default_value = "explicit")]
-    integrator: String,
+    /// Default: symplectic for the underwater preset, explicit for the paper's models.
+    #[arg(long)]
+    integrator: Option<String>,
     /// How D^{1/2} is evaluated: soe (accurate, constant cost; the default), paper (Eq. 6 with
     /// the last --u states), full (exact convolution, cost grows with time), off.
     #[arg(long, default_value = "soe")]
@@ -129,12 +132,33 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((p(w)?, p(h)?))
 }
 
+/// The integrator and step a bake uses: as given, or the variant's own and a stable step.
+fn integrator_and_dt(args: &Args, variant: Variant) -> Result<(Integrator, f64), String> {
+    let key = match (&args.integrator, variant) {
+        (Some(k), _) => k.as_str(),
+        (None, Variant::Underwater) => "symplectic",
+        (None, _) => "explicit",
+    };
+    let integrator = Integrator::ALL
+        .into_iter()
+        .find(|i| i.key() == key)
+        .ok_or_else(|| format!("unknown integrator {key:?} (explicit, symplectic, implicit)"))?;
+    let (width, _) = parse_size(&args.size)?;
+    let spacing = fraccloth::scenes::CLOTH_WIDTH / f64::from(width.max(2) - 1);
+    let dt = args.dt.unwrap_or_else(|| stable_dt(spacing, integrator));
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(format!("--dt must be positive, got {dt}"));
+    }
+    Ok((integrator, dt))
+}
+
 fn scheme_from(args: &Args) -> Result<Scheme, String> {
+    let dt = args.dt.unwrap_or(DEFAULT_DT);
     Ok(match args.history.as_str() {
         "soe" => Scheme::SumOfExponentials {
             tolerance: args.tolerance,
             horizon: fraccloth::history::DEFAULT_SOE_HORIZON.max(2.0 * args.seconds),
-            min_dt: fraccloth::history::DEFAULT_SOE_MIN_DT.min(args.dt),
+            min_dt: fraccloth::history::DEFAULT_SOE_MIN_DT.min(dt),
         },
         "paper" => Scheme::Truncated { u: args.u },
         "full" => Scheme::Full,
@@ -150,19 +174,11 @@ fn spec_from(args: &Args, variant: Variant, scheme: Scheme) -> Result<SceneSpec,
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.fps.is_finite() && args.fps > 0.0) {
         return Err("--seconds and --fps must be positive".into());
     }
-    let integrator = Integrator::ALL
-        .into_iter()
-        .find(|i| i.key() == args.integrator)
-        .ok_or_else(|| {
-            format!(
-                "unknown integrator {:?} (explicit, symplectic, implicit)",
-                args.integrator
-            )
-        })?;
+    let (integrator, dt) = integrator_and_dt(args, variant)?;
     Ok(SceneSpec {
         width,
         height,
-        dt: args.dt,
+        dt,
         scheme,
         integrator,
         ..SceneSpec::paper(kind, variant)
@@ -270,7 +286,7 @@ fn look_command(a: &LookArgs) -> Result<(), String> {
 fn bake(args: &Args) -> Result<(), String> {
     let variant = Variant::from_name(&args.variant).ok_or_else(|| {
         format!(
-            "unknown variant {:?} (fractional, regular, regular-viscous, regular-viscous-normal)",
+            "unknown variant {:?} (underwater, fractional, regular, regular-viscous, regular-viscous-normal)",
             args.variant
         )
     })?;
@@ -476,7 +492,7 @@ fn look_row(name: &str, look: &Look) -> String {
 }
 
 fn compare(args: &Args) -> Result<(), String> {
-    let models: [(&str, Variant, Scheme); 5] = [
+    let models: [(&str, Variant, Scheme); 6] = [
         (
             "regular v+n",
             Variant::Regular(RegularDrag::ViscousAndNormal),
@@ -490,6 +506,7 @@ fn compare(args: &Args) -> Result<(), String> {
         ("regular norm", Variant::Regular(RegularDrag::Normal), Scheme::Off),
         ("paper u=3", Variant::Fractional, Scheme::PAPER),
         ("fractional", Variant::Fractional, Scheme::DEFAULT),
+        ("underwater", Variant::Underwater, Scheme::DEFAULT),
     ];
     std::fs::create_dir_all(&args.out).map_err(io(&args.out))?;
     let rows_out = 6usize;
@@ -571,8 +588,8 @@ fn compare(args: &Args) -> Result<(), String> {
     let sheet_path = args.out.join(format!("compare-{}.png", args.scene));
     save_png(&sheet, &sheet_path).map_err(io(&sheet_path))?;
     let table = format!(
-        "Look of `{}` ({}, {} s, dt {} s, {} integrator), measured by `fraccloth look` on the centre column over whole drive periods of the second half:\n\n{LOOK_HEADER}{table}",
-        args.scene, args.size, args.seconds, args.dt, args.integrator
+        "Look of `{}` ({}, {} s; each model with its own integrator and a stable step unless given: explicit Euler for the paper's models, symplectic Euler for the underwater preset), measured by `fraccloth look` on the centre column over whole drive periods of the second half:\n\n{LOOK_HEADER}{table}",
+        args.scene, args.size, args.seconds
     );
     let table_path = args.out.join(format!("look-{}.md", args.scene));
     std::fs::write(&table_path, &table).map_err(io(&table_path))?;

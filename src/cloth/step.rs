@@ -296,7 +296,7 @@ impl Cloth {
             let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
             // With added mass the step needs M^{-1} f: the effective force of `added_mass.rs`.
             let mut effective;
-            let force = match (model.water.added_mass != 0.0, tile.normals) {
+            let force = match (forces::has_added_inertia(model), tile.normals) {
                 (true, Some(n)) => {
                     let len = r.len();
                     effective = [[0.0; TILE]; 3];
@@ -400,12 +400,13 @@ impl Cloth {
         if m.water.added_mass == 0.0 {
             return;
         }
+        let entrained = |i: usize| forces::entrained_mass(m, self.topology.areas[i]);
         let s = &mut self.scratch;
         s.normals_new.resize(s.x_new.len(), Vec3::zeros());
         forces::vertex_normals(&s.x_new, &self.topology.triangles, &mut s.normals_new);
         let old = s.force_pass.normals();
         for i in 0..s.v_new.len() {
-            let (v, mass) = (s.v_new[i], self.topology.masses[i]);
+            let (v, mass) = (s.v_new[i], self.topology.masses[i] + entrained(i));
             let ma = forces::added_mass(m, self.topology.areas[i]);
             let t_old = mass * v.norm_squared() + ma * v.dot(&old[i]).powi(2);
             let t_new = mass * v.norm_squared() + ma * v.dot(&s.normals_new[i]).powi(2);

@@ -17,14 +17,26 @@ use crate::model::Model;
 use crate::parallel::TILE;
 use crate::Vec3;
 
-/// The added mass of a particle of area `area`, kg.
+/// The added mass for normal motion of a particle of area `area`, kg.
 #[inline]
 pub fn added_mass(m: &Model, area: f64) -> f64 {
     m.water.added_mass * area
 }
 
-/// Writes the effective forces `f - beta (n . f) n` of a tile into `out` (component arrays),
-/// `beta = m_a / (m + m_a)`.
+/// The water entrained in every direction by a particle of area `area`, kg.
+#[inline]
+pub fn entrained_mass(m: &Model, area: f64) -> f64 {
+    m.water.entrained_mass * area
+}
+
+/// Whether the model adds any inertia.
+pub fn has_added_inertia(m: &Model) -> bool {
+    m.water.added_mass != 0.0 || m.water.entrained_mass != 0.0
+}
+
+/// Writes the effective forces of a tile into `out` (component arrays): `m M^{-1} f` with
+/// `M = (m + m_e) I + m_a n n^T`, that is `m / (m + m_e) (f - beta (n . f) n)`,
+/// `beta = m_a / (m + m_e + m_a)`.
 pub fn effective_forces(
     m: &Model,
     masses: &[f64],
@@ -35,11 +47,12 @@ pub fn effective_forces(
 ) {
     let len = force[0].len();
     for k in 0..len {
-        let ma = added_mass(m, areas[k]);
-        let beta = ma / (masses[k] + ma);
+        let (ma, me) = (added_mass(m, areas[k]), entrained_mass(m, areas[k]));
+        let iso = masses[k] + me;
+        let beta = ma / (iso + ma);
         let n = normals[k];
         let f = Vec3::new(force[0][k], force[1][k], force[2][k]);
-        let g = f - (beta * n.dot(&f)) * n;
+        let g = (masses[k] / iso) * (f - (beta * n.dot(&f)) * n);
         (out[0][k], out[1][k], out[2][k]) = (g.x, g.y, g.z);
     }
 }

@@ -54,9 +54,10 @@ pub struct Linearisation {
     pub damping: Vec<Matrix3<f64>>,
     /// Per-particle `-df/dx`.
     pub stiffness: Vec<Matrix3<f64>>,
-    /// Per-particle added mass for normal motion and the unit normal it acts along (empty when
-    /// the model has none): the mass matrix is `m I + m_a n n^T`.
-    pub added_mass: Vec<(f64, Vec3)>,
+    /// Per-particle added mass for normal motion, the unit normal it acts along, and the
+    /// entrained mass (empty when the model has none): the mass matrix is
+    /// `(m + m_e) I + m_a n n^T`.
+    pub added_mass: Vec<(f64, Vec3, f64)>,
 }
 
 fn outer(a: &Vec3) -> Matrix3<f64> {
@@ -116,8 +117,10 @@ pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Li
         out.stiffness[i] = b.stiffness;
     }
     out.added_mass.clear();
-    if m.water.added_mass != 0.0 {
-        out.added_mass
-            .extend((0..n).map(|i| (super::added_mass(m, input.topology.areas[i]), normals[i])));
+    if super::has_added_inertia(m) {
+        out.added_mass.extend((0..n).map(|i| {
+            let a = input.topology.areas[i];
+            (super::added_mass(m, a), normals[i], super::entrained_mass(m, a))
+        }));
     }
 }

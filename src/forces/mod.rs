@@ -26,7 +26,7 @@ mod springs;
 pub(crate) mod terms;
 mod tiles;
 
-pub use added_mass::{added_mass, effective_forces};
+pub use added_mass::{added_mass, effective_forces, entrained_mass, has_added_inertia};
 pub use assemble::add_spring_values;
 pub use body::{body_acceleration, body_force};
 pub use contact::{apply_friction, friction_active, Capsule, Collider, Plane, Sphere};

@@ -256,7 +256,7 @@ const CONTACTS: Term = Term {
 /// force, reads the normals too).
 pub fn reads(m: &Model, colliders: bool) -> Reads {
     let mass = Reads {
-        normals: m.water.added_mass != 0.0,
+        normals: super::has_added_inertia(m),
         ..Reads::NONE
     };
     TERMS

@@ -81,8 +81,8 @@ fn apply_system(
         for (k, o) in chunk.iter_mut().enumerate() {
             let i = first + k;
             *o = inp.masses[i] * p[i] + h * (lin.damping[i] * p[i]) + h * h * (lin.stiffness[i] * p[i]);
-            if let Some((ma, n)) = lin.added_mass.get(i) {
-                *o += (ma * n.dot(&p[i])) * n;
+            if let Some((ma, n, me)) = lin.added_mass.get(i) {
+                *o += *me * p[i] + (ma * n.dot(&p[i])) * n;
             }
         }
         add_spring_values(inp.topology, first, values, -1.0, chunk);
@@ -155,8 +155,8 @@ pub fn implicit_euler(
         for (k, m) in chunk.iter_mut().enumerate() {
             let i = first + k;
             *m = inp.masses[i] * Matrix3::identity() + h * lin.damping[i] + h * h * lin.stiffness[i];
-            if let Some((ma, n)) = lin.added_mass.get(i) {
-                *m += *ma * (n * n.transpose());
+            if let Some((ma, n, me)) = lin.added_mass.get(i) {
+                *m += *me * Matrix3::identity() + *ma * (n * n.transpose());
             }
         }
         add_spring_values(t, first, matrices, 1.0, chunk);
