@@ -1,11 +1,12 @@
 //! Steps the 61 x 41 throughput cloth in blocks of 1000 steps and prints the fastest block in
 //! ns per particle-step: the least noisy figure on a shared machine, for comparing two builds
 //! while optimising (the benchmark of record is `examples/throughput.rs`, which reports medians).
-//! `cargo run --release --example step_cycles -- [fractional|regular|memoryless] [blocks] [WxH] [shuffled]`
+//! `cargo run --release --example step_cycles -- [fractional|regular|memoryless|underwater] [blocks] [WxH] [shuffled]`
 //! (default 61x41; blocks of 1000 steps, fewer for big cloths; `shuffled` builds the grid as a
 //! quad mesh with its vertices in a scrambled order, so the force pass cannot walk it in tiles). `memoryless` is the fractional
 //! model with the history switched off (`Scheme::Off`): the same step without the fractional
 //! memory's work and bytes, to tell what the history costs at a size from what the rest does.
+//! `underwater` is the underwater preset (entrained water and form drag, no history).
 
 use fraccloth::history::Scheme;
 use fraccloth::scenes::Variant;
@@ -17,8 +18,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let variant_arg = args.get(1).map_or("fractional", String::as_str);
     let regular = variant_arg == "regular";
     let memoryless = variant_arg == "memoryless";
-    if !matches!(variant_arg, "fractional" | "regular" | "memoryless") {
-        return Err(format!("unknown variant {variant_arg}: fractional, regular or memoryless").into());
+    let underwater = variant_arg == "underwater";
+    if !matches!(variant_arg, "fractional" | "regular" | "memoryless" | "underwater") {
+        return Err(format!("unknown variant {variant_arg}: fractional, regular, memoryless or underwater").into());
     }
     let blocks: u64 = args.get(2).map_or(Ok(20), |s| s.parse())?;
     let (w, h) = match args.get(3) {
@@ -70,6 +72,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let variant = if regular {
         Variant::Regular(RegularDrag::Normal)
+    } else if underwater {
+        Variant::Underwater
     } else {
         Variant::Fractional
     };
