@@ -338,6 +338,19 @@ typedef struct {
    * Normal drag per unit area, N s/m^3, added to `normal_drag` times the area. Default 0.
    */
   double normal_drag_per_area;
+  /**
+   * Multiplies `spring_damping` for the stretch springs (>= 0). Default 1.
+   */
+  double stretch_damping_scale;
+  /**
+   * Multiplies `spring_damping` for the shear springs (>= 0). Default 1.
+   */
+  double shear_damping_scale;
+  /**
+   * Multiplies `spring_damping` for the bend springs (>= 0). Default 1; e.g. 0, 0, 1 damps
+   * the bend springs alone.
+   */
+  double bend_damping_scale;
 } FcClothDesc;
 
 #ifdef __cplusplus

@@ -40,6 +40,9 @@ pub struct Model {
     pub spring_damping: f64,
     /// Which damping the springs carry.
     pub spring_damping_mode: SpringDamping,
+    /// Multiplies `spring_damping` for each family: stretch, shear, bend (default 1, 1, 1; e.g.
+    /// 0, 0, 1 damps the bend springs alone).
+    pub spring_damping_scale: [f64; 3],
     /// Viscous drag k_vd, N s/m (Eq. 3).
     pub viscous_drag: f64,
     /// History (Basset) drag k_hd, N s^{1/2}/m (Eq. 4).
@@ -93,6 +96,11 @@ impl Model {
             || (self.spring_damping_mode == SpringDamping::Fractional && self.spring_damping != 0.0)
     }
 
+    /// Damping constant of a spring family: `spring_damping` times the family's scale.
+    pub fn spring_damping_of(&self, kind: SpringKind) -> f64 {
+        self.spring_damping * self.spring_damping_scale[kind as usize]
+    }
+
     /// Spring constant of a spring family, N/m.
     pub fn stiffness(&self, kind: SpringKind) -> f64 {
         match kind {
@@ -112,6 +120,16 @@ impl Model {
         check_non_negative("shear_stiffness", self.shear_stiffness)?;
         check_non_negative("bend_stiffness", self.bend_stiffness)?;
         check_non_negative("spring_damping", self.spring_damping)?;
+        for (name, v) in [
+            "stretch_damping_scale",
+            "shear_damping_scale",
+            "bend_damping_scale",
+        ]
+        .into_iter()
+        .zip(self.spring_damping_scale)
+        {
+            check_non_negative(name, v)?;
+        }
         check_non_negative("viscous_drag", self.viscous_drag)?;
         check_non_negative("history_drag", self.history_drag)?;
         check_non_negative("normal_drag", self.normal_drag)?;
@@ -144,6 +162,7 @@ impl Model {
             bend_stiffness: 0.5,
             spring_damping: 0.35,
             spring_damping_mode: SpringDamping::Fractional,
+            spring_damping_scale: [1.0; 3],
             viscous_drag: 1.0e-3,
             history_drag: 2.0e-3,
             normal_drag: 0.0,

@@ -206,3 +206,61 @@ fn a_cloth_without_fractional_terms_keeps_no_history() {
         .unwrap();
     assert!(!f.cloth.history().is_off());
 }
+
+/// Spring damping per family: scales (0, 0, 0) damp nothing (the same forces as no damping),
+/// (1, 1, 1) is the common value, and one family can be damped alone.
+#[test]
+fn spring_damping_can_be_set_per_family() {
+    use fraccloth::forces::{total_forces, ForceInput, ForceScratch};
+    let t = fraccloth::GridSpec {
+        width: 6,
+        height: 5,
+        spacing: 0.01,
+        total_mass: 0.01,
+    }
+    .build()
+    .unwrap();
+    let n = t.vertex_count();
+    let x: Vec<Vec3> = t
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p + 1e-3 * Vec3::new((i as f64).sin(), 0.0, (i as f64 * 0.7).cos()))
+        .collect();
+    let v: Vec<Vec3> = (0..n)
+        .map(|i| Vec3::new((i as f64 * 1.3).cos(), (i as f64).sin(), 0.2))
+        .collect();
+    let forces = |scale: [f64; 3], damping: f64| {
+        let model = Model {
+            spring_damping: damping,
+            spring_damping_mode: SpringDamping::Velocity,
+            spring_damping_scale: scale,
+            ..Model::fractional()
+        };
+        let mut f = vec![Vec3::zeros(); n];
+        let input = ForceInput {
+            model: &model,
+            topology: &t,
+            x: &x,
+            v: &v,
+            half_derivative: &[],
+            colliders: &[],
+        };
+        total_forces(&input, &mut ForceScratch::default(), &mut f);
+        f
+    };
+    let undamped = forces([1.0; 3], 0.0);
+    assert_eq!(forces([0.0; 3], 0.1), undamped);
+    let all = forces([1.0; 3], 0.1);
+    let bend_only = forces([0.0, 0.0, 1.0], 0.1);
+    let stretch_only = forces([1.0, 0.0, 0.0], 0.1);
+    assert_ne!(bend_only, undamped);
+    assert_ne!(bend_only, all);
+    // Damping is linear in the velocities: the families' parts add up to the whole.
+    let shear_only = forces([0.0, 1.0, 0.0], 0.1);
+    for i in 0..n {
+        let sum =
+            (bend_only[i] - undamped[i]) + (stretch_only[i] - undamped[i]) + (shear_only[i] - undamped[i]);
+        assert!((sum - (all[i] - undamped[i])).norm() < 1e-12, "{i}");
+    }
+}

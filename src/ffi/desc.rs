@@ -157,6 +157,13 @@ pub struct FcClothDesc {
     pub history_drag_per_area: f64,
     /// Normal drag per unit area, N s/m^3, added to `normal_drag` times the area. Default 0.
     pub normal_drag_per_area: f64,
+    /// Multiplies `spring_damping` for the stretch springs (>= 0). Default 1.
+    pub stretch_damping_scale: f64,
+    /// Multiplies `spring_damping` for the shear springs (>= 0). Default 1.
+    pub shear_damping_scale: f64,
+    /// Multiplies `spring_damping` for the bend springs (>= 0). Default 1; e.g. 0, 0, 1 damps
+    /// the bend springs alone.
+    pub bend_damping_scale: f64,
 }
 
 fn v3(a: [f64; 3]) -> Vec3 {
@@ -227,6 +234,9 @@ impl FcClothDesc {
             viscous_drag_per_area: model.water.viscous_drag,
             history_drag_per_area: model.water.history_drag,
             normal_drag_per_area: model.water.normal_drag,
+            stretch_damping_scale: model.spring_damping_scale[0],
+            shear_damping_scale: model.spring_damping_scale[1],
+            bend_damping_scale: model.spring_damping_scale[2],
         }
     }
 
@@ -303,6 +313,11 @@ impl FcClothDesc {
                 bend_stiffness: self.bend_stiffness,
                 spring_damping: self.spring_damping,
                 spring_damping_mode,
+                spring_damping_scale: [
+                    self.stretch_damping_scale,
+                    self.shear_damping_scale,
+                    self.bend_damping_scale,
+                ],
                 viscous_drag: self.viscous_drag,
                 history_drag: self.history_drag,
                 normal_drag: self.normal_drag,

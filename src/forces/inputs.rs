@@ -194,7 +194,7 @@ mod tests {
                 w.cover(keep, upto);
                 let p = Params {
                     stiffness: [0.0; 3],
-                    kd: 0.0,
+                    kd: [0.0; 3],
                     x: [&[]; 3],
                     q: [&[]; 3],
                     base: 0,

@@ -95,7 +95,7 @@ pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Li
             along: ks * (1.0 - transverse),
             across: ks * transverse,
         };
-        out.spring_damping[k] = cd;
+        out.spring_damping[k] = cd * m.spring_damping_scale[s.kind as usize];
     }
     // Every per-particle term's blocks, in the order of the list (`terms.rs`).
     let context = Context {

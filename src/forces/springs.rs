@@ -26,7 +26,8 @@ use crate::topology::{for_each_piece, SpringKind, SpringRun};
 pub(super) struct Params<'a> {
     pub stiffness: [f64; 3],
     /// Damping coefficient, 0 when the springs are undamped.
-    pub kd: f64,
+    /// Damping constant of each family (stretch, shear, bend); 0 when the springs are undamped.
+    pub kd: [f64; 3],
     /// Positions, one array per component.
     pub x: [&'a [f64]; 3],
     /// Rate the damping acts on (v or D^{1/2}x); `x` when undamped (then never read).
@@ -95,7 +96,15 @@ pub(super) fn params<'a>(
             m.stiffness(SpringKind::Shear),
             m.stiffness(SpringKind::Bend),
         ],
-        kd: if rate.is_some() { m.spring_damping } else { 0.0 },
+        kd: if rate.is_some() {
+            [
+                m.spring_damping_of(SpringKind::Stretch),
+                m.spring_damping_of(SpringKind::Shear),
+                m.spring_damping_of(SpringKind::Bend),
+            ]
+        } else {
+            [0.0; 3]
+        },
         x: scratch.x.slices(),
         q: if rate.is_some() {
             scratch.q.slices()
@@ -165,7 +174,7 @@ fn run_kernel<'a, const UNIFORM: bool>(
         &p.rest[first_spring..first_spring + n]
     };
     let rest_at = |t: usize| if UNIFORM { uniform_rest } else { rest[t] };
-    let kd = p.kd;
+    let kd = p.kd[p.kinds[first_spring] as usize];
     // Out-of-range squared lengths (see `inverse_length`) fall back to the exact kernel.
     // A squared length outside `[SEED_MIN, SEED_MAX]` (see `inverse_length`), or NaN: the slice
     // is done again exactly.
