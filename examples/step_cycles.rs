@@ -19,8 +19,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let regular = variant_arg == "regular";
     let memoryless = variant_arg == "memoryless";
     let underwater = variant_arg == "underwater";
-    if !matches!(variant_arg, "fractional" | "regular" | "memoryless" | "underwater") {
-        return Err(format!("unknown variant {variant_arg}: fractional, regular, memoryless or underwater").into());
+    if !matches!(
+        variant_arg,
+        "fractional" | "regular" | "memoryless" | "underwater"
+    ) {
+        return Err(
+            format!("unknown variant {variant_arg}: fractional, regular, memoryless or underwater").into(),
+        );
     }
     let blocks: u64 = args.get(2).map_or(Ok(20), |s| s.parse())?;
     let (w, h) = match args.get(3) {
