@@ -273,6 +273,13 @@ impl Cloth {
                 k => return Err(Error::invalid(format!("snapshot: bad collider slot tag {k}"))),
             });
         }
+        {
+            use crate::history::HalfDerivative;
+            crate::memory::ensure_available(
+                2 * self.history.bytes_per_particle() as u64 * n as u64 + bytes.len() as u64,
+                "loading a snapshot",
+            )?;
+        }
         let mut history: History = self.history.clone();
         history.read_state(&mut r)?;
         if r.remaining() != 4 {

@@ -130,7 +130,8 @@ impl<'a> ByteReader<'a> {
     pub fn vec3s_into(&mut self, expected: Option<usize>, out: &mut Vec<Vec3>) -> Result<(), Error> {
         let n = self.len(expected, 24)?;
         out.clear();
-        out.reserve(n);
+        out.try_reserve(n)
+            .map_err(|_| Error::out_of_memory(format!("no memory to read {n} vectors")))?;
         for _ in 0..n {
             out.push(self.vec3()?);
         }
@@ -139,7 +140,8 @@ impl<'a> ByteReader<'a> {
     pub fn f64s_into(&mut self, expected: Option<usize>, out: &mut Vec<f64>) -> Result<(), Error> {
         let n = self.len(expected, 8)?;
         out.clear();
-        out.reserve(n);
+        out.try_reserve(n)
+            .map_err(|_| Error::out_of_memory(format!("no memory to read {n} numbers")))?;
         for _ in 0..n {
             out.push(self.f64()?);
         }

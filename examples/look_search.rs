@@ -1,0 +1,233 @@
+//! The honest comparison of issue 22: for each model family, search its coefficients with the
+//! same budget (seeded random search, log-uniform ranges) toward the same target, the
+//! underwater preset's measured look on the swing at 31 x 21, and report the best each reaches.
+//!
+//! `cargo run --release --example look_search -- [evaluations per family, default 16]`
+//! Prints a Markdown table (docs/underwater.md holds the run of record).
+
+use fraccloth::history::Scheme;
+use fraccloth::look::{measure, Descriptors};
+use fraccloth::model::{SpringDamping, Water};
+use fraccloth::scenes::{stable_dt, top_offset, SceneKind, Variant, CLOTH_MASS, CLOTH_WIDTH};
+use fraccloth::topology::grid_index;
+use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, Model, Vec3};
+
+const W: u32 = 31;
+const H: u32 = 21;
+/// The preset's look at 31 x 21 (docs/underwater.md).
+const TARGET: (f64, f64, f64) = (4.33, 0.152, 0.31);
+
+/// Bakes the swing (the preset's 4 cm at 0.5 Hz) for 12 s and measures it; None if unstable.
+fn look(model: Model, scheme: Scheme) -> Option<Descriptors> {
+    let spacing = CLOTH_WIDTH / f64::from(W - 1);
+    let t = GridSpec {
+        width: W,
+        height: H,
+        spacing,
+        total_mass: CLOTH_MASS,
+    }
+    .build()
+    .ok()?;
+    let integrator = Integrator::SymplecticEuler;
+    let config = ClothConfig {
+        model,
+        scheme,
+        integrator,
+        ..ClothConfig::default()
+    };
+    let mut c = Cloth::new(t, config).ok()?;
+    let top: Vec<u32> = (0..W).map(|i| grid_index(W, i, 0)).collect();
+    c.set_pinned(&top).ok()?;
+    let rest: Vec<Vec3> = top.iter().map(|&i| c.positions()[i as usize]).collect();
+    let dt = stable_dt(spacing, integrator);
+    let (fps, mut frames, mut times) = (30.0, vec![c.positions().to_vec()], vec![0.0]);
+    let per_frame = (1.0 / fps / dt).round() as usize;
+    let h = 1.0 / fps / per_frame as f64;
+    for f in 1..=(12.0 * fps) as usize {
+        for _ in 0..per_frame {
+            let off = top_offset(SceneKind::Swing, Variant::Underwater, c.time() + h);
+            let targets: Vec<Vec3> = rest.iter().map(|p| p + off).collect();
+            c.set_pin_targets(&top, &targets).ok()?;
+            c.step(h).ok()?;
+        }
+        frames.push(c.positions().to_vec());
+        times.push(f as f64 / fps);
+    }
+    let topo = c.topology();
+    measure(&topo.rest_positions, &topo.triangles, &frames, &times, Vec3::y())
+        .ok()
+        .map(|l| l.descriptors)
+}
+
+/// Distance to the target look: relative half-waves, log travel speed, mid ratio in tenths;
+/// penalties for no travelling wave, a zigzag above 3, a column hanging short, instability.
+fn cost(d: &Option<Descriptors>) -> f64 {
+    let Some(d) = d else { return 100.0 };
+    let mut j = (d.half_waves / TARGET.0 - 1.0).powi(2) + ((d.mid_ratio - TARGET.2) / 0.1).powi(2);
+    j += match d.travel_speed {
+        Some(c) if c > 0.0 => (c / TARGET.1).ln().powi(2),
+        _ => 4.0,
+    };
+    j += (d.zigzag.unwrap_or(0.0) - 3.0).max(0.0).powi(2);
+    j += 10.0 * (0.9 - d.hang_depth / 0.4).max(0.0);
+    j
+}
+
+/// A seeded generator of numbers in [0, 1).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Log-uniform in [lo, hi], or 0 a fifth of the time when `zero` (switched off).
+    fn coef(&mut self, lo: f64, hi: f64, zero: bool) -> f64 {
+        if zero && self.next() < 0.2 {
+            return 0.0;
+        }
+        lo * (hi / lo).powf(self.next())
+    }
+}
+
+fn main() {
+    let budget: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(16);
+    let base = Model {
+        viscous_drag: 0.0,
+        history_drag: 0.0,
+        normal_drag: 0.0,
+        ..Model::fractional()
+    };
+    type Family = (&'static str, Scheme, fn(&mut Rng, &Model) -> (Model, String));
+    let families: [Family; 5] = [
+        ("paper fractional (Eq. 6, u = 3)", Scheme::PAPER, |r, b| {
+            fractional(r, b)
+        }),
+        ("fractional, full memory (SOE)", Scheme::DEFAULT, |r, b| {
+            fractional(r, b)
+        }),
+        (
+            "regular (damped springs, viscous and normal drag)",
+            Scheme::Off,
+            |r, b| {
+                let (kd, kv, kn) = (
+                    r.coef(1e-3, 0.1, true),
+                    r.coef(0.1, 50.0, true),
+                    r.coef(0.1, 100.0, true),
+                );
+                let m = Model {
+                    spring_damping: kd,
+                    spring_damping_mode: SpringDamping::Velocity,
+                    water: Water {
+                        viscous_drag: kv,
+                        normal_drag: kn,
+                        ..Water::default()
+                    },
+                    ..b.clone()
+                };
+                (
+                    m,
+                    format!("k_d {kd:.3} N s/m, viscous {kv:.2}, normal {kn:.2} N s/m^3"),
+                )
+            },
+        ),
+        (
+            "physical: entrained water + form drag, no half-derivative",
+            Scheme::Off,
+            |r, b| {
+                let (me, cd, kd) = (
+                    r.coef(0.5, 40.0, false),
+                    r.coef(0.05, 4.0, true),
+                    r.coef(1e-3, 0.1, true),
+                );
+                let m = Model {
+                    spring_damping: kd,
+                    spring_damping_mode: SpringDamping::Velocity,
+                    water: Water {
+                        entrained_mass: me,
+                        form_drag: cd,
+                        ..Water::default()
+                    },
+                    ..b.clone()
+                };
+                (
+                    m,
+                    format!("entrained {me:.2} kg/m^2, C_d {cd:.2}, k_d {kd:.3} N s/m"),
+                )
+            },
+        ),
+        (
+            "physical + half-derivative (fractional springs, history drag)",
+            Scheme::DEFAULT,
+            |r, b| {
+                let (me, cd) = (r.coef(0.5, 40.0, false), r.coef(0.05, 4.0, true));
+                let (kd, kh) = (r.coef(0.01, 1.0, true), r.coef(0.1, 50.0, true));
+                let m = Model {
+                    spring_damping: kd,
+                    spring_damping_mode: SpringDamping::Fractional,
+                    water: Water {
+                        entrained_mass: me,
+                        form_drag: cd,
+                        history_drag: kh,
+                        ..Water::default()
+                    },
+                    ..b.clone()
+                };
+                (m, format!("entrained {me:.2} kg/m^2, C_d {cd:.2}, fractional k_d {kd:.3}, history {kh:.2} N s^1/2/m^3"))
+            },
+        ),
+    ];
+    println!("target (the preset at {W} x {H}): {} half-waves, {} m/s, mid ratio {}; {budget} evaluations per family\n", TARGET.0, TARGET.1, TARGET.2);
+    println!(
+        "| family | cost | half-waves | travel (m/s) | mid ratio | zigzag | hang (m) | best coefficients |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for (k, (name, scheme, draw)) in families.iter().enumerate() {
+        let mut rng = Rng(0x5eed + k as u64);
+        let mut best: Option<(f64, Option<Descriptors>, String)> = None;
+        for _ in 0..budget {
+            let (model, label) = draw(&mut rng, &base);
+            let d = look(model, *scheme);
+            let j = cost(&d);
+            if best.as_ref().is_none_or(|b| j < b.0) {
+                best = Some((j, d, label));
+            }
+        }
+        let Some((j, d, label)) = best else { continue };
+        match d {
+            Some(d) => println!(
+                "| {name} | {j:.2} | {:.2} | {} | {:.2} | {} | {:.3} | {label} |",
+                d.half_waves,
+                d.travel_speed.map_or("none".into(), |c| format!("{c:.3}")),
+                d.mid_ratio,
+                d.zigzag.map_or("n/a".into(), |z| format!("{z:.2}")),
+                d.hang_depth
+            ),
+            None => println!("| {name} | {j:.2} | unstable | | | | | {label} |"),
+        }
+    }
+}
+
+fn fractional(r: &mut Rng, b: &Model) -> (Model, String) {
+    let (kd, kh, kv) = (
+        r.coef(0.01, 1.0, true),
+        r.coef(0.1, 50.0, true),
+        r.coef(0.1, 50.0, true),
+    );
+    let m = Model {
+        spring_damping: kd,
+        spring_damping_mode: SpringDamping::Fractional,
+        water: Water {
+            history_drag: kh,
+            viscous_drag: kv,
+            ..Water::default()
+        },
+        ..b.clone()
+    };
+    (
+        m,
+        format!("fractional k_d {kd:.3} N s^1/2/m, history {kh:.2} N s^1/2/m^3, viscous {kv:.2} N s/m^3"),
+    )
+}
