@@ -50,6 +50,10 @@ class BuildWithLibrary(build_py):
         shutil.copy2(find_or_build_library(), dest / library_name())
         header = Path(os.environ.get("FRACCLOTH_HEADER", REPO / "include" / "fraccloth.h"))
         shutil.copy2(header, dest / "fraccloth.h")
+        # The license texts travel with the wheel.
+        for name in ("LICENSE-MIT", "LICENSE-APACHE"):
+            if (REPO / name).exists():
+                shutil.copy2(REPO / name, dest / name)
 
 
 class BinaryDistribution(Distribution):

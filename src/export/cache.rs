@@ -89,8 +89,8 @@ fn obj_file(path: &Path, positions: &[Vec3], triangles: &[[u32; 3]]) -> io::Resu
 
 impl CacheWriter {
     /// Opens `path` for `vertex_count` vertices. `start_frame` is the host frame of the first
-    /// sample (|start_frame| <= [`MAX_START_FRAME`]), `fps` frames per second (within
-    /// [`FPS_RANGE`]), `expected_frames` how many frames will be written (MDD needs it up front,
+    /// sample (|start_frame| <= `MAX_START_FRAME`), `fps` frames per second (within
+    /// `FPS_RANGE`), `expected_frames` how many frames will be written (MDD needs it up front,
     /// at most [`super::MAX_MDD_FRAMES`]; the others ignore it). `triangles` are written into
     /// every OBJ.
     pub fn create(

@@ -18,7 +18,7 @@ use crate::topology::Topology;
 
 /// Adds `values[s]` (times 1 at the `i` end, `j_sign` at the `j` end) of every spring touching
 /// particles `first .. first + out.len()` to `out`. `first` must be a multiple of
-/// [`crate::parallel::CHUNK`] and `out` at most one chunk long.
+/// `crate::parallel::CHUNK` and `out` at most one chunk long.
 pub fn add_spring_values<T>(t: &Topology, first: usize, values: &[T], j_sign: f64, out: &mut [T])
 where
     T: Pod + AddAssign + Mul<f64, Output = T>,
@@ -69,7 +69,7 @@ pub(super) use crate::parallel::TILE;
 
 /// Sets `acc[c][k]` to the sum of the forces of every spring touching particle `p0 + k`
 /// (`+f` at its `i` end, `-f` at its `j` end), for `k < len <= TILE`, from the per-spring
-/// component arrays `f`. The tile must lie inside one [`crate::parallel::CHUNK`]. Each
+/// component arrays `f`. The tile must lie inside one `crate::parallel::CHUNK`. Each
 /// particle's springs are added in a fixed order (run by run, or along its adjacency row), so
 /// the sums do not depend on tiles, chunks or threads.
 pub(super) fn add_spring_forces(

@@ -1,5 +1,5 @@
 //! Forces on the particles (paper, section 4.1): one file per force family, the per-particle
-//! terms listed once ([`terms`]), and the pass that sums them tile by tile ([`pass`]).
+//! terms listed once (`terms`), and the pass that sums them tile by tile (`pass`).
 //!
 //! | file | what |
 //! |---|---|

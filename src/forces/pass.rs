@@ -106,7 +106,7 @@ pub fn total_forces_with(
 }
 
 /// Evaluates the total force on every particle, tile by tile, and hands each tile's totals
-/// and state to `sink` once (at most [`TILE`] particles, all in one [`parallel::CHUNK`]).
+/// and state to `sink` once (at most [`TILE`] particles, all in one `parallel::CHUNK`).
 /// Tiles of different chunks may be handed over on different threads, in any order; the
 /// forces do not depend on the thread count.
 pub fn for_each_tile<S>(input: &ForceInput<'_>, scratch: &mut ForceScratch, inputs: SpringInputs, sink: S)

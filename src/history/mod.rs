@@ -6,11 +6,11 @@
 //! what lets an implicit integrator treat `w0` as damping and `H_n` as a known force.
 //!
 //! How a step uses it (`src/cloth/step.rs`):
-//! 1. [`History::begin_step`] readies the step's weights (each scheme keeps its own clock) and
-//!    returns a [`StepPast`] that fills `H_n` range by range inside the step's pass over the
+//! 1. `History::begin_step` readies the step's weights (each scheme keeps its own clock) and
+//!    returns a `StepPast` that fills `H_n` range by range inside the step's pass over the
 //!    particles; the SOE history folds the last accepted step into its modes during that same
-//!    walk; then [`History::end_step`];
-//! 2. after the step is accepted, [`History::record`] takes the velocities the step started
+//!    walk; then `History::end_step`;
+//! 2. after the step is accepted, `History::record` takes the velocities the step started
 //!    from (relative to the water) and the step size.
 //!
 //! [`HalfDerivative`] (`prepare`, `current_weight`, `past`, `push`) is the same protocol one
@@ -313,7 +313,7 @@ impl History {
     }
 }
 
-/// What one step's pass over the particles reads of the history, from [`History::begin_step`].
+/// What one step's pass over the particles reads of the history, from `History::begin_step`.
 pub(crate) enum StepPast<'a> {
     /// Schemes whose past is read only.
     Read(&'a History),

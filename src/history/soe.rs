@@ -67,13 +67,13 @@ pub(crate) const LANES: usize = 16;
 
 /// SOE history of `n` particles.
 ///
-/// Layout: particles are stored in blocks of [`LANES`]; within a block the modes are ordered
+/// Layout: particles are stored in blocks of `LANES`; within a block the modes are ordered
 /// mode, component, particle (`[K][3][LANES]`), so the update of one mode is the same
 /// arithmetic on `3 * LANES` contiguous numbers and the compiler vectorises it across particles.
 ///
 /// Work per step, deferred: an accepted step only records its velocities `v_n`
-/// ([`Self::record`], a buffer swap). The next step's pass over the particles ([`Self::begin`],
-/// then [`SoePass::past_range`] tile by tile) folds that panel into every mode and, in the same
+/// (`Self::record`, a buffer swap). The next step's pass over the particles (`Self::begin`,
+/// then `SoePass::past_range` tile by tile) folds that panel into every mode and, in the same
 /// walk over the modes, sums the past `H = w_prev v_n + sum_l w_l e^{-s_l h} G_l` that step
 /// needs, while the step's other per-particle work has the tile in cache: the modes are read
 /// and written once per step and no other array of the history is streamed. The fold depends
@@ -348,7 +348,7 @@ impl SumOfExponentials {
 
     /// Begins a step's pass: readies its weights and plans the fold of what the last accepted
     /// step recorded. The caller then fills `H_n` of every particle exactly once through the
-    /// returned pass (in ranges that start on a block of [`LANES`]) and calls [`Self::end`].
+    /// returned pass (in ranges that start on a block of `LANES`) and calls [`Self::end`].
     pub(crate) fn begin(&mut self) -> SoePass<'_> {
         self.set_weights();
         self.plan = plan(&self.kernel, self.cut, &self.clock, &mut self.coef);
@@ -365,7 +365,7 @@ impl SumOfExponentials {
         }
     }
 
-    /// Ends the pass begun by [`Self::begin`], which covered every particle: the recorded
+    /// Ends the pass begun by `Self::begin`, which covered every particle: the recorded
     /// sample is now folded in.
     pub(crate) fn end(&mut self) {
         if let Some(h) = self.plan.fold.take() {
@@ -544,8 +544,8 @@ impl SoePass<'_> {
     /// there is one) and writes their `H_n` into `out`.
     ///
     /// # Safety
-    /// Ranges passed by calls that overlap in time must not share a block of [`LANES`]
-    /// particles: `first` must be a multiple of [`LANES`], and the range must end on one or at
+    /// Ranges passed by calls that overlap in time must not share a block of `LANES`
+    /// particles: `first` must be a multiple of `LANES`, and the range must end on one or at
     /// the last particle. Each particle must be covered exactly once per pass (a fold is not
     /// idempotent). Panics when the range is not aligned so.
     pub(crate) unsafe fn past_range(&self, first: usize, out: &mut [Vec3]) {
@@ -689,7 +689,7 @@ fn pass_blocks(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64
     }
 }
 
-/// One block of up to [`LANES`] particles: folds the panel (`prev`, `v`) into its modes when
+/// One block of up to `LANES` particles: folds the panel (`prev`, `v`) into its modes when
 /// `FOLD`, and writes each particle's `H` into `out`. Same arithmetic, in the same order, for
 /// every particle as a scalar loop over its modes; laid out so it vectorises across lanes.
 /// `WITH_PREV`: whether the `a v_{n-1}` term is added (some `a` is not zero).

@@ -52,7 +52,7 @@ impl Adjacency {
         Self::from_pairs(n, pairs)
     }
 
-    /// Runs touching each chunk of [`crate::parallel::CHUNK`] vertices (as the `i` end or as
+    /// Runs touching each chunk of `crate::parallel::CHUNK` vertices (as the `i` end or as
     /// the `j` end), in ascending run order.
     pub fn chunk_runs(n: usize, runs: &[super::SpringRun]) -> Self {
         let chunk = crate::parallel::CHUNK;

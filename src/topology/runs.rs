@@ -2,7 +2,7 @@
 //! ... of one family. A run's end points are contiguous in memory, so the spring pass loads
 //! them as plain slices (no index loads, no gathers) and the compiler vectorises it.
 //!
-//! [`order_into_runs`] sorts a spring list by (family, offset, first vertex); a grid then falls
+//! `order_into_runs` sorts a spring list by (family, offset, first vertex); a grid then falls
 //! into long runs (a whole vertical family is one run) and any mesh whose vertices are
 //! numbered in rows (most are) into fairly long ones. A spring that fits no run is a run of
 //! one: the layout is never wrong, only less fast.
@@ -89,7 +89,7 @@ pub struct TileRuns {
 }
 
 impl TileRuns {
-    /// Pads `runs` (from [`order_into_runs`] on `springs`) for `n` vertices.
+    /// Pads `runs` (from `order_into_runs` on `springs`) for `n` vertices.
     pub fn new(n: usize, springs: &[Spring], runs: &[SpringRun]) -> Self {
         let mut t = Self::default();
         for r in runs {

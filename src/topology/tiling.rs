@@ -6,7 +6,7 @@
 use super::TileRuns;
 use crate::parallel::TILE;
 
-/// Largest run offset the tile path accepts: one [`crate::parallel::CHUNK`], so that a spring
+/// Largest run offset the tile path accepts: one `crate::parallel::CHUNK`, so that a spring
 /// reaching into a group from before it ends in the group's first chunk (grids up to 2048
 /// columns). Beyond it, the per-spring buffer path is used.
 const MAX_OFFSET: usize = crate::parallel::CHUNK;
@@ -18,7 +18,7 @@ pub struct TileLayout {
     /// Numbers per component of the window: the largest offset plus whole tiles, at least as
     /// many particles as the offset, so sliding it copies at most one number per particle.
     pub window: usize,
-    /// Particles per group, a multiple of [`crate::parallel::CHUNK`].
+    /// Particles per group, a multiple of `crate::parallel::CHUNK`.
     pub group: usize,
     /// Runs when the topology has at most [`GATHER_RUNS`] of them (a grid has eight; a few more
     /// allow a grid with holes or a row-ordered mesh), and the
@@ -27,11 +27,11 @@ pub struct TileLayout {
     /// Entries before a tile in each force window of the gather path: the largest offset,
     /// rounded up to whole cache lines so that a tile's entries start on one.
     pub lead: usize,
-    /// Numbers per component of each force window: `lead` and [`GATHER_TILES`] tiles or more.
+    /// Numbers per component of each force window: `lead` and `GATHER_TILES` tiles or more.
     pub force_window: usize,
     /// Particles in the window of inputs (`forces::inputs::InputWindow`): what the springs from before a
     /// group read (twice the largest offset) or what a tile's springs read (a tile and the
-    /// largest offset), and [`INPUT_TILES`] tiles more, so that it slides once every few tiles.
+    /// largest offset), and `INPUT_TILES` tiles more, so that it slides once every few tiles.
     pub inputs: usize,
 }
 
