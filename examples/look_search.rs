@@ -2,8 +2,10 @@
 //! same budget (seeded random search, log-uniform ranges) toward the same target, the
 //! underwater preset's measured look on the swing at 31 x 21, and report the best each reaches.
 //!
-//! `cargo run --release --example look_search -- [evaluations per family, default 16]`
-//! Prints a Markdown table (docs/underwater.md holds the run of record).
+//! `cargo run --release --example look_search -- [evaluations per family, default 16] [OUT_DIR]`
+//! Prints a Markdown table (docs/underwater.md holds the run of record). With OUT_DIR, the best
+//! draw of each family is baked again and written there as `familyK.mdd` with `rest.obj`, for
+//! `fraccloth look familyK.mdd --rest rest.obj --pictures PREFIX` (side views, space-time plots).
 
 use fraccloth::history::Scheme;
 use fraccloth::look::{measure, Descriptors};
@@ -18,7 +20,8 @@ const H: u32 = 21;
 const TARGET: (f64, f64, f64) = (4.33, 0.152, 0.31);
 
 /// Bakes the swing (the preset's 4 cm at 0.5 Hz) for 12 s and measures it; None if unstable.
-fn look(model: Model, scheme: Scheme) -> Option<Descriptors> {
+/// With `save`, also writes the frames as an MDD cache and the rest mesh as OBJ.
+fn look(model: Model, scheme: Scheme, save: Option<(&std::path::Path, usize)>) -> Option<Descriptors> {
     let spacing = CLOTH_WIDTH / f64::from(W - 1);
     let t = GridSpec {
         width: W,
@@ -54,6 +57,32 @@ fn look(model: Model, scheme: Scheme) -> Option<Descriptors> {
         times.push(f as f64 / fps);
     }
     let topo = c.topology();
+    if let Some((dir, k)) = save {
+        use fraccloth::export::{write_obj, CacheFormat, CacheWriter};
+        let file = std::fs::File::create(dir.join("rest.obj")).ok()?;
+        write_obj(
+            std::io::BufWriter::new(file),
+            &topo.rest_positions,
+            &topo.triangles,
+        )
+        .ok()?;
+        let path = dir.join(format!("family{k}.mdd"));
+        let n = frames.len() as u32;
+        let mut w = CacheWriter::create(
+            &path,
+            CacheFormat::Mdd,
+            c.vertex_count(),
+            &topo.triangles,
+            1.0,
+            fps,
+            n,
+        )
+        .ok()?;
+        for f in &frames {
+            w.write_frame(f).ok()?;
+        }
+        w.finish().ok()?;
+    }
     measure(&topo.rest_positions, &topo.triangles, &frames, &times, Vec3::y())
         .ok()
         .map(|l| l.descriptors)
@@ -94,6 +123,13 @@ impl Rng {
 
 fn main() {
     let budget: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(16);
+    let out = std::env::args().nth(2).map(std::path::PathBuf::from);
+    if let Some(dir) = &out {
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            eprintln!("{}: {e}", dir.display());
+            return;
+        }
+    }
     let base = Model {
         viscous_drag: 0.0,
         history_drag: 0.0,
@@ -186,16 +222,21 @@ fn main() {
     println!("|---|---|---|---|---|---|---|---|");
     for (k, (name, scheme, draw)) in families.iter().enumerate() {
         let mut rng = Rng(0x5eed + k as u64);
-        let mut best: Option<(f64, Option<Descriptors>, String)> = None;
+        let mut best: Option<(f64, Option<Descriptors>, String, Model)> = None;
         for _ in 0..budget {
             let (model, label) = draw(&mut rng, &base);
-            let d = look(model, *scheme);
+            let d = look(model.clone(), *scheme, None);
             let j = cost(&d);
             if best.as_ref().is_none_or(|b| j < b.0) {
-                best = Some((j, d, label));
+                best = Some((j, d, label, model));
             }
         }
-        let Some((j, d, label)) = best else { continue };
+        let Some((j, d, label, model)) = best else {
+            continue;
+        };
+        if let Some(dir) = &out {
+            look(model, *scheme, Some((dir, k + 1)));
+        }
         match d {
             Some(d) => println!(
                 "| {name} | {j:.2} | {:.2} | {} | {:.2} | {} | {:.3} | {label} |",
