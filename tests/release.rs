@@ -27,6 +27,15 @@ fn the_version_is_defined_once_and_every_package_carries_it() {
         read("bindings/blender/fraccloth_blender/__init__.py").contains(&tuple),
         "the add-on's bl_info is not at {v}"
     );
+    // The CMake example asks for this major.minor (the package accepts the same major.minor).
+    let cmake = read("examples_c/CMakeLists.txt");
+    let wanted = format!("find_package(fraccloth {}.{} REQUIRED)", parts[0], parts[1]);
+    assert!(
+        cmake.contains(&wanted),
+        "examples_c/CMakeLists.txt does not ask for {}.{}",
+        parts[0],
+        parts[1]
+    );
     // The header's FC_VERSION and fc_version() come from the crate version (tests/header.rs).
     let number: u32 = parts[0].parse::<u32>().unwrap() * 1_000_000
         + parts[1].parse::<u32>().unwrap() * 1_000
