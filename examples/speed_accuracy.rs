@@ -1,5 +1,6 @@
 //! Speed against accuracy: every history scheme x integrator x time step on the fractional
-//! oscillator and on the `swing` and `sphere` scenes, with the Pareto chart users choose from.
+//! oscillator and on the `swing` and `sphere` scenes, and every integrator x time step on the
+//! underwater preset's swing, with the Pareto chart users choose from.
 //!
 //! `cargo run --release --example speed_accuracy` (the full run, for humans: about 15 minutes on
 //! 2 cores) writes docs/speed_accuracy.csv, docs/pareto.png, docs/pareto.svg and
@@ -51,7 +52,7 @@ fn label(s: &Scheme) -> String {
         Scheme::Truncated { u } => format!("paper u={u}"),
         Scheme::Full => "full".into(),
         Scheme::SumOfExponentials { tolerance, .. } => format!("SOE {tolerance:e}"),
-        Scheme::Off => "off".into(),
+        Scheme::Off => "no history (underwater preset)".into(),
     }
 }
 
@@ -139,14 +140,25 @@ fn run_oscillator(set: &Settings, scheme: Scheme, integrator: Integrator, dt: f6
     rec
 }
 
-fn scene_spec(set: &Settings, kind: SceneKind, scheme: Scheme, integrator: Integrator, dt: f64) -> SceneSpec {
+/// One scene of the chart: which scene, which model, which history schemes it is run with.
+struct SceneProblem {
+    name: &'static str,
+    kind: SceneKind,
+    variant: Variant,
+    /// History schemes to run (the underwater preset has no half-derivative term: `Off`).
+    schemes: Vec<Scheme>,
+    /// History scheme of the reference run.
+    reference: Scheme,
+}
+
+fn scene_spec(set: &Settings, p: &SceneProblem, scheme: Scheme, integrator: Integrator, dt: f64) -> SceneSpec {
     SceneSpec {
         width: set.width,
         height: set.height,
         scheme,
         integrator,
         dt,
-        ..SceneSpec::paper(kind, Variant::Fractional)
+        ..SceneSpec::paper(p.kind, p.variant)
     }
 }
 
@@ -204,7 +216,7 @@ fn ratios(set: &Settings, records: &[Record], out: &mut String) -> Result<(), Bo
     let ratio_t = if set.quick { 0.5 } else { 2.0 };
     writeln!(
         out,
-        "== fractional (SOE 1e-3) vs regular (damped springs, normal drag): same {}x{} mesh, {ratio_t} s of swing",
+        "== fractional (SOE 1e-3) and the underwater preset vs regular (damped springs, normal drag): same {}x{} mesh, {ratio_t} s of swing",
         set.width, set.height
     )?;
     for integrator in [
@@ -218,23 +230,33 @@ fn ratios(set: &Settings, records: &[Record], out: &mut String) -> Result<(), Bo
             5e-4
         };
         let mut walls = vec![];
-        for variant in [Variant::Fractional, Variant::Regular(RegularDrag::Normal)] {
+        for variant in [
+            Variant::Fractional,
+            Variant::Regular(RegularDrag::Normal),
+            Variant::Underwater,
+        ] {
             let spec = SceneSpec {
-                variant,
+                width: set.width,
+                height: set.height,
                 scheme: Scheme::DEFAULT,
-                ..scene_spec(set, SceneKind::Swing, Scheme::DEFAULT, integrator, dt)
+                integrator,
+                dt,
+                ..SceneSpec::paper(SceneKind::Swing, variant)
             };
             let (_, wall, _, _) = run_scene(spec, ratio_t).ok_or("run failed")?;
             walls.push(wall);
         }
         writeln!(
             out,
-            "{:17} dt {:.2e}: fractional {:.3} s, regular {:.3} s, ratio {:.2}x (target <= 1.3x)",
+            "{:17} dt {:.2e}: fractional {:.3} s, regular {:.3} s, ratio {:.2}x (target <= 1.3x); \
+             underwater preset {:.3} s, ratio to regular {:.2}x (target <= 1.3x)",
             integrator.name(),
             dt,
             walls[0],
             walls[1],
-            walls[0] / walls[1]
+            walls[0] / walls[1],
+            walls[2],
+            walls[2] / walls[1]
         )?;
     }
     // 2. Equal error on swing.
@@ -277,6 +299,25 @@ fn ratios(set: &Settings, records: &[Record], out: &mut String) -> Result<(), Bo
             writeln!(out, "the paper's configuration (u=3, explicit Euler) never reaches 1 mm: its best error is {best:.2e} m")?;
         }
     }
+    // 3. The underwater preset at equal error: the cheapest run of each integrator within 1 mm.
+    writeln!(out, "\n== underwater preset at equal error (1 mm RMS)")?;
+    for integrator in Integrator::ALL {
+        let best = records
+            .iter()
+            .filter(|r| r.problem == "underwater" && r.completed && r.integrator == integrator && r.error <= 1e-3)
+            .min_by(|a, b| a.wall_per_sim_s.total_cmp(&b.wall_per_sim_s));
+        match best {
+            Some(r) => writeln!(
+                out,
+                "{}: dt {:.2e}, error {:.2e} m, {:.3} s per simulated s",
+                integrator.name(),
+                r.dt,
+                r.error,
+                r.wall_per_sim_s
+            )?,
+            None => writeln!(out, "{}: no step tried reaches 1 mm", integrator.name())?,
+        }
+    }
     // 3. SOE per-step cost at step 1e3 against 1e6 (1e5 in quick mode).
     let far = if set.quick { 100_000 } else { 1_000_000 };
     let soe = small(Scheme::DEFAULT, far, &[1_000, far]);
@@ -316,8 +357,8 @@ fn colour(i: Integrator) -> RGBColor {
     }
 }
 
-const GLYPHS: [&str; 7] = [
-    "\u{25cf}", "\u{25b2}", "\u{25bc}", "\u{25a0}", "\u{25c6}", "\u{2715}", "\u{2605}",
+const GLYPHS: [&str; 8] = [
+    "\u{25cf}", "\u{25b2}", "\u{25bc}", "\u{25a0}", "\u{25c6}", "\u{2715}", "\u{2605}", "\u{271a}",
 ];
 
 fn pareto(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
@@ -341,7 +382,8 @@ where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE)?;
-    let all = schemes();
+    let mut all = schemes();
+    all.push(Scheme::Off);
     let panels = root.split_evenly((1, problems.len()));
     for (panel, &problem) in panels.iter().zip(problems) {
         let mine: Vec<&Record> = records
@@ -492,18 +534,44 @@ fn main() -> Result<(), Box<dyn Error>> {
         }
     }
     // Scenes.
-    for kind in [SceneKind::Swing, SceneKind::Sphere] {
-        // Reference: implicit Euler with the SOE history at 1e-8, Richardson-extrapolated from
-        // dt and 2 dt (first order in time: 2 x(dt) - x(2 dt) cancels the leading error). Its
-        // uncertainty is estimated by the same extrapolation one level coarser (2 dt and 4 dt).
-        let ref_scheme = Scheme::SumOfExponentials {
-            tolerance: 1e-8,
-            horizon: 3600.0,
-            min_dt: 1e-5,
-        };
+    let fine = Scheme::SumOfExponentials {
+        tolerance: 1e-8,
+        horizon: 3600.0,
+        min_dt: 1e-5,
+    };
+    let problems = [
+        SceneProblem {
+            name: "swing",
+            kind: SceneKind::Swing,
+            variant: Variant::Fractional,
+            schemes: schemes(),
+            reference: fine,
+        },
+        SceneProblem {
+            name: "sphere",
+            kind: SceneKind::Sphere,
+            variant: Variant::Fractional,
+            schemes: schemes(),
+            reference: fine,
+        },
+        // The underwater preset (added mass, form drag, entrained water; no half-derivative).
+        SceneProblem {
+            name: "underwater",
+            kind: SceneKind::Swing,
+            variant: Variant::Underwater,
+            schemes: vec![Scheme::Off],
+            reference: Scheme::Off,
+        },
+    ];
+    for p in &problems {
+        // Reference: implicit Euler with the SOE history at 1e-8 (no history for the underwater
+        // preset), Richardson-extrapolated from dt and 2 dt (first order in time: 2 x(dt) -
+        // x(2 dt) cancels the leading error). Its uncertainty is estimated by the same
+        // extrapolation one level coarser (2 dt and 4 dt).
+        let ref_scheme = p.reference;
         let run_ref = |dt: f64| -> Result<Vec<Vec3>, Box<dyn Error>> {
             Ok(run_scene(
-                scene_spec(&set, kind, ref_scheme, Integrator::ImplicitEuler, dt),
+                scene_spec(&set, p, ref_scheme, Integrator::ImplicitEuler, dt),
                 set.t_end,
             )
             .ok_or("reference run failed")?
@@ -519,9 +587,10 @@ fn main() -> Result<(), Box<dyn Error>> {
         let reference = extrapolate(&x1, &x2);
         let coarse = extrapolate(&x2, &x4);
         let line = format!(
-            "{} reference (implicit, SOE 1e-8, Richardson from dt {:.1e} and {:.1e}): plain runs differ by {:.3e} m; \
+            "{} reference (implicit, {}, Richardson from dt {:.1e} and {:.1e}): plain runs differ by {:.3e} m; \
              extrapolated reference differs from the one at 2x coarser steps by {:.3e} m",
-            kind.name(),
+            p.name,
+            label(&ref_scheme),
             set.ref_dt,
             2.0 * set.ref_dt,
             rms(&x1, &x2),
@@ -530,15 +599,15 @@ fn main() -> Result<(), Box<dyn Error>> {
         println!("{line}");
         writeln!(log, "{line}")?;
         let n = (set.width * set.height) as usize;
-        for scheme in schemes() {
+        for &scheme in &p.schemes {
             for integrator in Integrator::ALL {
                 for &dt in &set.dts {
                     let steps = set.t_end / dt;
-                    let mut rec = Record::new(kind.name(), scheme, integrator, dt, n);
+                    let mut rec = Record::new(p.name, scheme, integrator, dt, n);
                     let skip = scheme == Scheme::Full && steps > 2_000.0;
                     if !skip {
                         if let Some((pos, wall, count, bytes)) =
-                            run_scene(scene_spec(&set, kind, scheme, integrator, dt), set.t_end)
+                            run_scene(scene_spec(&set, p, scheme, integrator, dt), set.t_end)
                         {
                             rec.completed = true;
                             rec.error = rms(&pos, &reference);
@@ -549,7 +618,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                     }
                     println!(
                         "{} {:10} {:17} dt {dt:.2e}: {} error {:.3e} m, {:.3e} s/sim-s",
-                        kind.name(),
+                        p.name,
                         label(&scheme),
                         integrator.name(),
                         if skip {
@@ -591,14 +660,14 @@ fn main() -> Result<(), Box<dyn Error>> {
     ratios(&set, &records, &mut text)?;
     print!("{text}");
     std::fs::write(out_dir.join("ratios.txt"), &text)?;
-    let problems = ["oscillator", "swing", "sphere"];
+    let problems = ["oscillator", "swing", "sphere", "underwater"];
     draw(
-        BitMapBackend::new(&out_dir.join("pareto.png"), (1800, 640)).into_drawing_area(),
+        BitMapBackend::new(&out_dir.join("pareto.png"), (2400, 640)).into_drawing_area(),
         &records,
         &problems,
     )?;
     draw(
-        SVGBackend::new(&out_dir.join("pareto.svg"), (1800, 640)).into_drawing_area(),
+        SVGBackend::new(&out_dir.join("pareto.svg"), (2400, 640)).into_drawing_area(),
         &records,
         &problems,
     )?;

@@ -1,6 +1,7 @@
 //! Stability map: for each integrator x history scheme, the largest stable time step on
 //! (a) the fractional oscillator m x'' + c D^{1/2}x + k x = F over a range of stiffness k and
-//! (b) the `swing` scene (31 x 21, fractional) over a range of spring stiffness scales.
+//! (b) the `swing` scene (31 x 21, fractional) and (c) the underwater preset's swing (31 x 21:
+//! added mass, entrained water, form drag) over a range of spring stiffness scales.
 //!
 //! `cargo run --release --example stability_map` writes docs/stability.csv,
 //! docs/stability.png and docs/stability.svg. `-- --quick` runs a reduced sweep.
@@ -57,7 +58,7 @@ fn growth(cloth: &mut Cloth, o: &Oscillator, dt: f64, steps: usize) -> Option<(f
     Some((a, b))
 }
 
-fn swing_stable(scale: f64, scheme: Scheme, integrator: Integrator, dt: f64) -> bool {
+fn swing_stable(variant: Variant, scale: f64, scheme: Scheme, integrator: Integrator, dt: f64) -> bool {
     let spec = SceneSpec {
         width: 31,
         height: 21,
@@ -65,7 +66,7 @@ fn swing_stable(scale: f64, scheme: Scheme, integrator: Integrator, dt: f64) -> 
         integrator,
         dt,
         stiffness_scale: scale,
-        ..SceneSpec::paper(SceneKind::Swing, Variant::Fractional)
+        ..SceneSpec::paper(SceneKind::Swing, variant)
     };
     let Ok(mut scene) = spec.build() else { return false };
     let t_end = 2.0f64.max(50.0 * dt);
@@ -107,7 +108,7 @@ fn scheme_label(s: Scheme) -> String {
         Scheme::Truncated { u } => format!("paper Eq.6 u={u}"),
         Scheme::Full => "full".into(),
         Scheme::SumOfExponentials { tolerance, .. } => format!("SOE {tolerance:e}"),
-        Scheme::Off => "off".into(),
+        Scheme::Off => "preset, no history".into(),
     }
 }
 
@@ -128,10 +129,11 @@ where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE)?;
-    let panels = root.split_evenly((1, 2));
+    let panels = root.split_evenly((1, 3));
     for (panel, (problem, xdesc)) in panels.iter().zip([
         ("oscillator", "spring constant k (N/m), m = 1 kg, c = 0.8"),
         ("swing", "stiffness scale of the swing cloth (1 = 10 N/m stretch)"),
+        ("underwater", "stiffness scale of the underwater preset's springs"),
     ]) {
         let mine: Vec<&Row> = rows
             .iter()
@@ -141,11 +143,10 @@ where
         let (xmin, xmax) = xs.fold((f64::INFINITY, 0.0f64), |(a, b), x| (a.min(x), b.max(x)));
         let mut chart = ChartBuilder::on(panel)
             .caption(
-                if problem == "oscillator" {
-                    "largest stable dt: fractional oscillator (top = stable at every dt tried, 1 s)"
-                        .to_string()
-                } else {
-                    "largest stable dt: swing scene 31 x 21 (top = stable at frame rate, 1/24 s)".to_string()
+                match problem {
+                    "oscillator" => "largest stable dt: fractional oscillator (top: 1 s, every dt tried)",
+                    "swing" => "largest stable dt: fractional swing 31 x 21 (top: frame rate, 1/24 s)",
+                    _ => "largest stable dt: underwater preset's swing 31 x 21 (top: 1/24 s)",
                 },
                 ("sans-serif", 18),
             )
@@ -182,6 +183,7 @@ where
                         0 => Circle::new((x, y), 5, style).into_dyn(),
                         1 => TriangleMarker::new((x, y), 6, style).into_dyn(),
                         2 => Cross::new((x, y), 5, style).into_dyn(),
+                        4 => Circle::new((x, y), 3, style).into_dyn(),
                         _ => Rectangle::new([(x, y), (x, y)], style).into_dyn(),
                     }
                 };
@@ -189,7 +191,7 @@ where
                     .draw_series(pts.iter().map(|&p| marker(p)))?
                     .label(label)
                     .legend(move |(x, y)| {
-                        let glyph = ["\u{25cf}", "\u{25b2}", "\u{2715}", "\u{25a0}"][si.min(3)];
+                        let glyph = ["\u{25cf}", "\u{25b2}", "\u{2715}", "\u{25a0}", "\u{2022}"][si.min(4)];
                         EmptyElement::at((x, y))
                             + PathElement::new(vec![(-10, 0), (10, 0)], c.stroke_width(1))
                             + Text::new(glyph, (-5, -7), ("sans-serif", 14).into_font().color(&c))
@@ -284,25 +286,33 @@ fn main() -> Result<(), Box<dyn Error>> {
             }
         }
     }
-    for &scale in scales {
-        for integrator in Integrator::ALL {
-            for scheme in swing_schemes {
-                let dt = largest_stable(1e-5, 1.0 / 24.0, iters.min(10), |dt| {
-                    swing_stable(scale, scheme, integrator, dt)
-                });
-                println!(
-                    "swing scale={scale:5} {:10} {:16} largest stable dt {dt:.4e}",
-                    integrator.key(),
-                    scheme_label(scheme)
-                );
-                rows.push(Row {
-                    lowest: 1e-5,
-                    problem: "swing",
-                    integrator,
-                    scheme,
-                    stiffness: scale,
-                    dt,
-                });
+    // The paper's fractional swing with two history schemes, and the underwater preset's swing
+    // (added mass, entrained water, form drag; no half-derivative term, so no history).
+    let swings = [
+        ("swing", Variant::Fractional, swing_schemes.to_vec()),
+        ("underwater", Variant::Underwater, vec![Scheme::Off]),
+    ];
+    for (problem, variant, schemes) in &swings {
+        for &scale in scales {
+            for integrator in Integrator::ALL {
+                for &scheme in schemes {
+                    let dt = largest_stable(1e-5, 1.0 / 24.0, iters.min(10), |dt| {
+                        swing_stable(*variant, scale, scheme, integrator, dt)
+                    });
+                    println!(
+                        "{problem} scale={scale:5} {:10} {:16} largest stable dt {dt:.4e}",
+                        integrator.key(),
+                        scheme_label(scheme)
+                    );
+                    rows.push(Row {
+                        lowest: 1e-5,
+                        problem,
+                        integrator,
+                        scheme,
+                        stiffness: scale,
+                        dt,
+                    });
+                }
             }
         }
     }
@@ -333,14 +343,15 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
     let suffix = if quick { "-quick" } else { "" };
     std::fs::write(out.join(format!("stability{suffix}.csv")), csv)?;
-    let all: Vec<Scheme> = osc_schemes.to_vec();
+    let mut all: Vec<Scheme> = osc_schemes.to_vec();
+    all.push(Scheme::Off);
     draw(
-        BitMapBackend::new(&out.join(format!("stability{suffix}.png")), (1500, 620)).into_drawing_area(),
+        BitMapBackend::new(&out.join(format!("stability{suffix}.png")), (2100, 620)).into_drawing_area(),
         &rows,
         &all,
     )?;
     draw(
-        SVGBackend::new(&out.join(format!("stability{suffix}.svg")), (1500, 620)).into_drawing_area(),
+        SVGBackend::new(&out.join(format!("stability{suffix}.svg")), (2100, 620)).into_drawing_area(),
         &rows,
         &all,
     )?;

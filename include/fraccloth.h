@@ -351,6 +351,14 @@ typedef struct {
    * the bend springs alone.
    */
   double bend_damping_scale;
+  /**
+   * Added mass for normal motion as a coefficient C_a (dimensionless, >= 0): adds
+   * `C_a * water_density * W` kg/m^2 to `added_mass`, W the cloth's width (the smaller extent
+   * of its rest shape in its own plane). pi/4 is a rigid plate's added mass for face-first
+   * motion (potential flow); `lambda / (pi W)` that of ripples of wavelength lambda.
+   * Default 0.
+   */
+  double added_mass_coefficient;
 } FcClothDesc;
 
 #ifdef __cplusplus

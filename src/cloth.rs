@@ -118,8 +118,13 @@ pub struct Cloth {
 
 impl Cloth {
     /// Builds a cloth at rest in its rest positions.
-    pub fn new(topology: Topology, config: ClothConfig) -> Result<Self, Error> {
+    pub fn new(topology: Topology, mut config: ClothConfig) -> Result<Self, Error> {
         config.model.validate()?;
+        // An added mass given as a coefficient becomes kg/m^2 for this cloth's width, once.
+        let water = &mut config.model.water;
+        water.added_mass = water.added_mass_for(config.model.water_density, topology.width());
+        water.added_mass_coefficient = 0.0;
+        check_non_negative("added_mass (with added_mass_coefficient)", water.added_mass)?;
         check_positive("max_speed", config.max_speed)?;
         if config.max_speed >= MAX_COORDINATE {
             return Err(Error::invalid(format!(
@@ -183,6 +188,8 @@ impl Cloth {
     pub fn config(&self) -> &ClothConfig {
         &self.config
     }
+    /// The model this cloth steps with: the one it was built from, its added mass given as a
+    /// coefficient resolved into [`crate::model::Water::added_mass`] (kg/m^2).
     pub fn model(&self) -> &Model {
         &self.config.model
     }

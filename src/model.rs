@@ -68,6 +68,14 @@ pub struct Water {
     /// `m I + m_a n n^T`, `m_a = added_mass * area`. For a sheet rippled with wavelength
     /// lambda, about `rho_w lambda / pi` (both sides): tens of kg/m^2.
     pub added_mass: f64,
+    /// Added mass for normal motion given as a coefficient C_a (dimensionless) of the water
+    /// density times the cloth's width W ([`crate::Topology::width`]): adds
+    /// `C_a * water_density * W` kg/m^2 to [`Water::added_mass`] when the cloth is built
+    /// ([`crate::Cloth::model`] holds the sum). Potential flow gives `C_a = pi/4` for a rigid
+    /// plate translating face first (`rho_w pi W / 4` per unit area: the whole-sheet value)
+    /// and `C_a = lambda / (pi W)` for ripples of wavelength lambda (`rho_w lambda / pi`, both
+    /// sides). 0 (the default) adds nothing.
+    pub added_mass_coefficient: f64,
     /// Water carried along in every direction, kg/m^2: a particle's mass matrix gains
     /// `m_e I`, `m_e = entrained_mass * area` (inertia only; the weight is unchanged). The
     /// coarse, whole-sheet part of the added mass: a towel moving as a whole drags water along
@@ -86,6 +94,17 @@ pub struct Water {
     pub history_drag: f64,
     /// Normal drag per unit area, N s/m^3 (adds to [`Model::normal_drag`] times the area).
     pub normal_drag: f64,
+}
+
+impl Water {
+    /// The normal added mass per unit area of a cloth of width `width` (m) in water of density
+    /// `water_density` (kg/m^3): `added_mass + added_mass_coefficient * water_density * width`.
+    pub fn added_mass_for(&self, water_density: f64, width: f64) -> f64 {
+        if self.added_mass_coefficient == 0.0 {
+            return self.added_mass;
+        }
+        self.added_mass + self.added_mass_coefficient * water_density * width
+    }
 }
 
 impl Model {
@@ -138,6 +157,7 @@ impl Model {
         check_non_negative("collision_margin", self.collision_margin)?;
         let w = &self.water;
         check_non_negative("added_mass", w.added_mass)?;
+        check_non_negative("added_mass_coefficient", w.added_mass_coefficient)?;
         check_non_negative("entrained_mass", w.entrained_mass)?;
         check_non_negative("form_drag", w.form_drag)?;
         check_non_negative("skin_drag", w.skin_drag)?;

@@ -235,8 +235,79 @@ fn a_free_cloth_with_strongly_anisotropic_added_mass_does_not_gain_energy() {
 }
 
 #[test]
+fn an_added_mass_coefficient_is_water_density_times_the_cloths_width() {
+    // The plate is 0.1 m square, so W = 0.1 m: C_a = pi/4 means rho_w pi W / 4 kg/m^2.
+    let c_a = std::f64::consts::FRAC_PI_4;
+    let by_coefficient = plate(
+        10,
+        Vec3::new(0.0, 0.0, -9.81),
+        Water {
+            added_mass: 5.0,
+            added_mass_coefficient: c_a,
+            ..Water::default()
+        },
+        Integrator::SymplecticEuler,
+    );
+    let per_area = 5.0 + c_a * RHO_W * SIDE;
+    assert!((by_coefficient.topology().width() - SIDE).abs() < 1e-12);
+    assert!((by_coefficient.model().water.added_mass - per_area).abs() < 1e-9);
+    assert_eq!(by_coefficient.model().water.added_mass_coefficient, 0.0);
+    // The same motion as the added mass given directly (the first step's accelerations).
+    let mut a = by_coefficient;
+    let mut b = plate(
+        10,
+        Vec3::new(0.0, 0.0, -9.81),
+        Water {
+            added_mass: per_area,
+            ..Water::default()
+        },
+        Integrator::SymplecticEuler,
+    );
+    for _ in 0..50 {
+        a.step(1e-3).unwrap();
+        b.step(1e-3).unwrap();
+    }
+    for (p, q) in a.positions().iter().zip(b.positions()) {
+        assert!((p - q).norm() < 1e-12, "{p} vs {q}");
+    }
+}
+
+#[test]
+fn a_cloths_width_is_the_smaller_extent_in_its_own_plane_in_any_orientation() {
+    let grid = GridSpec {
+        width: 61,
+        height: 41,
+        spacing: 0.01,
+        total_mass: 0.24,
+    }
+    .build()
+    .unwrap();
+    assert!((grid.width() - 0.4).abs() < 1e-9, "{}", grid.width());
+    // The same sheet turned about an oblique axis, as a mesh.
+    let turn = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(Vec3::new(1.0, 2.0, 3.0)), 0.7);
+    let positions: Vec<Vec3> = grid.rest_positions.iter().map(|p| turn * p).collect();
+    let indices: Vec<u32> = grid.triangles.iter().flatten().copied().collect();
+    let turned = MeshSpec {
+        positions: &positions,
+        indices: &indices,
+        face_size: 3,
+        mass: MeshMass::ArealDensity(MU),
+    }
+    .build()
+    .unwrap();
+    assert!((turned.width() - 0.4).abs() < 1e-9, "{}", turned.width());
+}
+
+#[test]
 fn bad_water_coefficients_name_the_field() {
     for (field, water) in [
+        (
+            "added_mass_coefficient",
+            Water {
+                added_mass_coefficient: -0.5,
+                ..Water::default()
+            },
+        ),
         (
             "added_mass",
             Water {

@@ -164,6 +164,12 @@ pub struct FcClothDesc {
     /// Multiplies `spring_damping` for the bend springs (>= 0). Default 1; e.g. 0, 0, 1 damps
     /// the bend springs alone.
     pub bend_damping_scale: f64,
+    /// Added mass for normal motion as a coefficient C_a (dimensionless, >= 0): adds
+    /// `C_a * water_density * W` kg/m^2 to `added_mass`, W the cloth's width (the smaller extent
+    /// of its rest shape in its own plane). pi/4 is a rigid plate's added mass for face-first
+    /// motion (potential flow); `lambda / (pi W)` that of ripples of wavelength lambda.
+    /// Default 0.
+    pub added_mass_coefficient: f64,
 }
 
 fn v3(a: [f64; 3]) -> Vec3 {
@@ -237,6 +243,7 @@ impl FcClothDesc {
             stretch_damping_scale: model.spring_damping_scale[0],
             shear_damping_scale: model.spring_damping_scale[1],
             bend_damping_scale: model.spring_damping_scale[2],
+            added_mass_coefficient: model.water.added_mass_coefficient,
         }
     }
 
@@ -326,6 +333,7 @@ impl FcClothDesc {
                 collision_margin: self.collision_margin,
                 water: crate::model::Water {
                     added_mass: self.added_mass,
+                    added_mass_coefficient: self.added_mass_coefficient,
                     entrained_mass: self.entrained_mass,
                     form_drag: self.form_drag,
                     skin_drag: self.skin_drag,

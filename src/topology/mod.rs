@@ -111,6 +111,34 @@ impl Topology {
         self.rest_positions.len()
     }
 
+    /// The cloth's width: the smaller of its two extents in its own plane at rest, m. The plane
+    /// is the rest shape's principal plane (its two largest principal axes), so a cloth modelled
+    /// in any orientation gives the same width. What `Water::added_mass_coefficient`
+    /// multiplies. 0 for fewer than two particles.
+    pub fn width(&self) -> f64 {
+        let p = &self.rest_positions;
+        if p.len() < 2 {
+            return 0.0;
+        }
+        let centre = p.iter().sum::<Vec3>() / p.len() as f64;
+        let covariance = p
+            .iter()
+            .map(|q| (q - centre) * (q - centre).transpose())
+            .sum::<nalgebra::Matrix3<f64>>();
+        let eigen = nalgebra::SymmetricEigen::new(covariance);
+        let mut order = [0usize, 1, 2];
+        order.sort_by(|&a, &b| eigen.eigenvalues[b].total_cmp(&eigen.eigenvalues[a]));
+        let extent = |axis: usize| {
+            let e = eigen.eigenvectors.column(order[axis]).into_owned();
+            let (lo, hi) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
+                let s = (q - centre).dot(&e);
+                (lo.min(s), hi.max(s))
+            });
+            hi - lo
+        };
+        extent(0).min(extent(1))
+    }
+
     /// Whether the springs form runs long enough (8 springs on average) that the force pass
     /// adds them run by run rather than gathering them vertex by vertex.
     pub fn long_runs(&self) -> bool {
