@@ -109,6 +109,9 @@ pub struct Cloth {
     colliders: Vec<Collider>,
     friction: Vec<f64>,
     history: History,
+    /// One scalar per spring for the rotation-invariant fractional springs
+    /// (`forces/strain.rs`), three springs to an entry; `Off` without them.
+    strain_history: History,
     time: f64,
     steps: u64,
     scratch: StepScratch,
@@ -169,6 +172,14 @@ impl Cloth {
             colliders: Vec::new(),
             friction: Vec::new(),
             history: History::new(scheme, n)?,
+            strain_history: History::new(
+                if config.model.uses_strain_history() {
+                    config.scheme
+                } else {
+                    Scheme::Off
+                },
+                forces::strain::entries(topology.springs.len()),
+            )?,
             time: 0.0,
             steps: 0,
             scratch: StepScratch::default(),

@@ -17,6 +17,10 @@ pub enum SpringDamping {
     Velocity,
     /// Fractional viscoelastic element, Eq. 5: `-k_d [(D^{1/2}x_i - D^{1/2}x_j) . l_hat] l_hat`.
     Fractional,
+    /// Rotation-invariant fractional element: `-k_d D^{1/2}(|l| - r) l_hat`, the half-derivative
+    /// of the spring's elongation (zero for any rigid motion; `forces/strain.rs`). Not in the
+    /// paper; `k_d` in the same unit as Eq. 5's, N s^{1/2}/m.
+    FractionalStrain,
 }
 
 /// Every force coefficient. A coefficient of zero switches its term off and costs nothing.
@@ -113,6 +117,12 @@ impl Model {
         self.history_drag != 0.0
             || self.water.history_drag != 0.0
             || (self.spring_damping_mode == SpringDamping::Fractional && self.spring_damping != 0.0)
+    }
+
+    /// True when the springs damp the half-derivative of their elongation, so a history per
+    /// spring must be kept ([`SpringDamping::FractionalStrain`]).
+    pub fn uses_strain_history(&self) -> bool {
+        self.spring_damping_mode == SpringDamping::FractionalStrain && self.spring_damping != 0.0
     }
 
     /// Damping constant of a spring family: `spring_damping` times the family's scale.

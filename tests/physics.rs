@@ -245,6 +245,8 @@ fn spring_damping_can_be_set_per_family() {
             v: &v,
             half_derivative: &[],
             colliders: &[],
+            strain_forces: &[],
+            strain_w0: 0.0,
         };
         total_forces(&input, &mut ForceScratch::default(), &mut f);
         f

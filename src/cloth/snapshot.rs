@@ -13,6 +13,7 @@
 //!          vec3s positions  vec3s velocities  f64s pin_weights  u64 n + u32[n] pin_order
 //!          vec3s pin_targets  u64 slots, per slot: u8 present [u8 kind, shape f64s, f64 friction]
 //!          history state (scheme specific: see history/*.rs `write_state`)
+//!          [history state of the springs, with rotation-invariant fractional springs only]
 //! trailer  u32 CRC-32 (IEEE) of header and payload
 //! ```
 //!
@@ -83,6 +84,11 @@ fn history_fingerprint(c: &Cloth) -> u64 {
                 h.word(x.to_bits());
             }
         }
+    }
+    // A history per spring (rotation-invariant fractional springs) changes the state's layout;
+    // without one the fingerprint is what it always was.
+    if !c.strain_history.is_off() {
+        h.word(u64::from(b'S'));
     }
     h.0
 }
@@ -184,7 +190,8 @@ impl Cloth {
                 }
             }
         }
-        self.history.write_state(w)
+        self.history.write_state(w)?;
+        self.strain_history.write_state(w)
     }
 
     /// Restores a state saved by [`Cloth::save_snapshot`] from a cloth of the same topology and
@@ -276,12 +283,17 @@ impl Cloth {
         {
             use crate::history::HalfDerivative;
             crate::memory::ensure_available(
-                2 * self.history.bytes_per_particle() as u64 * n as u64 + bytes.len() as u64,
+                2 * self.history.bytes_per_particle() as u64 * n as u64
+                    + 2 * self.strain_history.bytes_per_particle() as u64
+                        * crate::forces::strain::entries(self.topology.springs.len()) as u64
+                    + bytes.len() as u64,
                 "loading a snapshot",
             )?;
         }
         let mut history: History = self.history.clone();
         history.read_state(&mut r)?;
+        let mut strain_history: History = self.strain_history.clone();
+        strain_history.read_state(&mut r)?;
         if r.remaining() != 4 {
             return Err(Error::invalid("snapshot has trailing data"));
         }
@@ -306,6 +318,7 @@ impl Cloth {
             )));
         }
         history.check_state(time)?;
+        strain_history.check_state(time)?;
         for (i, &w) in weights.iter().enumerate() {
             check_weight(i, w)?;
         }
@@ -338,6 +351,7 @@ impl Cloth {
         self.collider_slots = collider_slots;
         self.rebuild_colliders();
         self.history = history;
+        self.strain_history = strain_history;
         Ok(())
     }
 

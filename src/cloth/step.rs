@@ -62,6 +62,12 @@ pub(super) struct StepScratch {
     pub hard_pins: Vec<u32>,
     /// Vertex normals of the proposed state (with added mass only).
     pub normals_new: Vec<Vec3>,
+    /// Rotation-invariant fractional springs only (`forces/strain.rs`): each spring's rate of
+    /// elongation at the start of the step and the past part of its D^{1/2}, packed three
+    /// springs to an entry, and the force on every particle.
+    pub strain_rates: Vec<Vec3>,
+    pub strain_past: Vec<Vec3>,
+    pub strain_forces: Vec<Vec3>,
     pub force_pass: ForceScratch,
     pub implicit: ImplicitScratch,
 }
@@ -72,6 +78,7 @@ pub(super) struct Rollback {
     x: Vec<Vec3>,
     v: Vec<Vec3>,
     history: Option<History>,
+    strain_history: Option<History>,
     time: f64,
     steps: u64,
 }
@@ -81,7 +88,8 @@ impl Rollback {
     /// that grew (the full history) cannot be allocated.
     pub(super) fn save(&mut self, c: &Cloth) -> Result<(), Error> {
         use crate::history::HalfDerivative;
-        let need = c.history.bytes_per_particle() as u64 * c.x.len() as u64;
+        let need = c.history.bytes_per_particle() as u64 * c.x.len() as u64
+            + c.strain_history.bytes_per_particle() as u64 * forces::strain::entries(c.topology.springs.len()) as u64;
         let have = self
             .history
             .as_ref()
@@ -98,6 +106,10 @@ impl Rollback {
             Some(h) => h.clone_from(&c.history),
             None => self.history = Some(c.history.clone()),
         }
+        match &mut self.strain_history {
+            Some(h) => h.clone_from(&c.strain_history),
+            None => self.strain_history = Some(c.strain_history.clone()),
+        }
         self.time = c.time;
         self.steps = c.steps;
         Ok(())
@@ -108,6 +120,9 @@ impl Rollback {
         std::mem::swap(&mut c.v, &mut self.v);
         if let Some(h) = &mut self.history {
             std::mem::swap(&mut c.history, h);
+        }
+        if let Some(h) = &mut self.strain_history {
+            std::mem::swap(&mut c.strain_history, h);
         }
         c.time = self.time;
         c.steps = self.steps;
@@ -121,9 +136,10 @@ impl Cloth {
         self.prepare()?;
         self.pin_goals(fraction);
         let w0 = self.step_velocities(h);
+        let strain_w0 = self.strain_damping();
         let integrated_sound = match Route::of(self.config.integrator) {
-            Route::ExplicitTiles(step) => self.forces_and_explicit_step(h, step),
-            Route::Implicit => self.forces_and_implicit_step(h, w0)?,
+            Route::ExplicitTiles(step) => self.forces_and_explicit_step(h, strain_w0, step),
+            Route::Implicit => self.forces_and_implicit_step(h, w0, strain_w0)?,
         };
         let friction = self.friction(h);
         self.added_mass_energy();
@@ -133,9 +149,10 @@ impl Cloth {
         Ok(())
     }
 
-    /// Sizes the step's buffers and lets the history make room for the step.
+    /// Sizes the step's buffers and lets the histories make room for the step.
     fn prepare(&mut self) -> Result<(), Error> {
         self.history.reserve_step()?;
+        self.strain_history.reserve_step()?;
         let n = self.vertex_count();
         let s = &mut self.scratch;
         for buf in [
@@ -270,9 +287,36 @@ impl Cloth {
         w0
     }
 
+    /// The rotation-invariant fractional springs' forces at the start of the step, from each
+    /// spring's rate of elongation and its history (nothing without them). Returns their w0.
+    fn strain_damping(&mut self) -> f64 {
+        if self.strain_history.is_off() {
+            return 0.0;
+        }
+        let s = &mut self.scratch;
+        forces::strain::elongation_rates(&self.topology, &self.x, &s.v_step, &mut s.strain_rates);
+        s.strain_past.resize(s.strain_rates.len(), Vec3::zeros());
+        let past = self.strain_history.begin_step();
+        let w0 = past.current_weight();
+        // SAFETY: one call covers every entry once.
+        unsafe { past.past_range(0, &mut s.strain_past) };
+        self.strain_history.end_step();
+        s.strain_forces.resize(self.x.len(), Vec3::zeros());
+        forces::strain::forces(
+            &self.config.model,
+            &self.topology,
+            &self.x,
+            w0,
+            &s.strain_rates,
+            &s.strain_past,
+            &mut s.strain_forces,
+        );
+        w0
+    }
+
     /// The force pass with an explicit integrator stepping each tile in cache; returns whether
     /// every result it wrote was sound.
-    fn forces_and_explicit_step(&mut self, h: f64, step: StepSoa) -> bool {
+    fn forces_and_explicit_step(&mut self, h: f64, strain_w0: f64, step: StepSoa) -> bool {
         let s = &mut self.scratch;
         let input = ForceInput {
             model: &self.config.model,
@@ -281,6 +325,8 @@ impl Cloth {
             v: &s.v_step,
             half_derivative: &s.half,
             colliders: &self.colliders,
+            strain_forces: &s.strain_forces,
+            strain_w0,
         };
         let (masses, areas) = (&self.topology.masses, &self.topology.areas);
         let model = &self.config.model;
@@ -331,7 +377,7 @@ impl Cloth {
     /// The force pass into one array, then linearised backward Euler solved by CG; refused
     /// when the solver stops above its tolerance (unless accepted). The result is checked by
     /// [`Self::check`], so this returns false (not checked here).
-    fn forces_and_implicit_step(&mut self, h: f64, w0: f64) -> Result<bool, Error> {
+    fn forces_and_implicit_step(&mut self, h: f64, w0: f64, strain_w0: f64) -> Result<bool, Error> {
         let n = self.vertex_count();
         let s = &mut self.scratch;
         s.force_array.resize(n, Vec3::zeros());
@@ -342,6 +388,8 @@ impl Cloth {
             v: &s.v_step,
             half_derivative: &s.half,
             colliders: &self.colliders,
+            strain_forces: &s.strain_forces,
+            strain_w0,
         };
         forces::total_forces_with(
             &input,
@@ -456,6 +504,9 @@ impl Cloth {
         std::mem::swap(&mut self.x, &mut s.x_new);
         std::mem::swap(&mut self.v, &mut s.v_new);
         self.history.record(&mut s.v_rel, h);
+        if !self.strain_history.is_off() {
+            self.strain_history.record(&mut s.strain_rates, h);
+        }
         self.time += h;
         self.steps += 1;
     }

@@ -51,6 +51,9 @@ pub enum FcSpringDamping {
     FC_SPRING_DAMPING_VELOCITY = 1,
     /// Fractional viscoelastic springs, Eq. 5: `-k_d [(D^{1/2}x_i - D^{1/2}x_j) . l_hat] l_hat`.
     FC_SPRING_DAMPING_FRACTIONAL = 2,
+    /// Rotation-invariant fractional springs (not in the paper): `-k_d D^{1/2}(|l| - r) l_hat`,
+    /// the half-derivative of each spring's elongation, zero for any rigid motion.
+    FC_SPRING_DAMPING_FRACTIONAL_STRAIN = 3,
 }
 
 /// Values for `fc_cloth_desc_preset`.
@@ -212,6 +215,7 @@ impl FcClothDesc {
                 SpringDamping::None => FcSpringDamping::FC_SPRING_DAMPING_NONE,
                 SpringDamping::Velocity => FcSpringDamping::FC_SPRING_DAMPING_VELOCITY,
                 SpringDamping::Fractional => FcSpringDamping::FC_SPRING_DAMPING_FRACTIONAL,
+                SpringDamping::FractionalStrain => FcSpringDamping::FC_SPRING_DAMPING_FRACTIONAL_STRAIN,
             } as u32,
             viscous_drag: model.viscous_drag,
             history_drag: model.history_drag,
@@ -277,6 +281,7 @@ impl FcClothDesc {
             0 => SpringDamping::None,
             1 => SpringDamping::Velocity,
             2 => SpringDamping::Fractional,
+            3 => SpringDamping::FractionalStrain,
             x => {
                 return Err(FfiError::invalid(format!(
                     "spring_damping_mode {x} is not an FcSpringDamping value"

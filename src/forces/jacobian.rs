@@ -78,6 +78,7 @@ pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Li
         SpringDamping::None => 0.0,
         SpringDamping::Velocity => m.spring_damping,
         SpringDamping::Fractional => m.spring_damping * w0,
+        SpringDamping::FractionalStrain => m.spring_damping * input.strain_w0,
     };
     for (k, s) in input.topology.springs.iter().enumerate() {
         let ks = m.stiffness(s.kind);

@@ -7,6 +7,7 @@
 //! | `body.rs` | Eq. 2 gravity and buoyancy |
 //! | `drag.rs` | Eq. 3 viscous, Eq. 4 history, and normal drag |
 //! | `contact.rs` | collider contacts and friction |
+//! | `strain.rs` | the rotation-invariant fractional spring: D^{1/2} of each spring's elongation |
 //! | `added_mass.rs` | the water's added mass for normal motion (an inertia: Sherman-Morrison) |
 //! | `terms.rs` | the list of per-particle terms, what each reads, its Jacobian block |
 //! | `jacobian.rs` | the linearised forces of the implicit integrator |
@@ -23,6 +24,7 @@ mod jacobian;
 mod normals;
 mod pass;
 mod springs;
+pub mod strain;
 pub(crate) mod terms;
 mod tiles;
 

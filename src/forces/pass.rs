@@ -32,6 +32,12 @@ pub struct ForceInput<'a> {
     pub half_derivative: &'a [Vec3],
     /// Colliders present this step.
     pub colliders: &'a [Collider],
+    /// Force of the rotation-invariant fractional springs on every particle (N), evaluated
+    /// before the pass (`strain.rs`); empty when the model has none.
+    pub strain_forces: &'a [Vec3],
+    /// The current-rate weight w0 of those springs' D^{1/2} (what the implicit integrator
+    /// treats as their damping); 0 without them.
+    pub strain_w0: f64,
 }
 
 /// Scratch buffers the force pass reuses (no allocation in a step).
@@ -140,6 +146,11 @@ where
             areas: &areas[p0..p0 + len],
         };
         let [fx, fy, fz] = s;
+        if let Some(strain) = input.strain_forces.get(p0..p0 + len) {
+            for (k, f) in strain.iter().enumerate() {
+                (fx[k], fy[k], fz[k]) = (fx[k] + f.x, fy[k] + f.y, fz[k] + f.z);
+            }
+        }
         terms::add_all(&context, &tile, [&mut *fx, &mut *fy, &mut *fz]);
         sink(TileTotals {
             p0,

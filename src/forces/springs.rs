@@ -65,6 +65,8 @@ pub fn spring_rate(m: &crate::model::Model) -> SpringRate {
         SpringDamping::None => SpringRate::None,
         SpringDamping::Velocity => SpringRate::Velocity,
         SpringDamping::Fractional => SpringRate::HalfDerivative,
+        // Its own pass (`strain.rs`): the springs' kernel leaves it out.
+        SpringDamping::FractionalStrain => SpringRate::None,
     }
 }
 

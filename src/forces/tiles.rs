@@ -602,6 +602,8 @@ mod tests {
                 v: q,
                 half_derivative: q,
                 colliders: &[],
+                strain_forces: &[],
+                strain_w0: 0.0,
             };
             let mut f = vec![Vec3::zeros(); n];
             total_forces(&input, &mut ForceScratch::default(), &mut f);
