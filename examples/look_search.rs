@@ -6,6 +6,9 @@
 //! Prints a Markdown table (docs/underwater.md holds the run of record). With OUT_DIR, the best
 //! draw of each family is baked again and written there as `familyK.mdd` with `rest.obj`, for
 //! `fraccloth look familyK.mdd --rest rest.obj --pictures PREFIX` (side views, space-time plots).
+//!
+//! `cargo run --release --example look_search -- strain` measures the paper's fractional springs
+//! (Eq. 5) against the rotation-invariant element in the paper's model and the underwater preset.
 
 use fraccloth::history::Scheme;
 use fraccloth::look::{measure, Descriptors};
@@ -19,19 +22,45 @@ const H: u32 = 21;
 /// The preset's look at 31 x 21 (docs/underwater.md).
 const TARGET: (f64, f64, f64) = (4.33, 0.152, 0.31);
 
-/// Bakes the swing (the preset's 4 cm at 0.5 Hz) for 12 s and measures it; None if unstable.
-/// With `save`, also writes the frames as an MDD cache and the rest mesh as OBJ.
+/// How a swing is baked: the search's is [`SEARCH`].
+#[derive(Clone, Copy)]
+struct Bake {
+    size: (u32, u32),
+    integrator: Integrator,
+    /// Whose drive the top follows (the underwater preset's 4 cm or the paper's swing).
+    drive: Variant,
+}
+
+/// The search's bake: 31 x 21, symplectic Euler, the underwater preset's swing.
+const SEARCH: Bake = Bake {
+    size: (W, H),
+    integrator: Integrator::SymplecticEuler,
+    drive: Variant::Underwater,
+};
+
+/// Bakes the swing for 12 s and measures it; None if unstable. With `save`, also writes the
+/// frames as an MDD cache and the rest mesh as OBJ.
 fn look(model: Model, scheme: Scheme, save: Option<(&std::path::Path, usize)>) -> Option<Descriptors> {
-    let spacing = CLOTH_WIDTH / f64::from(W - 1);
+    look_with(SEARCH, model, scheme, save)
+}
+
+fn look_with(
+    bake: Bake,
+    model: Model,
+    scheme: Scheme,
+    save: Option<(&std::path::Path, usize)>,
+) -> Option<Descriptors> {
+    let (w, h_rows) = bake.size;
+    let spacing = CLOTH_WIDTH / f64::from(w - 1);
     let t = GridSpec {
-        width: W,
-        height: H,
+        width: w,
+        height: h_rows,
         spacing,
         total_mass: CLOTH_MASS,
     }
     .build()
     .ok()?;
-    let integrator = Integrator::SymplecticEuler;
+    let integrator = bake.integrator;
     let config = ClothConfig {
         model,
         scheme,
@@ -39,7 +68,7 @@ fn look(model: Model, scheme: Scheme, save: Option<(&std::path::Path, usize)>) -
         ..ClothConfig::default()
     };
     let mut c = Cloth::new(t, config).ok()?;
-    let top: Vec<u32> = (0..W).map(|i| grid_index(W, i, 0)).collect();
+    let top: Vec<u32> = (0..w).map(|i| grid_index(w, i, 0)).collect();
     c.set_pinned(&top).ok()?;
     let rest: Vec<Vec3> = top.iter().map(|&i| c.positions()[i as usize]).collect();
     let dt = stable_dt(spacing, integrator);
@@ -48,7 +77,7 @@ fn look(model: Model, scheme: Scheme, save: Option<(&std::path::Path, usize)>) -
     let h = 1.0 / fps / per_frame as f64;
     for f in 1..=(12.0 * fps) as usize {
         for _ in 0..per_frame {
-            let off = top_offset(SceneKind::Swing, Variant::Underwater, c.time() + h);
+            let off = top_offset(SceneKind::Swing, bake.drive, c.time() + h);
             let targets: Vec<Vec3> = rest.iter().map(|p| p + off).collect();
             c.set_pin_targets(&top, &targets).ok()?;
             c.step(h).ok()?;
@@ -121,7 +150,67 @@ impl Rng {
     }
 }
 
+/// `look_search strain`: the paper's fractional springs (Eq. 5) against the rotation-invariant
+/// element (D^{1/2} of each spring's elongation) in the paper's model and in the underwater
+/// preset, at 31 x 21 and 61 x 41 (full memory, SOE).
+fn strain_comparison() {
+    println!("| model | springs | size | half-waves | travel (m/s) | mid ratio | zigzag | hang (m) |");
+    println!("|---|---|---|---|---|---|---|---|");
+    let paper = Bake {
+        size: (61, 41),
+        integrator: Integrator::ExplicitEuler,
+        drive: Variant::Fractional,
+    };
+    let preset = Bake {
+        size: (61, 41),
+        ..SEARCH
+    };
+    let under = |kd: f64, mode: SpringDamping| Model {
+        spring_damping: kd,
+        spring_damping_mode: mode,
+        ..Model::underwater()
+    };
+    let rows: [(&str, &str, Bake, Model); 5] = [
+        ("paper fractional (Eq. 2-5)", "Eq. 5", paper, Model::fractional()),
+        (
+            "paper fractional (Eq. 2-5)",
+            "strain",
+            paper,
+            Model {
+                spring_damping_mode: SpringDamping::FractionalStrain,
+                ..Model::fractional()
+            },
+        ),
+        ("underwater preset", "velocity 0.015", preset, Model::underwater()),
+        ("underwater preset", "Eq. 5, 0.35", preset, under(0.35, SpringDamping::Fractional)),
+        ("underwater preset", "strain, 0.35", preset, under(0.35, SpringDamping::FractionalStrain)),
+    ];
+    for (name, springs, bake, model) in rows {
+        for size in [(31, 21), (61, 41)] {
+            let bake = Bake { size, ..bake };
+            let d = look_with(bake, model.clone(), Scheme::DEFAULT, None);
+            match d {
+                Some(d) => println!(
+                    "| {name} | {springs} | {} x {} | {:.2} | {} | {:.2} | {} | {:.3} |",
+                    size.0,
+                    size.1,
+                    d.half_waves,
+                    d.travel_speed.map_or("none".into(), |c| format!("{c:.3}")),
+                    d.mid_ratio,
+                    d.zigzag.map_or("n/a".into(), |z| format!("{z:.2}")),
+                    d.hang_depth
+                ),
+                None => println!("| {name} | {springs} | {} x {} | unstable | | | | |", size.0, size.1),
+            }
+        }
+    }
+}
+
 fn main() {
+    if std::env::args().nth(1).as_deref() == Some("strain") {
+        strain_comparison();
+        return;
+    }
     let budget: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(16);
     let out = std::env::args().nth(2).map(std::path::PathBuf::from);
     if let Some(dir) = &out {
