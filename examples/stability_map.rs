@@ -117,6 +117,8 @@ fn colour(i: Integrator) -> RGBColor {
         Integrator::ExplicitEuler => RGBColor(214, 39, 40),
         Integrator::SymplecticEuler => RGBColor(31, 119, 180),
         Integrator::ImplicitEuler => RGBColor(44, 160, 44),
+        Integrator::ExtrapolatedSymplectic => RGBColor(148, 103, 189),
+        Integrator::ExtrapolatedImplicit => RGBColor(255, 127, 14),
     }
 }
 

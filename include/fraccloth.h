@@ -101,6 +101,17 @@ typedef enum {
    * Backward Euler (Baraff & Witkin), CG solve. Stable at frame-rate steps with stiff cloth.
    */
   FC_INTEGRATOR_IMPLICIT_EULER = 2,
+  /**
+   * Second order, explicit: symplectic Euler over the step and over two half steps,
+   * extrapolated (`2 x_half - x_whole`). Three force evaluations per step; about symplectic
+   * Euler's stability. For small steps where accuracy matters (docs/accuracy.md).
+   */
+  FC_INTEGRATOR_EXTRAPOLATED_SYMPLECTIC = 3,
+  /**
+   * Second order, stable at frame-rate steps: implicit Euler extrapolated in the same way.
+   * Three linear solves per step.
+   */
+  FC_INTEGRATOR_EXTRAPOLATED_IMPLICIT = 4,
 } FcIntegrator;
 
 /**
@@ -119,6 +130,11 @@ typedef enum {
    * Fractional viscoelastic springs, Eq. 5: `-k_d [(D^{1/2}x_i - D^{1/2}x_j) . l_hat] l_hat`.
    */
   FC_SPRING_DAMPING_FRACTIONAL = 2,
+  /**
+   * Rotation-invariant fractional springs (not in the paper): `-k_d D^{1/2}(|l| - r) l_hat`,
+   * the half-derivative of each spring's elongation, zero for any rigid motion.
+   */
+  FC_SPRING_DAMPING_FRACTIONAL_STRAIN = 3,
 } FcSpringDamping;
 
 /**
@@ -806,6 +822,50 @@ FcStatus fc_cloth_save_snapshot(const FcCloth *cloth,
  * `cloth` NULL or live; `data` NULL or `size` readable bytes.
  */
 FcStatus fc_cloth_load_snapshot(FcCloth *cloth, const void *data, size_t size);
+
+/**
+ * Sets every vertex velocity from float xyz triples (m/s); `float_count` must be
+ * 3 * vertex_count. The history is kept (it holds the past, not the present velocity).
+ *
+ * # Safety
+ * `cloth` NULL or live; `xyz` NULL or `float_count` readable floats.
+ */
+FcStatus fc_cloth_set_velocities(FcCloth *cloth, const float *xyz, size_t float_count);
+
+/**
+ * `fc_cloth_set_velocities` from double triples (m/s), exactly.
+ *
+ * # Safety
+ * `cloth` NULL or live; `xyz` NULL or `double_count` readable doubles.
+ */
+FcStatus fc_cloth_set_velocities_f64(FcCloth *cloth, const double *xyz, size_t double_count);
+
+/**
+ * `fc_cloth_set_positions` from double triples (m), exactly: velocities and history are kept,
+ * pinned vertices are re-pinned there.
+ *
+ * # Safety
+ * `cloth` NULL or live; `xyz` NULL or `double_count` readable doubles.
+ */
+FcStatus fc_cloth_set_positions_f64(FcCloth *cloth, const double *xyz, size_t double_count);
+
+/**
+ * Copies every vertex position (m) into `xyz` as double triples, exactly; `double_count`
+ * must be 3 * vertex_count.
+ *
+ * # Safety
+ * `cloth` NULL or live; `xyz` NULL or `double_count` writable doubles.
+ */
+FcStatus fc_cloth_get_positions_f64(const FcCloth *cloth, double *xyz, size_t double_count);
+
+/**
+ * Copies every vertex velocity (m/s) into `xyz` as double triples, exactly; `double_count`
+ * must be 3 * vertex_count.
+ *
+ * # Safety
+ * `cloth` NULL or live; `xyz` NULL or `double_count` writable doubles.
+ */
+FcStatus fc_cloth_get_velocities_f64(const FcCloth *cloth, double *xyz, size_t double_count);
 
 /**
  * `major * 1000000 + minor * 1000 + patch`; equals `FC_VERSION` of the header the host compiled against.

@@ -6,6 +6,7 @@
 //! than [`ClothConfig::max_speed`] (an underwater cloth never moves at 100 m/s; a
 //! state that does has exploded).
 
+mod extrapolate;
 mod prepass;
 mod snapshot;
 mod step;
@@ -116,6 +117,8 @@ pub struct Cloth {
     steps: u64,
     scratch: StepScratch,
     rollback: Rollback,
+    /// The whole step of an extrapolated integrator, beside its two half steps.
+    probe: Rollback,
     solver_stats: SolverStats,
 }
 
@@ -184,6 +187,7 @@ impl Cloth {
             steps: 0,
             scratch: StepScratch::default(),
             rollback: Rollback::default(),
+            probe: Rollback::default(),
             solver_stats: SolverStats::default(),
             topology,
             config,
@@ -492,7 +496,8 @@ impl Cloth {
                 "substeps must be in 1..={MAX_SUBSTEPS}, got {substeps}"
             )));
         }
-        if substeps == 1 {
+        let extrapolated = self.config.integrator.is_extrapolated();
+        if substeps == 1 && !extrapolated {
             return self.advance(dt, None);
         }
         let h = dt / f64::from(substeps);
@@ -507,10 +512,17 @@ impl Cloth {
             .extend(self.pin_list.iter().map(|&i| self.x[i as usize]));
         for k in 1..=substeps {
             let goal = (k < substeps).then_some(f64::from(k) / f64::from(substeps));
-            if let Err(mut e) = self.advance(h, goal) {
+            let done = if extrapolated {
+                self.extrapolated_advance(h, f64::from(k - 1) / f64::from(substeps), goal)
+            } else {
+                self.advance(h, goal)
+            };
+            if let Err(mut e) = done {
                 snap.restore(self);
                 self.rollback = snap;
-                e.message = format!("substep {k} of {substeps}: {}", e.message);
+                if substeps > 1 {
+                    e.message = format!("substep {k} of {substeps}: {}", e.message);
+                }
                 return Err(e);
             }
         }

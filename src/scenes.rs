@@ -209,7 +209,7 @@ pub const DEFAULT_DT: f64 = 5.0e-4;
 /// one frame at 30 fps for the implicit one (stable at any step).
 pub fn stable_dt(spacing: f64, integrator: Integrator) -> f64 {
     match integrator {
-        Integrator::ImplicitEuler => 1.0 / 30.0,
+        i if i.is_implicit() => 1.0 / 30.0,
         _ => DEFAULT_DT * (spacing / REFERENCE_SPACING).min(1.0),
     }
 }

@@ -75,8 +75,8 @@ pub(super) struct StepScratch {
 /// State saved before a multi-substep call, restored if a substep fails.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Rollback {
-    x: Vec<Vec3>,
-    v: Vec<Vec3>,
+    pub(super) x: Vec<Vec3>,
+    pub(super) v: Vec<Vec3>,
     history: Option<History>,
     strain_history: Option<History>,
     time: f64,

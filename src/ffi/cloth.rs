@@ -65,7 +65,7 @@ pub(crate) fn triples(xyz: &[f32], what: &str) -> Result<Vec<Vec3>, FfiError> {
     Ok(out)
 }
 
-fn check_float_count(cloth: &Cloth, float_count: usize) -> Result<(), FfiError> {
+pub(crate) fn check_float_count(cloth: &Cloth, float_count: usize) -> Result<(), FfiError> {
     let want = 3 * cloth.vertex_count();
     if float_count == want {
         Ok(())

@@ -3,7 +3,8 @@
 //! One file per header area: [`status`] (status codes, last error, the panic
 //! boundary), [`desc`] (the description struct and its defaults), [`cloth`]
 //! (lifetime, pins, positions, stepping), [`mesh`] (cloths from meshes), [`collider`]
-//! (colliders), [`cache`] (PC2 / MDD / OBJ writers), [`version`].
+//! (colliders), [`cache`] (PC2 / MDD / OBJ writers), [`state`] (positions and velocities in
+//! double precision, velocities in float), [`version`].
 //!
 //! Rules every export follows:
 //! - it runs inside a panic boundary; a panic becomes `FC_ERROR_PANIC`;
@@ -22,6 +23,7 @@ pub mod collider;
 pub mod desc;
 pub mod mesh;
 pub mod snapshot;
+pub mod state;
 pub mod version;
 
 pub use cache::*;
@@ -30,5 +32,6 @@ pub use collider::*;
 pub use desc::*;
 pub use mesh::*;
 pub use snapshot::*;
+pub use state::*;
 pub use status::*;
 pub use version::*;

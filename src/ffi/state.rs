@@ -1,0 +1,141 @@
+//! The cloth's state in double precision, and velocities in both precisions: for hosts that
+//! keep their own state (an undo stack, a network replica) and for tests and references that
+//! need exact initial states. Positions and velocities in `float` are in `cloth.rs`.
+
+use super::cloth::{check_float_count, handle, handle_mut, slice_in, FcCloth};
+use super::status::{guard, FcStatus, FfiError};
+use crate::{Cloth, Vec3};
+
+/// The vectors of `xyz` (triples), rejecting NaN and infinities; allocation fallible.
+fn vectors<T: Copy + Into<f64>>(xyz: &[T], what: &str) -> Result<Vec<Vec3>, FfiError> {
+    let mut out = Vec::new();
+    out.try_reserve_exact(xyz.len() / 3).map_err(|_| {
+        FfiError::from(crate::Error::out_of_memory(format!(
+            "no memory for {} {what}s",
+            xyz.len() / 3
+        )))
+    })?;
+    for (k, c) in xyz.chunks_exact(3).enumerate() {
+        let v = Vec3::new(c[0].into(), c[1].into(), c[2].into());
+        if !v.iter().all(|x| x.is_finite()) {
+            return Err(FfiError::invalid(format!(
+                "{what} {k} is not finite: ({}, {}, {})",
+                v.x, v.y, v.z
+            )));
+        }
+        out.push(v);
+    }
+    Ok(out)
+}
+
+/// Reads `float_count` values of the caller's after the usual checks and hands the vectors to
+/// `set`.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `count` readable values.
+unsafe fn set_all<T: Copy + Into<f64>>(
+    cloth: *mut FcCloth,
+    xyz: *const T,
+    count: usize,
+    what: &str,
+    set: fn(&mut Cloth, &[Vec3]) -> Result<(), crate::Error>,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        check_float_count(cloth, count)?;
+        let xyz = unsafe { slice_in(xyz, count, "xyz") }?;
+        Ok(set(cloth, &vectors(xyz, what)?)?)
+    })
+}
+
+/// Writes `values(cloth)` into the caller's buffer of `count` doubles after the usual checks.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `count` writable doubles.
+unsafe fn get_all_f64(cloth: *const FcCloth, xyz: *mut f64, count: usize, values: fn(&Cloth) -> &[Vec3]) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { handle(cloth) }?;
+        check_float_count(cloth, count)?;
+        if xyz.is_null() {
+            return Err(FfiError::null("xyz"));
+        }
+        // SAFETY: non-NULL and the caller promises `count` writable doubles.
+        let out = unsafe { std::slice::from_raw_parts_mut(xyz, count) };
+        for (o, v) in out.chunks_exact_mut(3).zip(values(cloth)) {
+            o.copy_from_slice(v.as_slice());
+        }
+        Ok(())
+    })
+}
+
+/// Sets every vertex velocity from float xyz triples (m/s); `float_count` must be
+/// 3 * vertex_count. The history is kept (it holds the past, not the present velocity).
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `float_count` readable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_velocities(cloth: *mut FcCloth, xyz: *const f32, float_count: usize) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { set_all(cloth, xyz, float_count, "velocity", Cloth::set_velocities) }
+}
+
+/// `fc_cloth_set_velocities` from double triples (m/s), exactly.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `double_count` readable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_velocities_f64(
+    cloth: *mut FcCloth,
+    xyz: *const f64,
+    double_count: usize,
+) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { set_all(cloth, xyz, double_count, "velocity", Cloth::set_velocities) }
+}
+
+/// `fc_cloth_set_positions` from double triples (m), exactly: velocities and history are kept,
+/// pinned vertices are re-pinned there.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `double_count` readable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_positions_f64(
+    cloth: *mut FcCloth,
+    xyz: *const f64,
+    double_count: usize,
+) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { set_all(cloth, xyz, double_count, "position", Cloth::set_positions) }
+}
+
+/// Copies every vertex position (m) into `xyz` as double triples, exactly; `double_count`
+/// must be 3 * vertex_count.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `double_count` writable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_positions_f64(
+    cloth: *const FcCloth,
+    xyz: *mut f64,
+    double_count: usize,
+) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { get_all_f64(cloth, xyz, double_count, Cloth::positions) }
+}
+
+/// Copies every vertex velocity (m/s) into `xyz` as double triples, exactly; `double_count`
+/// must be 3 * vertex_count.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `double_count` writable doubles.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_velocities_f64(
+    cloth: *const FcCloth,
+    xyz: *mut f64,
+    double_count: usize,
+) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { get_all_f64(cloth, xyz, double_count, Cloth::velocities) }
+}
