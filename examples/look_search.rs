@@ -182,8 +182,18 @@ fn strain_comparison() {
             },
         ),
         ("underwater preset", "velocity 0.015", preset, Model::underwater()),
-        ("underwater preset", "Eq. 5, 0.35", preset, under(0.35, SpringDamping::Fractional)),
-        ("underwater preset", "strain, 0.35", preset, under(0.35, SpringDamping::FractionalStrain)),
+        (
+            "underwater preset",
+            "Eq. 5, 0.35",
+            preset,
+            under(0.35, SpringDamping::Fractional),
+        ),
+        (
+            "underwater preset",
+            "strain, 0.35",
+            preset,
+            under(0.35, SpringDamping::FractionalStrain),
+        ),
     ];
     for (name, springs, bake, model) in rows {
         for size in [(31, 21), (61, 41)] {
@@ -200,7 +210,10 @@ fn strain_comparison() {
                     d.zigzag.map_or("n/a".into(), |z| format!("{z:.2}")),
                     d.hang_depth
                 ),
-                None => println!("| {name} | {springs} | {} x {} | unstable | | | | |", size.0, size.1),
+                None => println!(
+                    "| {name} | {springs} | {} x {} | unstable | | | | |",
+                    size.0, size.1
+                ),
             }
         }
     }

@@ -17,11 +17,28 @@ fn step_extrap(c: &mut Cloth, h: f64) {
 
 fn main() {
     let text = std::fs::read_to_string("tests/data/oscillator_reference.csv").unwrap();
-    let refs: Vec<(f64, f64)> = text.lines().skip(1).map(|l| { let p: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect(); (p[0], p[1]) }).collect();
+    let refs: Vec<(f64, f64)> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let p: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (p[0], p[1])
+        })
+        .collect();
     let o = Oscillator::default();
-    let tol: f64 = std::env::var("TOL").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-9);
-    for integrator in [Integrator::ExtrapolatedSymplectic, Integrator::ExtrapolatedImplicit] {
-        for scheme in [Scheme::SumOfExponentials { tolerance: tol, horizon: 3600.0, min_dt: 1e-5 }] {
+    let tol: f64 = std::env::var("TOL")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1e-9);
+    for integrator in [
+        Integrator::ExtrapolatedSymplectic,
+        Integrator::ExtrapolatedImplicit,
+    ] {
+        for scheme in [Scheme::SumOfExponentials {
+            tolerance: tol,
+            horizon: 3600.0,
+            min_dt: 1e-5,
+        }] {
             let mut prev = None;
             for dt in [1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4] {
                 let mut c = o.cloth(scheme, integrator).unwrap();
@@ -32,10 +49,16 @@ fn main() {
                         c.step(dt).unwrap();
                     }
                     let e = (Oscillator::elongation(&c) - x).abs();
-                    if e > err { err = e; worst_t = t; }
+                    if e > err {
+                        err = e;
+                        worst_t = t;
+                    }
                 }
                 let order = prev.map(|(pd, pe): (f64, f64)| (pe / err).ln() / (pd / dt).ln());
-                println!("{integrator:?} {} dt {dt:e}: max err {err:.3e} at {worst_t} order {order:?}", scheme.name());
+                println!(
+                    "{integrator:?} {} dt {dt:e}: max err {err:.3e} at {worst_t} order {order:?}",
+                    scheme.name()
+                );
                 prev = Some((dt, err));
             }
         }

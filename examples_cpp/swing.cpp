@@ -52,6 +52,12 @@ int main(int argc, char** argv) {
         } catch (const fraccloth::Error& e) {
             std::printf("error %d %s\n", static_cast<int>(e.status()), e.what());
         }
+        // The state in double precision round-trips exactly.
+        std::vector<double> x64 = cloth.positions_f64();
+        std::vector<double> v64 = cloth.velocities_f64();
+        cloth.set_positions_f64(x64);
+        cloth.set_velocities_f64(v64);
+        std::printf("exact %d\n", static_cast<int>(cloth.positions_f64() == x64 && cloth.velocities_f64() == v64));
         // Moving the handle leaves the source empty; destroying it is harmless.
         fraccloth::Cloth moved = std::move(cloth);
         std::printf("moved %zu %zu\n", moved.vertex_count(), cloth.vertex_count());

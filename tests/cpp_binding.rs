@@ -79,6 +79,8 @@ fn cpp_wrapper_runs_the_swing_like_the_c_abi() {
     let err = line(&out, "error ");
     assert_eq!(err[0], "2");
     assert!(out.contains("dt must be finite"), "{out}");
+    // The double-precision state round-trips exactly.
+    assert_eq!(line(&out, "exact "), vec!["1"]);
     // A moved-from handle is empty.
     assert_eq!(line(&out, "moved "), vec!["2501", "0"]);
     // The PC2 has 40 frames, the last equal to the final positions.

@@ -204,7 +204,7 @@ fn bad_descriptions_are_rejected_without_output() {
         ("soe horizon below min_dt", Box::new(|d| d.history_horizon = 1e-5)),
         ("soe min_dt negative", Box::new(|d| d.history_min_dt = -1.0)),
         ("integrator unknown", Box::new(|d| d.integrator = 9)),
-        ("damping mode unknown", Box::new(|d| d.spring_damping_mode = 3)),
+        ("damping mode unknown", Box::new(|d| d.spring_damping_mode = 4)),
         ("max speed 0", Box::new(|d| d.max_speed = 0.0)),
         (
             "huge grid",

@@ -90,7 +90,10 @@ fn max_error(integrator: u32, forced: bool, dt: f64) -> f64 {
             assert_eq!(unsafe { fc_cloth_step(cloth, dt) }, FC_OK);
             n += 1;
         }
-        assert_eq!(unsafe { fc_cloth_get_positions_f64(cloth, xyz.as_mut_ptr(), 12) }, FC_OK);
+        assert_eq!(
+            unsafe { fc_cloth_get_positions_f64(cloth, xyz.as_mut_ptr(), 12) },
+            FC_OK
+        );
         let x: f64 = (0..3).map(|c| (xyz[9 + c] - rest[c]) * axis()[c]).sum();
         worst = worst.max((x - if forced { f } else { free }).abs());
     }
@@ -107,9 +110,16 @@ fn check_second_order(integrator: u32) {
         let order = (e[0] / e[2]).log10() / 2.0;
         let case = if forced { "forced" } else { "free" };
         println!("integrator {integrator} {case}: max error {:.3e} {:.3e} {:.3e} at dt 1e-2, 1e-3, 1e-4; order {order:.3}", e[0], e[1], e[2]);
-        assert!(e[2] <= 1e-6, "integrator {integrator} {case}: {:e} at dt = 1e-4", e[2]);
+        assert!(
+            e[2] <= 1e-6,
+            "integrator {integrator} {case}: {:e} at dt = 1e-4",
+            e[2]
+        );
         assert!(order >= 1.9, "integrator {integrator} {case}: order {order}");
-        assert!((e[0] / e[1]).log10() >= 1.9 && (e[1] / e[2]).log10() >= 1.9, "{e:?}");
+        assert!(
+            (e[0] / e[1]).log10() >= 1.9 && (e[1] / e[2]).log10() >= 1.9,
+            "{e:?}"
+        );
     }
 }
 

@@ -62,11 +62,7 @@ fn on_a_straight_line_the_strain_element_is_eq5() {
                 b.step(1e-3).unwrap();
                 largest = largest.max(Oscillator::elongation(&a).abs());
                 let d = Oscillator::elongation(&a) - Oscillator::elongation(&b);
-                assert!(
-                    d.abs() < 1e-12,
-                    "{scheme:?} {integrator:?} at {}: {d}",
-                    a.time()
-                );
+                assert!(d.abs() < 1e-12, "{scheme:?} {integrator:?} at {}: {d}", a.time());
             }
             // Not trivially equal: the spring moved (static deflection F/k = 0.04 m) and is damped.
             assert!(largest > 0.04, "{largest}");
@@ -89,7 +85,11 @@ fn the_strain_element_follows_the_fractional_oscillators_closed_form() {
             32,
         )
     };
-    let mut c = line_oscillator(SpringDamping::FractionalStrain, Scheme::Full, Integrator::SymplecticEuler);
+    let mut c = line_oscillator(
+        SpringDamping::FractionalStrain,
+        Scheme::Full,
+        Integrator::SymplecticEuler,
+    );
     for t in [1.0, 2.0] {
         while c.time() < t - 0.5e-4 {
             c.step(1e-4).unwrap();
@@ -160,14 +160,21 @@ fn a_spinning_cloth_keeps_its_shape_with_the_strain_element_and_not_with_eq5() {
     let strain = spin(SpringDamping::FractionalStrain, 0.35, omega, 2.0);
     let eq5 = spin(SpringDamping::Fractional, 0.35, omega, 2.0);
     println!("largest relative spring length change: undamped {undamped:.3e}, strain {strain:.3e}, Eq. 5 {eq5:.3e}");
-    assert!(strain <= 1.05 * undamped, "strain {strain} vs undamped {undamped}");
+    assert!(
+        strain <= 1.05 * undamped,
+        "strain {strain} vs undamped {undamped}"
+    );
     assert!(eq5 > 10.0 * undamped, "Eq. 5 {eq5} vs undamped {undamped}");
 }
 
 #[test]
 fn a_snapshot_of_a_cloth_with_strain_springs_resumes_bit_for_bit() {
     let make = || {
-        let mut c = line_oscillator(SpringDamping::FractionalStrain, Scheme::DEFAULT, Integrator::ImplicitEuler);
+        let mut c = line_oscillator(
+            SpringDamping::FractionalStrain,
+            Scheme::DEFAULT,
+            Integrator::ImplicitEuler,
+        );
         for _ in 0..50 {
             c.step(1e-3).unwrap();
         }
@@ -176,7 +183,11 @@ fn a_snapshot_of_a_cloth_with_strain_springs_resumes_bit_for_bit() {
     let mut a = make();
     let bytes = a.save_snapshot().unwrap();
     assert_eq!(bytes.len(), a.snapshot_size());
-    let mut b = line_oscillator(SpringDamping::FractionalStrain, Scheme::DEFAULT, Integrator::ImplicitEuler);
+    let mut b = line_oscillator(
+        SpringDamping::FractionalStrain,
+        Scheme::DEFAULT,
+        Integrator::ImplicitEuler,
+    );
     b.load_snapshot(&bytes).unwrap();
     for _ in 0..100 {
         a.step(1e-3).unwrap();
@@ -184,7 +195,11 @@ fn a_snapshot_of_a_cloth_with_strain_springs_resumes_bit_for_bit() {
     }
     assert_eq!(a.positions(), b.positions());
     // A cloth without a history per spring refuses it with a message.
-    let mut c = line_oscillator(SpringDamping::Fractional, Scheme::DEFAULT, Integrator::ImplicitEuler);
+    let mut c = line_oscillator(
+        SpringDamping::Fractional,
+        Scheme::DEFAULT,
+        Integrator::ImplicitEuler,
+    );
     let e = c.load_snapshot(&bytes).unwrap_err();
     assert!(e.message.contains("history"), "{}", e.message);
 }

@@ -284,7 +284,8 @@ fn a_cloths_width_is_the_smaller_extent_in_its_own_plane_in_any_orientation() {
     .unwrap();
     assert!((grid.width() - 0.4).abs() < 1e-9, "{}", grid.width());
     // The same sheet turned about an oblique axis, as a mesh.
-    let turn = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(Vec3::new(1.0, 2.0, 3.0)), 0.7);
+    let turn =
+        nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(Vec3::new(1.0, 2.0, 3.0)), 0.7);
     let positions: Vec<Vec3> = grid.rest_positions.iter().map(|p| turn * p).collect();
     let indices: Vec<u32> = grid.triangles.iter().flatten().copied().collect();
     let turned = MeshSpec {

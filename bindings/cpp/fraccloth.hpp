@@ -158,6 +158,20 @@ public:
         return xyz;
     }
     void set_positions(span<const float> xyz) { check(fc_cloth_set_positions(handle_, xyz.data(), xyz.size())); }
+    void set_velocities(span<const float> xyz) { check(fc_cloth_set_velocities(handle_, xyz.data(), xyz.size())); }
+    /// The state in double precision, exactly (undo stacks, replicas, references).
+    std::vector<double> positions_f64() const {
+        std::vector<double> xyz(3 * vertex_count());
+        check(fc_cloth_get_positions_f64(handle_, xyz.data(), xyz.size()));
+        return xyz;
+    }
+    std::vector<double> velocities_f64() const {
+        std::vector<double> xyz(3 * vertex_count());
+        check(fc_cloth_get_velocities_f64(handle_, xyz.data(), xyz.size()));
+        return xyz;
+    }
+    void set_positions_f64(span<const double> xyz) { check(fc_cloth_set_positions_f64(handle_, xyz.data(), xyz.size())); }
+    void set_velocities_f64(span<const double> xyz) { check(fc_cloth_set_velocities_f64(handle_, xyz.data(), xyz.size())); }
 
     /// Colliders; each returns its id. A null velocity means resting.
     uint32_t add_sphere(const Vec3f& center, float radius, const Vec3f& velocity = {}) {

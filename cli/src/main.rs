@@ -92,8 +92,9 @@ struct Args {
     /// 1 cm spacing, shrinking with the spacing for the explicit integrators; 1/30 s implicit).
     #[arg(long)]
     dt: Option<f64>,
-    /// Integrator: explicit (the paper's Eq. 7), symplectic, implicit (stable at frame rate).
-    /// Default: symplectic for the underwater preset, explicit for the paper's models.
+    /// Integrator: explicit (the paper's Eq. 7), symplectic, implicit (stable at frame rate);
+    /// second order: symplectic2, implicit2 (each step extrapolated from a whole and two half
+    /// steps). Default: symplectic for the underwater preset, explicit for the paper's models.
     #[arg(long)]
     integrator: Option<String>,
     /// How D^{1/2} is evaluated: soe (accurate, constant cost; the default), paper (Eq. 6 with
@@ -142,7 +143,9 @@ fn integrator_and_dt(args: &Args, variant: Variant) -> Result<(Integrator, f64),
     let integrator = Integrator::ALL
         .into_iter()
         .find(|i| i.key() == key)
-        .ok_or_else(|| format!("unknown integrator {key:?} (explicit, symplectic, implicit)"))?;
+        .ok_or_else(|| {
+            format!("unknown integrator {key:?} (explicit, symplectic, implicit, symplectic2, implicit2)")
+        })?;
     let (width, _) = parse_size(&args.size)?;
     let spacing = fraccloth::scenes::CLOTH_WIDTH / f64::from(width.max(2) - 1);
     let dt = args.dt.unwrap_or_else(|| stable_dt(spacing, integrator));

@@ -89,7 +89,8 @@ impl Rollback {
     pub(super) fn save(&mut self, c: &Cloth) -> Result<(), Error> {
         use crate::history::HalfDerivative;
         let need = c.history.bytes_per_particle() as u64 * c.x.len() as u64
-            + c.strain_history.bytes_per_particle() as u64 * forces::strain::entries(c.topology.springs.len()) as u64;
+            + c.strain_history.bytes_per_particle() as u64
+                * forces::strain::entries(c.topology.springs.len()) as u64;
         let have = self
             .history
             .as_ref()

@@ -53,7 +53,12 @@ unsafe fn set_all<T: Copy + Into<f64>>(
 ///
 /// # Safety
 /// `cloth` NULL or live; `xyz` NULL or `count` writable doubles.
-unsafe fn get_all_f64(cloth: *const FcCloth, xyz: *mut f64, count: usize, values: fn(&Cloth) -> &[Vec3]) -> FcStatus {
+unsafe fn get_all_f64(
+    cloth: *const FcCloth,
+    xyz: *mut f64,
+    count: usize,
+    values: fn(&Cloth) -> &[Vec3],
+) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { handle(cloth) }?;
@@ -76,7 +81,11 @@ unsafe fn get_all_f64(cloth: *const FcCloth, xyz: *mut f64, count: usize, values
 /// # Safety
 /// `cloth` NULL or live; `xyz` NULL or `float_count` readable floats.
 #[no_mangle]
-pub unsafe extern "C" fn fc_cloth_set_velocities(cloth: *mut FcCloth, xyz: *const f32, float_count: usize) -> FcStatus {
+pub unsafe extern "C" fn fc_cloth_set_velocities(
+    cloth: *mut FcCloth,
+    xyz: *const f32,
+    float_count: usize,
+) -> FcStatus {
     // SAFETY: forwarded caller promises.
     unsafe { set_all(cloth, xyz, float_count, "velocity", Cloth::set_velocities) }
 }

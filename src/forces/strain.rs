@@ -34,7 +34,11 @@ pub fn elongation_rates(topology: &Topology, x: &[Vec3], v: &[Vec3], out: &mut V
         let (i, j) = (s.i as usize, s.j as usize);
         let l = x[i] - x[j];
         let len = l.norm();
-        out[k / 3][k % 3] = if len > 0.0 { (v[i] - v[j]).dot(&l) / len } else { 0.0 };
+        out[k / 3][k % 3] = if len > 0.0 {
+            (v[i] - v[j]).dot(&l) / len
+        } else {
+            0.0
+        };
     }
 }
 

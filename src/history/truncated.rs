@@ -56,7 +56,13 @@ impl Clone for Truncated {
             slots: self.slots.clone(),
             head: self.head,
             pushed: self.pushed,
-            weights: self.weights.clone(),
+            weights: {
+                // Room for all u + 1 weights, as `new` makes: a copy taken while the history
+                // fills must not allocate when `clone_from` later copies more weights into it.
+                let mut w = Vec::with_capacity(self.u + 1);
+                w.extend_from_slice(&self.weights);
+                w
+            },
             h: self.h,
         }
     }

@@ -29,6 +29,7 @@ __all__ = [
     "PRESET_REGULAR_VISCOUS_NORMAL",
     "PRESET_REGULAR_VISCOUS",
     "PRESET_REGULAR_NORMAL",
+    "PRESET_UNDERWATER",
     "HISTORY_OFF",
     "HISTORY_TRUNCATED",
     "HISTORY_FULL",
@@ -36,6 +37,12 @@ __all__ = [
     "INTEGRATOR_EXPLICIT_EULER",
     "INTEGRATOR_SYMPLECTIC_EULER",
     "INTEGRATOR_IMPLICIT_EULER",
+    "INTEGRATOR_EXTRAPOLATED_SYMPLECTIC",
+    "INTEGRATOR_EXTRAPOLATED_IMPLICIT",
+    "SPRING_DAMPING_NONE",
+    "SPRING_DAMPING_VELOCITY",
+    "SPRING_DAMPING_FRACTIONAL",
+    "SPRING_DAMPING_FRACTIONAL_STRAIN",
     "CACHE_PC2",
     "CACHE_MDD",
     "CACHE_OBJ_SEQUENCE",
@@ -110,6 +117,7 @@ PRESET_FRACTIONAL_PAPER = _ENUMS["FC_PRESET_FRACTIONAL_PAPER"]
 PRESET_REGULAR_VISCOUS_NORMAL = _ENUMS["FC_PRESET_REGULAR_VISCOUS_NORMAL"]
 PRESET_REGULAR_VISCOUS = _ENUMS["FC_PRESET_REGULAR_VISCOUS"]
 PRESET_REGULAR_NORMAL = _ENUMS["FC_PRESET_REGULAR_NORMAL"]
+PRESET_UNDERWATER = _ENUMS["FC_PRESET_UNDERWATER"]
 HISTORY_OFF = _ENUMS["FC_HISTORY_OFF"]
 HISTORY_TRUNCATED = _ENUMS["FC_HISTORY_TRUNCATED"]
 HISTORY_FULL = _ENUMS["FC_HISTORY_FULL"]
@@ -117,6 +125,12 @@ HISTORY_SOE = _ENUMS["FC_HISTORY_SOE"]
 INTEGRATOR_EXPLICIT_EULER = _ENUMS["FC_INTEGRATOR_EXPLICIT_EULER"]
 INTEGRATOR_SYMPLECTIC_EULER = _ENUMS["FC_INTEGRATOR_SYMPLECTIC_EULER"]
 INTEGRATOR_IMPLICIT_EULER = _ENUMS["FC_INTEGRATOR_IMPLICIT_EULER"]
+INTEGRATOR_EXTRAPOLATED_SYMPLECTIC = _ENUMS["FC_INTEGRATOR_EXTRAPOLATED_SYMPLECTIC"]
+INTEGRATOR_EXTRAPOLATED_IMPLICIT = _ENUMS["FC_INTEGRATOR_EXTRAPOLATED_IMPLICIT"]
+SPRING_DAMPING_NONE = _ENUMS["FC_SPRING_DAMPING_NONE"]
+SPRING_DAMPING_VELOCITY = _ENUMS["FC_SPRING_DAMPING_VELOCITY"]
+SPRING_DAMPING_FRACTIONAL = _ENUMS["FC_SPRING_DAMPING_FRACTIONAL"]
+SPRING_DAMPING_FRACTIONAL_STRAIN = _ENUMS["FC_SPRING_DAMPING_FRACTIONAL_STRAIN"]
 CACHE_PC2 = _ENUMS["FC_CACHE_PC2"]
 CACHE_MDD = _ENUMS["FC_CACHE_MDD"]
 CACHE_OBJ_SEQUENCE = _ENUMS["FC_CACHE_OBJ_SEQUENCE"]
@@ -127,6 +141,7 @@ _c = ctypes
 _P = ctypes.c_void_p
 _F3 = ctypes.POINTER(ctypes.c_float)
 _U32P = ctypes.POINTER(ctypes.c_uint32)
+_D3 = ctypes.POINTER(ctypes.c_double)
 _SIGNATURES = {
     "fc_last_error_message": (_c.c_char_p, []),
     "fc_status_string": (_c.c_char_p, [_c.c_int32]),
@@ -149,6 +164,11 @@ _SIGNATURES = {
     "fc_cloth_set_positions": (_c.c_int, [_P, _F3, _c.c_size_t]),
     "fc_cloth_get_positions": (_c.c_int, [_P, _F3, _c.c_size_t]),
     "fc_cloth_get_velocities": (_c.c_int, [_P, _F3, _c.c_size_t]),
+    "fc_cloth_set_velocities": (_c.c_int, [_P, _F3, _c.c_size_t]),
+    "fc_cloth_get_positions_f64": (_c.c_int, [_P, _D3, _c.c_size_t]),
+    "fc_cloth_set_positions_f64": (_c.c_int, [_P, _D3, _c.c_size_t]),
+    "fc_cloth_get_velocities_f64": (_c.c_int, [_P, _D3, _c.c_size_t]),
+    "fc_cloth_set_velocities_f64": (_c.c_int, [_P, _D3, _c.c_size_t]),
     "fc_cloth_set_current": (_c.c_int, [_P, _F3]),
     "fc_cloth_step": (_c.c_int, [_P, _c.c_double]),
     "fc_cloth_step_substeps": (_c.c_int, [_P, _c.c_double, _c.c_uint32]),
@@ -198,6 +218,13 @@ def _floats(values, shape_last: Optional[int] = 3) -> np.ndarray:
     return a
 
 
+def _doubles(values) -> np.ndarray:
+    a = np.ascontiguousarray(values, dtype=np.float64)
+    if a.size % 3 != 0:
+        raise ValueError(f"expected a multiple of 3 values, got {a.size}")
+    return a
+
+
 def _u32(values) -> np.ndarray:
     a = np.asarray(values)
     if a.size and (a.min() < 0 or a.max() > 0xFFFFFFFF):
@@ -207,6 +234,10 @@ def _u32(values) -> np.ndarray:
 
 def _fp(a: np.ndarray):
     return a.ctypes.data_as(_F3)
+
+
+def _dp(a: np.ndarray):
+    return a.ctypes.data_as(_D3)
 
 
 def _up(a: np.ndarray):
@@ -311,8 +342,32 @@ class Cloth:
 
     @property
     def velocities(self) -> np.ndarray:
+        """Velocities (m/s), float32, shape (n, 3)."""
         out = np.empty((self.vertex_count, 3), dtype=np.float32)
         _check(library.fc_cloth_get_velocities(self._h, _fp(out), out.size))
+        return out
+
+    @velocities.setter
+    def velocities(self, xyz) -> None:
+        """Sets every velocity (m/s) exactly, in double precision; the history is kept."""
+        a = _doubles(xyz)
+        _check(library.fc_cloth_set_velocities_f64(self._h, _dp(a), a.size))
+
+    def positions_f64(self) -> np.ndarray:
+        """Positions (m), exactly: float64, shape (n, 3)."""
+        out = np.empty((self.vertex_count, 3), dtype=np.float64)
+        _check(library.fc_cloth_get_positions_f64(self._h, _dp(out), out.size))
+        return out
+
+    def set_positions_f64(self, xyz) -> None:
+        """Sets every position (m) exactly; velocities and history are kept."""
+        a = _doubles(xyz)
+        _check(library.fc_cloth_set_positions_f64(self._h, _dp(a), a.size))
+
+    def velocities_f64(self) -> np.ndarray:
+        """Velocities (m/s), exactly: float64, shape (n, 3)."""
+        out = np.empty((self.vertex_count, 3), dtype=np.float64)
+        _check(library.fc_cloth_get_velocities_f64(self._h, _dp(out), out.size))
         return out
 
     def set_pinned(self, indices: Iterable[int]) -> None:

@@ -92,6 +92,29 @@ def test_swing_pc2_matches_the_c_example(tmp_path):
     assert np.array_equal(np.array(mine), c_frames)
 
 
+def test_second_order_integrators_strain_springs_and_exact_state():
+    desc = fraccloth.preset_desc(fraccloth.PRESET_FRACTIONAL_PAPER)
+    desc.width, desc.height = 11, 7
+    desc.integrator = fraccloth.INTEGRATOR_EXTRAPOLATED_IMPLICIT
+    desc.spring_damping_mode = fraccloth.SPRING_DAMPING_FRACTIONAL_STRAIN
+    desc.history_scheme = fraccloth.HISTORY_SOE
+    with fraccloth.Cloth.grid(desc) as cloth:
+        x = cloth.positions_f64()
+        assert x.dtype == np.float64 and x.shape == (77, 3)
+        moved = x + 1e-9  # below float32's resolution at these coordinates
+        cloth.set_positions_f64(moved)
+        assert np.array_equal(cloth.positions_f64(), moved)
+        v = np.full((77, 3), 0.01)
+        cloth.velocities = v
+        assert np.array_equal(cloth.velocities_f64(), v)
+        cloth.set_pinned(range(11))
+        for _ in range(10):
+            cloth.step(1.0 / 60.0)
+        assert np.isfinite(cloth.positions_f64()).all()
+        with pytest.raises(fraccloth.Error):
+            cloth.velocities = np.full((77, 3), np.nan)
+
+
 def test_errors_raise_and_leave_the_cloth_alone():
     with fraccloth.Cloth.grid() as cloth:
         before = cloth.positions
