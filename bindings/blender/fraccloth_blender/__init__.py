@@ -51,6 +51,8 @@ INTEGRATOR_ITEMS = [
     ("SYMPLECTIC", "Symplectic Euler", "Fast; small time steps (about 1 ms)"),
     ("EXPLICIT", "Explicit Euler", "The paper's integrator; small time steps"),
     ("IMPLICIT", "Implicit Euler", "Stable at large steps (a frame)"),
+    ("SYMPLECTIC2", "Symplectic, 2nd order", "Extrapolated symplectic Euler: error shrinks with the square of the step; 3x the work per step"),
+    ("IMPLICIT2", "Implicit, 2nd order", "Extrapolated implicit Euler: second order and stable at a frame; 3x the work per step"),
 ]
 FORMAT_ITEMS = [("PC2", "PC2", "PC2 point cache"), ("MDD", "MDD", "MDD point cache")]
 
@@ -157,6 +159,8 @@ def build_cloth(context, obj, others):
         "SYMPLECTIC": fraccloth.INTEGRATOR_SYMPLECTIC_EULER,
         "EXPLICIT": fraccloth.INTEGRATOR_EXPLICIT_EULER,
         "IMPLICIT": fraccloth.INTEGRATOR_IMPLICIT_EULER,
+        "SYMPLECTIC2": fraccloth.INTEGRATOR_EXTRAPOLATED_SYMPLECTIC,
+        "IMPLICIT2": fraccloth.INTEGRATOR_EXTRAPOLATED_IMPLICIT,
     }[s.integrator]
     cloth = fraccloth.Cloth.mesh(desc, pos, faces)
     w = pin_weights(obj, s.pin_group)
