@@ -75,7 +75,6 @@ fn the_strain_element_follows_the_fractional_oscillators_closed_form() {
     // The exact response, by inverse Laplace transform (tests/common/reference.rs), at t = 1 s
     // and 2 s: first-order integrators at dt = 1e-4 land within 2e-4 of it.
     #[path = "common/reference.rs"]
-    #[allow(dead_code)]
     mod reference;
     let o = Oscillator::default();
     let exact = |t: f64| {
