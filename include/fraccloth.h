@@ -427,6 +427,18 @@ FcStatus fc_cache_open(const char *path,
 FcStatus fc_cache_write_frame(FcCache *cache, const FcCloth *cloth);
 
 /**
+ * Appends a frame of positions the host gives (float xyz triples, one per vertex of the cloth
+ * the cache was opened for; `float_count` = 3 * vertex_count): for a host that stores the
+ * cloth in another frame than it simulates it (a DCC object's local space while the cloth
+ * moves in world space). Errors as `fc_cache_write_frame`, and `FC_ERROR_INVALID_ARGUMENT` for
+ * a wrong count or a non-finite value (the cache is unchanged then).
+ *
+ * # Safety
+ * `cache` NULL or live (not closed); `xyz` NULL or `float_count` readable floats.
+ */
+FcStatus fc_cache_write_positions(FcCache *cache, const float *xyz, size_t float_count);
+
+/**
  * Completes the cache file (patches its frame count, flushes it to disk) and frees the handle,
  * also when completing fails (the status then says why). A cache that failed earlier returns
  * that first error. NULL is fine.

@@ -176,8 +176,14 @@ impl CacheWriter {
         e
     }
 
+    /// Vertices per frame.
+    pub fn vertex_count(&self) -> usize {
+        self.vertex_count
+    }
+
     /// Appends one frame of positions. After a failure that may have written part of a frame,
     /// the cache is poisoned (module docs).
+
     pub fn write_frame(&mut self, positions: &[Vec3]) -> io::Result<()> {
         self.poisoned()?;
         if positions.len() != self.vertex_count {

@@ -126,6 +126,48 @@ pub unsafe extern "C" fn fc_cache_write_frame(cache: *mut FcCache, cloth: *const
     })
 }
 
+/// Appends a frame of positions the host gives (float xyz triples, one per vertex of the cloth
+/// the cache was opened for; `float_count` = 3 * vertex_count): for a host that stores the
+/// cloth in another frame than it simulates it (a DCC object's local space while the cloth
+/// moves in world space). Errors as `fc_cache_write_frame`, and `FC_ERROR_INVALID_ARGUMENT` for
+/// a wrong count or a non-finite value (the cache is unchanged then).
+///
+/// # Safety
+/// `cache` NULL or live (not closed); `xyz` NULL or `float_count` readable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cache_write_positions(
+    cache: *mut FcCache,
+    xyz: *const f32,
+    float_count: usize,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: the caller promises a live cache or NULL.
+        let cache = unsafe { cache.as_mut() }.ok_or_else(|| FfiError::null("cache"))?;
+        // SAFETY: forwarded caller promise.
+        let xyz = unsafe { super::cloth::slice_in(xyz, float_count, "xyz") }?;
+        if float_count % 3 != 0 {
+            return Err(FfiError::invalid(format!(
+                "float_count must be 3 * vertex_count, got {float_count}"
+            )));
+        }
+        let positions = super::cloth::triples(xyz, "position")?;
+        let path = cache.path.display().to_string();
+        let writer = cache
+            .writer
+            .as_mut()
+            .ok_or_else(|| FfiError::invalid("the cache failed earlier and was abandoned"))?;
+        if positions.len() != writer.vertex_count() {
+            return Err(FfiError::invalid(format!(
+                "float_count must be 3 * vertex_count = {}, got {float_count}",
+                3 * writer.vertex_count()
+            )));
+        }
+        writer
+            .write_frame(&positions)
+            .map_err(|e| FfiError::io(&format!("cannot write a frame to {path}"), &e))
+    })
+}
+
 /// Completes the cache file (patches its frame count, flushes it to disk) and frees the handle,
 /// also when completing fails (the status then says why). A cache that failed earlier returns
 /// that first error. NULL is fine.

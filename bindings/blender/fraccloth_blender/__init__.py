@@ -75,26 +75,50 @@ class FracclothSettings(bpy.types.PropertyGroup):
     cache_path: bpy.props.StringProperty(name="Cache file", subtype="FILE_PATH", default="//fraccloth_cache")
 
 
-def _local(obj):
-    """World -> object-local transform and its rotation (scale must be 1)."""
-    inv = obj.matrix_world.inverted()
-    rot = obj.matrix_world.to_3x3().normalized().transposed()
-    return inv, rot
-
-
-def collider_specs(obj, others):
-    """(kind, args) for every other selected object, in the cloth's local frame."""
-    inv, rot = _local(obj)
+def _world_specs(others):
+    """(kind, args) for every collider object, in world coordinates, at the current frame: a
+    flat object (one dimension below 1e-6 of the largest) is a plane through its origin along its
+    local z axis, anything else a sphere around its origin whose radius is half its largest
+    dimension."""
     specs = []
     for o in others:
         dims = o.dimensions
-        center = inv @ o.matrix_world.translation
+        center = o.matrix_world.translation.copy()
         if min(dims) < 1e-6 * max(max(dims), 1e-9):
-            normal = rot @ (o.matrix_world.to_3x3() @ Vector((0.0, 0.0, 1.0))).normalized()
+            normal = (o.matrix_world.to_3x3() @ Vector((0.0, 0.0, 1.0))).normalized()
             specs.append(("plane", tuple(center), tuple(normal)))
         else:
             specs.append(("sphere", tuple(center), 0.5 * max(dims)))
     return specs
+
+
+def collider_specs(obj, others):
+    """The colliders at the current frame (world coordinates; `obj` is unused and kept for
+    callers of earlier versions)."""
+    return _world_specs(others)
+
+
+def world_positions(obj):
+    """The evaluated mesh's vertex positions in world coordinates at the current frame (object
+    transform, parents, armatures, shape keys, hooks: whatever Blender evaluates), (N, 3)."""
+    deps = bpy.context.evaluated_depsgraph_get()
+    ev = obj.evaluated_get(deps)
+    me = ev.to_mesh()
+    try:
+        co = np.empty(3 * len(me.vertices), dtype=np.float64)
+        me.vertices.foreach_get("co", co)
+    finally:
+        ev.to_mesh_clear()
+    m = np.array(ev.matrix_world, dtype=np.float64)
+    co = co.reshape(-1, 3)
+    return co @ m[:3, :3].T + m[:3, 3]
+
+
+def to_local(obj, world):
+    """World positions into `obj`'s local frame at the current frame (what the Mesh Cache
+    modifier stores)."""
+    inv = np.array(obj.matrix_world.inverted(), dtype=np.float64)
+    return world @ inv[:3, :3].T + inv[:3, 3]
 
 
 def mesh_arrays(obj):
@@ -126,33 +150,33 @@ def pin_weights(obj, name):
 
 
 def build_cloth(context, obj, others):
-    """The fraccloth cloth for `obj` with the scene's settings; returns (cloth, step plan)."""
+    """The fraccloth cloth for `obj` with the scene's settings, in world coordinates at the
+    current frame; returns (cloth, step plan, pinned indices, collider ids)."""
     import fraccloth
 
     s = context.scene.fraccloth
     if any(abs(c - 1.0) > 1e-6 for c in obj.matrix_world.to_scale()):
         raise ValueError(f"{obj.name}: apply its scale first (Ctrl+A > Scale)")
-    pos, faces = mesh_arrays(obj)
-    _, rot = _local(obj)
+    _, faces = mesh_arrays(obj)
+    pos = world_positions(obj)
+    if len(pos) != len(obj.data.vertices):
+        raise ValueError(f"{obj.name}: its modifiers change the vertex count; apply or remove them")
     desc = fraccloth.default_desc()
     desc.total_mass = 0.0
     desc.areal_density = s.mass_per_area
-    g = rot @ Vector((0.0, 0.0, -9.81))
-    cur = rot @ Vector(s.current)
     for k in range(3):
-        desc.gravity[k] = g[k]
-        desc.current[k] = cur[k]
+        desc.gravity[k] = (0.0, 0.0, -9.81)[k]
+        desc.current[k] = s.current[k]
     desc.stretch_stiffness = s.stretch_stiffness
     desc.shear_stiffness = s.shear_stiffness
     desc.bend_stiffness = s.bend_stiffness
     desc.spring_damping = s.spring_damping
-    # Drags are per particle in the library; the panel's are per 1 cm^2: scale by the mean
-    # vertex area.
-    edges = np.linalg.norm(pos[faces[:, 0]] - pos[faces[:, 1]], axis=1)
-    spacing = float(np.mean(edges)) if len(edges) else 0.01
-    area_scale = (spacing / 0.01) ** 2
-    desc.history_drag = s.history_drag * area_scale
-    desc.viscous_drag = s.viscous_drag * area_scale
+    # The panel's drags are per 1 cm^2 of cloth; the library takes them per m^2 and multiplies
+    # each vertex's own area, so the look does not change with the mesh's resolution.
+    desc.history_drag = 0.0
+    desc.viscous_drag = 0.0
+    desc.history_drag_per_area = s.history_drag / 1e-4
+    desc.viscous_drag_per_area = s.viscous_drag / 1e-4
     desc.history_scheme = {"SOE": fraccloth.HISTORY_SOE, "PAPER": fraccloth.HISTORY_TRUNCATED, "OFF": fraccloth.HISTORY_OFF}[s.history]
     desc.history_u = 3
     desc.integrator = {
@@ -162,31 +186,64 @@ def build_cloth(context, obj, others):
         "SYMPLECTIC2": fraccloth.INTEGRATOR_EXTRAPOLATED_SYMPLECTIC,
         "IMPLICIT2": fraccloth.INTEGRATOR_EXTRAPOLATED_IMPLICIT,
     }[s.integrator]
-    cloth = fraccloth.Cloth.mesh(desc, pos, faces)
+    cloth = fraccloth.Cloth.mesh(desc, pos.astype(np.float32), faces)
     w = pin_weights(obj, s.pin_group)
     if w.any():
         cloth.set_pin_weights(w)
-    for spec in collider_specs(obj, others):
+    ids = []
+    for spec in _world_specs(others):
         if spec[0] == "plane":
             cid = cloth.add_plane(spec[1], spec[2])
         else:
             cid = cloth.add_sphere(spec[1], spec[2])
         cloth.set_collider_friction(cid, s.friction)
+        ids.append(cid)
     fps = context.scene.render.fps / context.scene.render.fps_base
     frame_dt = 1.0 / fps
     substeps = max(1, math.ceil(frame_dt / s.time_step - 1e-9))
-    return cloth, (frame_dt, substeps)
+    return cloth, (frame_dt, substeps), np.flatnonzero(w > 0.0).astype(np.uint32), ids
 
 
 def simulate(context, obj, others):
-    """Yields (frame, cloth) for every frame of the scene's range: the first frame is the rest
-    state, each next one a frame's worth of steps later."""
-    cloth, (frame_dt, substeps) = build_cloth(context, obj, others)
+    """Yields (frame, cloth, local positions) for every frame of the scene's range. The cloth
+    moves in world space; the first frame is the rest state, each next one a frame's worth of
+    steps later. Before each frame's steps the pinned vertices' evaluated world positions at that
+    frame become the pin targets (approached in a straight line over the substeps; a weight
+    below 1 is a soft pin), and every collider is moved to where it is at that frame with the
+    velocity that takes it there. Local positions: the cloth in `obj`'s frame at that frame."""
     scene = context.scene
+    # An earlier bake's cache must not feed the mesh this one reads.
+    ours = [m for m in obj.modifiers if m.type == "MESH_CACHE" and m.name == "fraccloth"]
+    shown = [m.show_viewport for m in ours]
+    for m in ours:
+        m.show_viewport = False
+    try:
+        yield from _simulate(context, obj, others)
+    finally:
+        for m, v in zip(ours, shown):
+            m.show_viewport = v
+
+
+def _simulate(context, obj, others):
+    scene = context.scene
+    scene.frame_set(scene.frame_start)
+    cloth, (frame_dt, substeps), pinned, ids = build_cloth(context, obj, others)
+    previous = _world_specs(others)
     for f in range(scene.frame_start, scene.frame_end + 1):
         if f > scene.frame_start:
+            scene.frame_set(f)
+            if len(pinned):
+                cloth.set_pin_targets(pinned, world_positions(obj)[pinned].astype(np.float32))
+            now = _world_specs(others)
+            for cid, old, new in zip(ids, previous, now):
+                velocity = (np.array(new[1]) - np.array(old[1])) / frame_dt
+                if new[0] == "plane":
+                    cloth.set_plane(cid, new[1], new[2], velocity)
+                else:
+                    cloth.set_sphere(cid, new[1], new[2], velocity)
+            previous = now
             cloth.step_substeps(frame_dt, substeps)
-        yield f, cloth
+        yield f, cloth, to_local(obj, cloth.positions_f64()).astype(np.float32)
 
 
 class FRACCLOTH_OT_bake(bpy.types.Operator):
@@ -219,16 +276,27 @@ class FRACCLOTH_OT_bake(bpy.types.Operator):
         for m in list(obj.modifiers):
             if m.type == "MESH_CACHE" and m.name == "fraccloth":
                 obj.modifiers.remove(m)
+        current = scene.frame_current
         try:
             cache = None
-            for f, cloth in simulate(context, obj, others):
+            for f, cloth, local in simulate(context, obj, others):
                 if cache is None:
                     cache = fraccloth.Cache(path, fmt, cloth, float(scene.frame_start), fps, frames)
-                cache.write_frame(cloth)
+                cache.write_positions(local)
             cache.close()
         except (fraccloth.Error, ValueError) as e:
+            # No cache that looks complete is left behind.
+            if cache is not None:
+                try:
+                    cache.close()
+                except fraccloth.Error:
+                    pass
+            if os.path.exists(path):
+                os.remove(path)
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
+        finally:
+            scene.frame_set(current)
         mod = obj.modifiers.new("fraccloth", "MESH_CACHE")
         mod.cache_format = s.cache_format
         mod.filepath = path

@@ -85,7 +85,7 @@ def test_bake_reads_back_exactly(addon, tmp_path, fmt):
     assert mod is not None and mod.type == "MESH_CACHE" and mod.cache_format == fmt
     assert Path(mod.filepath).exists()
     # The library's own positions: the add-on's simulation, run again with the same inputs.
-    expected = {f: c.positions.copy() for f, c in addon.simulate(bpy.context, cloth, others)}
+    expected = {f: local for f, _, local in addon.simulate(bpy.context, cloth, others)}
     for frame in (1, 2, 12, 24):
         got = evaluated(cloth, frame)
         assert got.shape == expected[frame].shape
@@ -94,7 +94,68 @@ def test_bake_reads_back_exactly(addon, tmp_path, fmt):
     last = expected[24]
     assert np.abs(last - rest).max() > 0.01
     pinned = [v.index for v in cloth.data.vertices if v.groups]
-    assert np.array_equal(last[pinned], rest[pinned])
+    assert np.allclose(last[pinned], rest[pinned], atol=1e-6)
+
+
+def world(obj, frame):
+    """Evaluated vertex positions in world coordinates at `frame`."""
+    local = evaluated(obj, frame).astype(np.float64)
+    m = np.array(obj.matrix_world, dtype=np.float64)
+    return local @ m[:3, :3].T + m[:3, 3]
+
+
+def test_pins_follow_an_animated_object_and_the_cloth_lags(addon, tmp_path):
+    # The cloth object moves 0.2 m along x over the first second, then stops: the pinned
+    # vertices go with it (the pins follow the evaluated mesh in world space), the free part
+    # trails behind in the water while the object moves.
+    def bake(animated):
+        cloth, _ = make_scene(tmp_path, "PC2")
+        bpy.context.scene.fraccloth.cache_path = str(tmp_path / ("moving" if animated else "still"))
+        if animated:
+            cloth.location = (0.1, -0.2, 0.2)
+            cloth.keyframe_insert("location", frame=1)
+            cloth.location = (0.3, -0.2, 0.2)
+            cloth.keyframe_insert("location", frame=24)
+        assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+        pinned = [v.index for v in cloth.data.vertices if v.groups]
+        rest = np.array([v.co[:] for v in cloth.data.vertices], dtype=np.float64)
+        m = np.array(cloth.matrix_world, dtype=np.float64)
+        return cloth, pinned, rest, evaluated(cloth, 12).astype(np.float64), m
+
+    _, _, _, still, _ = bake(False)
+    cloth, pinned, rest, moving, _ = bake(True)
+    # Pinned vertices sit where the animated object puts them (local = rest at every frame).
+    for frame in (6, 12, 24):
+        got = evaluated(cloth, frame)
+        assert np.allclose(got[pinned], rest[pinned], atol=1e-5), frame
+    # Mid-move, the free vertices trail: in the object's frame they sit behind (-x, the frame's
+    # own axis is turned by 0.3 rad) where they hang when nothing moves.
+    free = [i for i in range(len(rest)) if i not in set(pinned)]
+    lag = (moving[free] - still[free]).mean(axis=0)
+    back = np.array([-np.cos(0.3), np.sin(0.3), 0.0])
+    assert lag @ back > 0.005, f"free part did not trail: {lag}"
+
+
+def test_an_animated_sphere_pushes_the_cloth_and_never_enters_it(addon, tmp_path):
+    cloth, others = make_scene(tmp_path, "PC2")
+    ball = others[0]
+    # The ball rises from under the hanging cloth up through where it hangs.
+    ball.location = (0.1, -0.2, -0.15)
+    ball.keyframe_insert("location", frame=1)
+    ball.location = (0.1, -0.2, 0.35)
+    ball.keyframe_insert("location", frame=24)
+    assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+    margin, radius = 0.01, 0.05
+    closest = np.inf
+    for frame in range(1, 25):
+        x = world(cloth, frame)
+        bpy.context.scene.frame_set(frame)
+        c = np.array(ball.matrix_world.translation)
+        d = np.linalg.norm(x - c, axis=1)
+        assert d.min() >= radius - margin - 1e-4, f"frame {frame}: a vertex {radius - d.min():.4f} m inside"
+        closest = min(closest, d.min())
+    # The ball did reach the cloth (the check above could not pass by missing it).
+    assert closest < radius + margin, closest
 
 
 def test_bad_input_is_reported_not_crashed(addon, tmp_path):

@@ -188,6 +188,7 @@ _SIGNATURES = {
         [_c.c_char_p, _c.c_uint32, _P, _c.c_double, _c.c_double, _c.c_uint32, _c.POINTER(_P)],
     ),
     "fc_cache_write_frame": (_c.c_int, [_P, _P]),
+    "fc_cache_write_positions": (_c.c_int, [_P, _F3, _c.c_size_t]),
     "fc_cache_close": (_c.c_int, [_P]),
 }
 for _name, (_res, _args) in _SIGNATURES.items():
@@ -445,7 +446,14 @@ class Cache:
         )
 
     def write_frame(self, cloth: Cloth) -> None:
+        """Appends the cloth's current positions as the next frame."""
         _check(library.fc_cache_write_frame(self._h, cloth.handle))
+
+    def write_positions(self, xyz) -> None:
+        """Appends a frame of positions given by the caller (m; shape (n, 3)), e.g. the cloth
+        in another frame of reference than the one it was simulated in."""
+        a = _floats(xyz)
+        _check(library.fc_cache_write_positions(self._h, _fp(a), a.size))
 
     def close(self) -> None:
         h, self._h = self._h, ctypes.c_void_p()
