@@ -183,7 +183,6 @@ impl CacheWriter {
 
     /// Appends one frame of positions. After a failure that may have written part of a frame,
     /// the cache is poisoned (module docs).
-
     pub fn write_frame(&mut self, positions: &[Vec3]) -> io::Result<()> {
         self.poisoned()?;
         if positions.len() != self.vertex_count {
