@@ -11,8 +11,9 @@ Physics > fraccloth panel (Properties editor, Physics tab). "Bake underwater clo
   "Time step"; the result is written to a PC2 (or MDD) point cache by the fraccloth library and
   attached with a Mesh Cache modifier.
 
-Simulation happens in the object's local frame (gravity, current and colliders are carried
-into it), so the cache holds local coordinates as the Mesh Cache modifier expects.
+Settings are per object (each cloth its own preset, values and cache file). The cloth is
+simulated in world space, following its animated pins and colliders frame by frame, and the
+cache holds each frame in the object's own frame, as the Mesh Cache modifier expects.
 
 Needs the `fraccloth` Python package (bindings/python) importable from Blender's Python:
 `pip install ./bindings/python` into it, or put the package (with its _lib folder) next to
@@ -57,22 +58,81 @@ INTEGRATOR_ITEMS = [
 FORMAT_ITEMS = [("PC2", "PC2", "PC2 point cache"), ("MDD", "MDD", "MDD point cache")]
 
 
+DAMPING_ITEMS = [
+    ("FRACTIONAL", "Fractional (paper)", "Springs resist the half-derivative of their ends' motion: the paper's Eq. 5"),
+    ("STRAIN", "Fractional, turn-proof", "Half-derivative of each spring's stretch: like the paper's, without its grid-scale zigzag"),
+    ("VELOCITY", "Ordinary", "Springs resist how fast they stretch (classic damped springs)"),
+    ("NONE", "None", "Springs do not damp"),
+]
+
+# Presets in an artist's words: (label, tooltip, values). "Underwater towel" is the library's
+# FC_PRESET_UNDERWATER (docs/underwater.md); the others differ visibly from it.
+PRESETS = {
+    "UNDERWATER": ("Underwater towel", "A wet towel in still water: slow bumps that travel down it (the library's underwater preset)", {
+        "stretch_stiffness": 10.0, "shear_stiffness": 2.0, "bend_stiffness": 0.5,
+        "damping_mode": "VELOCITY", "spring_damping": 0.015, "history_drag": 0.0, "viscous_drag": 0.0,
+        "normal_drag": 0.0, "mass_per_area": 1.0, "cloth_density": 1100.0, "water_density": 1000.0,
+        "entrained_mass": 10.0, "added_mass": 0.0, "form_drag": 1.0, "skin_drag": 0.0,
+        "history": "OFF", "integrator": "SYMPLECTIC"}),
+    "SILK": ("Light silk", "A thin, light scarf: billows and drifts, settles slowly", {
+        "stretch_stiffness": 4.0, "shear_stiffness": 0.8, "bend_stiffness": 0.02,
+        "damping_mode": "VELOCITY", "spring_damping": 0.005, "history_drag": 0.0, "viscous_drag": 0.0,
+        "normal_drag": 0.0, "mass_per_area": 0.1, "cloth_density": 1300.0, "water_density": 1000.0,
+        "entrained_mass": 2.0, "added_mass": 0.0, "form_drag": 1.0, "skin_drag": 0.5,
+        "history": "OFF", "integrator": "SYMPLECTIC"}),
+    "CANVAS": ("Heavy canvas", "A heavy sheet: sinks and folds in broad, slow waves", {
+        "stretch_stiffness": 40.0, "shear_stiffness": 8.0, "bend_stiffness": 4.0,
+        "damping_mode": "VELOCITY", "spring_damping": 0.05, "history_drag": 0.0, "viscous_drag": 0.0,
+        "normal_drag": 0.0, "mass_per_area": 2.0, "cloth_density": 1500.0, "water_density": 1000.0,
+        "entrained_mass": 10.0, "added_mass": 0.0, "form_drag": 1.5, "skin_drag": 0.0,
+        "history": "OFF", "integrator": "SYMPLECTIC"}),
+    "PAPER": ("Fractional (paper)", "The paper's fractional cloth: half-derivative springs and drags, no water inertia", {
+        "stretch_stiffness": 10.0, "shear_stiffness": 2.0, "bend_stiffness": 0.5,
+        "damping_mode": "FRACTIONAL", "spring_damping": 0.35, "history_drag": 2e-3, "viscous_drag": 1e-3,
+        "normal_drag": 0.0, "mass_per_area": 1.0, "cloth_density": 1100.0, "water_density": 1000.0,
+        "entrained_mass": 0.0, "added_mass": 0.0, "form_drag": 0.0, "skin_drag": 0.0,
+        "history": "SOE", "integrator": "SYMPLECTIC"}),
+}
+PRESET_ITEMS = [("CUSTOM", "Custom", "Your own values")] + [(k, v[0], v[1]) for k, v in PRESETS.items()]
+
+
+def _apply_preset(self, context):
+    values = PRESETS.get(self.preset)
+    if values is None:
+        return
+    for name, value in values[2].items():
+        setattr(self, name, value)
+
+
 class FracclothSettings(bpy.types.PropertyGroup):
-    pin_group: bpy.props.StringProperty(name="Pin group", description="Vertex group of pinned vertices", default="pins")
-    stretch_stiffness: bpy.props.FloatProperty(name="Stretch", description="Stretch spring constant, N/m", default=10.0, min=0.0)
-    shear_stiffness: bpy.props.FloatProperty(name="Shear", description="Shear spring constant, N/m", default=2.0, min=0.0)
-    bend_stiffness: bpy.props.FloatProperty(name="Bend", description="Bend spring constant, N/m", default=0.5, min=0.0)
-    spring_damping: bpy.props.FloatProperty(name="Spring damping", description="Fractional spring damping, N s^1/2 / m", default=0.35, min=0.0)
-    history_drag: bpy.props.FloatProperty(name="History drag", description="Basset history drag per 1 cm^2, N s^1/2 / m", default=2e-3, min=0.0, precision=5)
-    viscous_drag: bpy.props.FloatProperty(name="Viscous drag", description="Viscous drag per 1 cm^2, N s / m", default=1e-3, min=0.0, precision=5)
-    mass_per_area: bpy.props.FloatProperty(name="Mass per area", description="kg per m^2 of cloth", default=1.0, min=1e-6)
+    preset: bpy.props.EnumProperty(name="Preset", items=PRESET_ITEMS, default="CUSTOM", update=_apply_preset,
+                                   description="Set every value below from a preset (then change what you like)")
+    pin_group: bpy.props.StringProperty(name="Pin group", description="Vertex group of pinned vertices (weight = how firmly)", default="pins")
+    stretch_stiffness: bpy.props.FloatProperty(name="Stretch", description="How hard the cloth resists stretching (spring constant, N/m)", default=10.0, min=0.0, soft_max=200.0)
+    shear_stiffness: bpy.props.FloatProperty(name="Shear", description="How hard it resists shearing (N/m)", default=2.0, min=0.0, soft_max=50.0)
+    bend_stiffness: bpy.props.FloatProperty(name="Bend", description="How hard it resists bending (N/m); low values give fine folds", default=0.5, min=0.0, soft_max=20.0)
+    damping_mode: bpy.props.EnumProperty(name="Spring damping", items=DAMPING_ITEMS, default="FRACTIONAL")
+    spring_damping: bpy.props.FloatProperty(name="Damping", description="How much the springs damp their own motion (N s^1/2/m fractional, N s/m ordinary)", default=0.35, min=0.0, soft_max=1.0, precision=4)
+    history_drag: bpy.props.FloatProperty(name="History drag", description="Water's memory drag per 1 cm^2 of cloth (N s^1/2/m)", default=2e-3, min=0.0, soft_max=0.05, precision=5)
+    viscous_drag: bpy.props.FloatProperty(name="Viscous drag", description="Drag in proportion to speed, per 1 cm^2 of cloth (N s/m)", default=1e-3, min=0.0, soft_max=0.05, precision=5)
+    normal_drag: bpy.props.FloatProperty(name="Normal drag", description="Drag on motion across the cloth, per 1 cm^2 (N s/m)", default=0.0, min=0.0, soft_max=0.05, precision=5)
+    mass_per_area: bpy.props.FloatProperty(name="Weight", description="Mass of the wet cloth per square metre (kg/m^2)", default=1.0, min=1e-6, soft_max=5.0)
+    cloth_density: bpy.props.FloatProperty(name="Cloth density", description="Density of the wet cloth (kg/m^3): above the water's it sinks, below it floats", default=1100.0, min=1.0, soft_min=500.0, soft_max=3000.0)
+    water_density: bpy.props.FloatProperty(name="Water density", description="kg/m^3 (1000 fresh water, 1025 sea water, 0 for air)", default=1000.0, min=0.0, soft_max=1100.0)
+    entrained_mass: bpy.props.FloatProperty(name="Water carried", description="Water the cloth drags along as it moves, kg per m^2 of cloth: makes it slow and heavy in the water", default=0.0, min=0.0, soft_max=40.0)
+    added_mass: bpy.props.FloatProperty(name="Added mass (across)", description="Water moved by motion across the cloth only, kg per m^2", default=0.0, min=0.0, soft_max=40.0)
+    form_drag: bpy.props.FloatProperty(name="Form drag", description="Drag coefficient of the cloth moving face first through water (1 to 2 for a sheet)", default=0.0, min=0.0, soft_max=4.0)
+    skin_drag: bpy.props.FloatProperty(name="Skin drag", description="Drag of water sliding along the cloth, N s/m^3", default=0.0, min=0.0, soft_max=5.0)
     current: bpy.props.FloatVectorProperty(name="Current", description="Water current, m/s (world)", default=(0.0, 0.0, 0.0), size=3)
     history: bpy.props.EnumProperty(name="History", items=HISTORY_ITEMS, default="SOE")
     integrator: bpy.props.EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="SYMPLECTIC")
-    time_step: bpy.props.FloatProperty(name="Time step", description="Longest step, s", default=5e-4, min=1e-6, max=0.1, precision=5)
-    friction: bpy.props.FloatProperty(name="Collider friction", default=0.0, min=0.0)
+    auto_step: bpy.props.BoolProperty(name="Automatic time step", description="Choose a stable step from the mesh spacing, stiffness and integrator (implicit ones step once per frame)", default=True)
+    time_step: bpy.props.FloatProperty(name="Time step", description="Longest step when not automatic, s", default=5e-4, min=1e-6, max=0.1, precision=5)
+    friction: bpy.props.FloatProperty(name="Collider friction", description="How much the colliders grip the cloth (0 = slippery, 1 = grippy)", default=0.0, min=0.0, soft_max=1.0)
+    collision_margin: bpy.props.FloatProperty(name="Collision margin", description="Distance from a collider at which the cloth is pushed away, m", default=0.01, min=0.0, soft_max=0.05)
     cache_format: bpy.props.EnumProperty(name="Format", items=FORMAT_ITEMS, default="PC2")
-    cache_path: bpy.props.StringProperty(name="Cache file", subtype="FILE_PATH", default="//fraccloth_cache")
+    cache_path: bpy.props.StringProperty(name="Cache file", subtype="FILE_PATH", default="",
+                                         description="Where the cache goes; empty: a 'fraccloth' folder next to the .blend, named after the object")
 
 
 def _world_specs(others):
@@ -149,21 +209,16 @@ def pin_weights(obj, name):
     return np.clip(w, 0.0, 1.0)
 
 
-def build_cloth(context, obj, others):
-    """The fraccloth cloth for `obj` with the scene's settings, in world coordinates at the
-    current frame; returns (cloth, step plan, pinned indices, collider ids)."""
+def describe(s):
+    """The library's description (`FcClothDesc`) for the settings `s`; grid size and time step
+    are not in it."""
     import fraccloth
 
-    s = context.scene.fraccloth
-    if any(abs(c - 1.0) > 1e-6 for c in obj.matrix_world.to_scale()):
-        raise ValueError(f"{obj.name}: apply its scale first (Ctrl+A > Scale)")
-    _, faces = mesh_arrays(obj)
-    pos = world_positions(obj)
-    if len(pos) != len(obj.data.vertices):
-        raise ValueError(f"{obj.name}: its modifiers change the vertex count; apply or remove them")
     desc = fraccloth.default_desc()
     desc.total_mass = 0.0
     desc.areal_density = s.mass_per_area
+    desc.cloth_density = s.cloth_density
+    desc.water_density = s.water_density
     for k in range(3):
         desc.gravity[k] = (0.0, 0.0, -9.81)[k]
         desc.current[k] = s.current[k]
@@ -171,12 +226,25 @@ def build_cloth(context, obj, others):
     desc.shear_stiffness = s.shear_stiffness
     desc.bend_stiffness = s.bend_stiffness
     desc.spring_damping = s.spring_damping
+    desc.spring_damping_mode = {
+        "FRACTIONAL": fraccloth.SPRING_DAMPING_FRACTIONAL,
+        "STRAIN": fraccloth.SPRING_DAMPING_FRACTIONAL_STRAIN,
+        "VELOCITY": fraccloth.SPRING_DAMPING_VELOCITY,
+        "NONE": fraccloth.SPRING_DAMPING_NONE,
+    }[s.damping_mode]
     # The panel's drags are per 1 cm^2 of cloth; the library takes them per m^2 and multiplies
     # each vertex's own area, so the look does not change with the mesh's resolution.
     desc.history_drag = 0.0
     desc.viscous_drag = 0.0
+    desc.normal_drag = 0.0
     desc.history_drag_per_area = s.history_drag / 1e-4
     desc.viscous_drag_per_area = s.viscous_drag / 1e-4
+    desc.normal_drag_per_area = s.normal_drag / 1e-4
+    desc.entrained_mass = s.entrained_mass
+    desc.added_mass = s.added_mass
+    desc.form_drag = s.form_drag
+    desc.skin_drag = s.skin_drag
+    desc.collision_margin = s.collision_margin
     desc.history_scheme = {"SOE": fraccloth.HISTORY_SOE, "PAPER": fraccloth.HISTORY_TRUNCATED, "OFF": fraccloth.HISTORY_OFF}[s.history]
     desc.history_u = 3
     desc.integrator = {
@@ -186,6 +254,37 @@ def build_cloth(context, obj, others):
         "SYMPLECTIC2": fraccloth.INTEGRATOR_EXTRAPOLATED_SYMPLECTIC,
         "IMPLICIT2": fraccloth.INTEGRATOR_EXTRAPOLATED_IMPLICIT,
     }[s.integrator]
+    return desc
+
+
+def automatic_step(s, spacing, frame_dt):
+    """A stable step for the settings on a mesh of edge length `spacing` (m). Implicit
+    integrators: one frame. Explicit ones: 0.5 ms at 1 cm spacing with the built-in cloth
+    (stretch 10 N/m, 1 kg/m^2; the stability map's symplectic bound there is about 1.6 ms),
+    scaled as the bound scales, spacing * sqrt(inertia / stiffness), and never above a frame."""
+    if s.integrator in ("IMPLICIT", "IMPLICIT2"):
+        return frame_dt
+    inertia = (s.mass_per_area + s.entrained_mass) / 1.0
+    stiffness = max(s.stretch_stiffness, s.shear_stiffness, s.bend_stiffness, 1e-9) / 10.0
+    dt = 5e-4 * (spacing / 0.01) * math.sqrt(inertia / stiffness)
+    if s.integrator == "EXPLICIT":
+        dt *= 0.5
+    return min(dt, frame_dt)
+
+
+def build_cloth(context, obj, others):
+    """The fraccloth cloth for `obj` with its settings, in world coordinates at the current
+    frame; returns (cloth, step plan, pinned indices, collider ids)."""
+    import fraccloth
+
+    s = obj.fraccloth
+    if any(abs(c - 1.0) > 1e-6 for c in obj.matrix_world.to_scale()):
+        raise ValueError(f"{obj.name}: apply its scale first (Ctrl+A > Scale)")
+    _, faces = mesh_arrays(obj)
+    pos = world_positions(obj)
+    if len(pos) != len(obj.data.vertices):
+        raise ValueError(f"{obj.name}: its modifiers change the vertex count; apply or remove them")
+    desc = describe(s)
     cloth = fraccloth.Cloth.mesh(desc, pos.astype(np.float32), faces)
     w = pin_weights(obj, s.pin_group)
     if w.any():
@@ -200,7 +299,10 @@ def build_cloth(context, obj, others):
         ids.append(cid)
     fps = context.scene.render.fps / context.scene.render.fps_base
     frame_dt = 1.0 / fps
-    substeps = max(1, math.ceil(frame_dt / s.time_step - 1e-9))
+    edges = np.linalg.norm(pos[faces[:, 0]] - pos[faces[:, 1]], axis=1)
+    spacing = float(np.mean(edges)) if len(edges) else 0.01
+    step = automatic_step(s, spacing, frame_dt) if s.auto_step else s.time_step
+    substeps = max(1, math.ceil(frame_dt / step - 1e-9))
     return cloth, (frame_dt, substeps), np.flatnonzero(w > 0.0).astype(np.uint32), ids
 
 
@@ -246,6 +348,16 @@ def _simulate(context, obj, others):
         yield f, cloth, to_local(obj, cloth.positions_f64()).astype(np.float32)
 
 
+def cache_path(obj):
+    """The object's cache file without extension: its own setting, or a `fraccloth` folder next
+    to the .blend (Blender's temporary folder for an unsaved file), named after the object."""
+    s = obj.fraccloth
+    if s.cache_path:
+        return bpy.path.abspath(s.cache_path)
+    base = os.path.dirname(bpy.data.filepath) if bpy.data.filepath else bpy.app.tempdir
+    return os.path.join(base, "fraccloth", bpy.path.clean_name(obj.name))
+
+
 class FRACCLOTH_OT_bake(bpy.types.Operator):
     """Simulate the active mesh underwater and attach the result as a point cache"""
 
@@ -262,10 +374,10 @@ class FRACCLOTH_OT_bake(bpy.types.Operator):
 
         obj = context.active_object
         others = [o for o in context.selected_objects if o is not obj]
-        s = context.scene.fraccloth
+        s = obj.fraccloth
         scene = context.scene
         ext = ".pc2" if s.cache_format == "PC2" else ".mdd"
-        path = bpy.path.abspath(s.cache_path)
+        path = cache_path(obj)
         if not path.endswith(ext):
             path += ext
         os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
@@ -314,14 +426,32 @@ class FRACCLOTH_PT_panel(bpy.types.Panel):
     bl_region_type = "WINDOW"
     bl_context = "physics"
 
+    @classmethod
+    def poll(cls, context):
+        return context.object is not None and context.object.type == "MESH"
+
     def draw(self, context):
-        s = context.scene.fraccloth
-        col = self.layout.column()
-        for name in ("pin_group", "stretch_stiffness", "shear_stiffness", "bend_stiffness", "spring_damping",
-                     "history_drag", "viscous_drag", "mass_per_area", "current", "history", "integrator",
-                     "time_step", "friction", "cache_format", "cache_path"):
-            col.prop(s, name)
-        col.operator(FRACCLOTH_OT_bake.bl_idname)
+        s = context.object.fraccloth
+        layout = self.layout
+        layout.prop(s, "preset")
+        layout.prop(s, "pin_group")
+        for title, names in (
+            ("Cloth", ("mass_per_area", "cloth_density", "stretch_stiffness", "shear_stiffness", "bend_stiffness",
+                       "damping_mode", "spring_damping")),
+            ("Water", ("water_density", "entrained_mass", "added_mass", "form_drag", "skin_drag", "history_drag",
+                       "viscous_drag", "normal_drag", "current")),
+            ("Colliders", ("friction", "collision_margin")),
+            ("Solver", ("history", "integrator", "auto_step", "time_step")),
+            ("Cache", ("cache_format", "cache_path")),
+        ):
+            box = layout.box()
+            box.label(text=title)
+            for name in names:
+                row = box.row()
+                row.prop(s, name)
+                if name == "time_step":
+                    row.enabled = not s.auto_step
+        layout.operator(FRACCLOTH_OT_bake.bl_idname)
 
 
 _classes = (FracclothSettings, FRACCLOTH_OT_bake, FRACCLOTH_PT_panel)
@@ -330,10 +460,10 @@ _classes = (FracclothSettings, FRACCLOTH_OT_bake, FRACCLOTH_PT_panel)
 def register():
     for c in _classes:
         bpy.utils.register_class(c)
-    bpy.types.Scene.fraccloth = bpy.props.PointerProperty(type=FracclothSettings)
+    bpy.types.Object.fraccloth = bpy.props.PointerProperty(type=FracclothSettings)
 
 
 def unregister():
-    del bpy.types.Scene.fraccloth
+    del bpy.types.Object.fraccloth
     for c in reversed(_classes):
         bpy.utils.unregister_class(c)

@@ -23,7 +23,7 @@ def addon():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     mod = addon_utils.enable("fraccloth_blender", default_set=True, handle_error=None)
     assert mod is not None, "the add-on did not enable"
-    assert hasattr(bpy.types.Scene, "fraccloth")
+    assert hasattr(bpy.types.Object, "fraccloth")
     yield mod
     addon_utils.disable("fraccloth_blender")
 
@@ -55,10 +55,11 @@ def make_scene(tmp_path, fmt):
         o.select_set(True)
     cloth.select_set(True)
     bpy.context.view_layer.objects.active = cloth
-    s = scene.fraccloth
+    s = cloth.fraccloth
     s.cache_format = fmt
     s.cache_path = str(tmp_path / "cloth")
     s.integrator = "SYMPLECTIC"
+    s.auto_step = False
     s.time_step = 1e-3
     s.current = (0.05, 0.0, 0.0)
     s.friction = 0.2
@@ -110,7 +111,7 @@ def test_pins_follow_an_animated_object_and_the_cloth_lags(addon, tmp_path):
     # trails behind in the water while the object moves.
     def bake(animated):
         cloth, _ = make_scene(tmp_path, "PC2")
-        bpy.context.scene.fraccloth.cache_path = str(tmp_path / ("moving" if animated else "still"))
+        cloth.fraccloth.cache_path = str(tmp_path / ("moving" if animated else "still"))
         if animated:
             cloth.location = (0.1, -0.2, 0.2)
             cloth.keyframe_insert("location", frame=1)
@@ -165,3 +166,49 @@ def test_bad_input_is_reported_not_crashed(addon, tmp_path):
     with pytest.raises(RuntimeError, match="apply its scale"):
         bpy.ops.fraccloth.bake()
     assert cloth.modifiers.get("fraccloth") is None
+
+
+def test_the_underwater_preset_is_the_librarys(addon, tmp_path):
+    import fraccloth
+
+    cloth, _ = make_scene(tmp_path, "PC2")
+    s = cloth.fraccloth
+    s.preset = "UNDERWATER"
+    got = addon.describe(s)
+    want = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
+    for field in ("stretch_stiffness", "shear_stiffness", "bend_stiffness", "spring_damping", "spring_damping_mode",
+                  "entrained_mass", "added_mass", "form_drag", "skin_drag", "cloth_density", "water_density",
+                  "integrator", "viscous_drag", "history_drag", "normal_drag", "viscous_drag_per_area",
+                  "history_drag_per_area", "normal_drag_per_area"):
+        assert getattr(got, field) == pytest.approx(getattr(want, field), rel=1e-6), field
+    # The other presets differ from it visibly (weight and stiffness), and CUSTOM changes nothing.
+    s.preset = "SILK"
+    assert s.mass_per_area < 0.5 and s.bend_stiffness < 0.1
+    s.preset = "CUSTOM"
+    assert s.mass_per_area < 0.5
+    # The automatic step: a frame for implicit integrators, a few hundred microseconds at 1 cm.
+    s.preset = "UNDERWATER"
+    assert addon.automatic_step(s, 0.01, 1 / 24) == pytest.approx(5e-4 * 11 ** 0.5)
+    s.integrator = "IMPLICIT2"
+    assert addon.automatic_step(s, 0.01, 1 / 24) == pytest.approx(1 / 24)
+
+
+def test_two_cloths_bake_to_their_own_caches(addon, tmp_path):
+    first, _ = make_scene(tmp_path, "PC2")
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=6, y_subdivisions=4, size=0.2, location=(1.0, 0.0, 0.3))
+    second = bpy.context.active_object
+    second.name = "Second towel"
+    for o in bpy.context.selected_objects:
+        o.select_set(False)
+    results = []
+    for obj in (first, second):
+        obj.fraccloth.cache_path = ""  # the default: next to the .blend (here: Blender's temp folder)
+        obj.fraccloth.preset = "UNDERWATER"
+        obj.select_set(True)
+        bpy.context.view_layer.objects.active = obj
+        results.append(bpy.ops.fraccloth.bake())
+        obj.select_set(False)
+    assert results == [{"FINISHED"}, {"FINISHED"}]
+    paths = [Path(o.modifiers["fraccloth"].filepath) for o in (first, second)]
+    assert paths[0] != paths[1] and all(p.exists() for p in paths)
+    assert paths[1].stem == "Second_towel"
