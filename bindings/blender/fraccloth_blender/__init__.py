@@ -358,8 +358,76 @@ def cache_path(obj):
     return os.path.join(base, "fraccloth", bpy.path.clean_name(obj.name))
 
 
+class BakeJob:
+    """One bake, a frame at a time, so that the interface can show progress and cancel between
+    frames. `step()` bakes the next frame and returns True once the cache is complete and
+    attached; `cancel()` stops and removes the partial cache, so no cache that looks complete is
+    left behind. Raises `fraccloth.Error` or `ValueError` from `step()` (call `cancel()` then)."""
+
+    def __init__(self, context, obj, others):
+        import fraccloth
+
+        self.context, self.obj = context, obj
+        s = obj.fraccloth
+        scene = context.scene
+        ext = ".pc2" if s.cache_format == "PC2" else ".mdd"
+        path = cache_path(obj)
+        self.path = path if path.endswith(ext) else path + ext
+        os.makedirs(os.path.dirname(self.path) or ".", exist_ok=True)
+        self.format = fraccloth.CACHE_PC2 if s.cache_format == "PC2" else fraccloth.CACHE_MDD
+        self.frames = scene.frame_end - scene.frame_start + 1
+        self.fps = scene.render.fps / scene.render.fps_base
+        self.done = 0
+        self.cache = None
+        self.return_to = scene.frame_current
+        # Remove an earlier cache modifier first, so the rest shape is the mesh's own.
+        for m in list(obj.modifiers):
+            if m.type == "MESH_CACHE" and m.name == "fraccloth":
+                obj.modifiers.remove(m)
+        self.frames_left = simulate(context, obj, others)
+
+    def step(self):
+        import fraccloth
+
+        scene = self.context.scene
+        f, cloth, local = next(self.frames_left)
+        if self.cache is None:
+            self.cache = fraccloth.Cache(self.path, self.format, cloth, float(scene.frame_start), self.fps, self.frames)
+        self.cache.write_positions(local)
+        self.done += 1
+        if self.done < self.frames:
+            return False
+        self.frames_left.close()
+        self.cache.close()
+        self.cache = None
+        scene.frame_set(self.return_to)
+        s = self.obj.fraccloth
+        mod = self.obj.modifiers.new("fraccloth", "MESH_CACHE")
+        mod.cache_format = s.cache_format
+        mod.filepath = self.path
+        mod.time_mode = "FRAME"
+        mod.play_mode = "SCENE"
+        mod.frame_start = float(scene.frame_start)
+        mod.interpolation = "NONE"
+        return True
+
+    def cancel(self):
+        import fraccloth
+
+        self.frames_left.close()
+        if self.cache is not None:
+            try:
+                self.cache.close()
+            except fraccloth.Error:
+                pass
+            self.cache = None
+        if os.path.exists(self.path):
+            os.remove(self.path)
+        self.context.scene.frame_set(self.return_to)
+
+
 class FRACCLOTH_OT_bake(bpy.types.Operator):
-    """Simulate the active mesh underwater and attach the result as a point cache"""
+    """Simulate the active mesh underwater and attach the result as a point cache (Esc cancels)"""
 
     bl_idname = "fraccloth.bake"
     bl_label = "Bake underwater cloth"
@@ -369,55 +437,77 @@ class FRACCLOTH_OT_bake(bpy.types.Operator):
     def poll(cls, context):
         return context.active_object is not None and context.active_object.type == "MESH"
 
-    def execute(self, context):
-        import fraccloth
-
+    def _start(self, context):
         obj = context.active_object
         others = [o for o in context.selected_objects if o is not obj]
-        s = obj.fraccloth
-        scene = context.scene
-        ext = ".pc2" if s.cache_format == "PC2" else ".mdd"
-        path = cache_path(obj)
-        if not path.endswith(ext):
-            path += ext
-        os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
-        fmt = fraccloth.CACHE_PC2 if s.cache_format == "PC2" else fraccloth.CACHE_MDD
-        frames = scene.frame_end - scene.frame_start + 1
-        fps = scene.render.fps / scene.render.fps_base
-        # Remove an earlier cache modifier first, so the rest shape is the mesh's own.
-        for m in list(obj.modifiers):
-            if m.type == "MESH_CACHE" and m.name == "fraccloth":
-                obj.modifiers.remove(m)
-        current = scene.frame_current
+        return BakeJob(context, obj, others)
+
+    def _fail(self, job, error):
+        if job is not None:
+            job.cancel()
+        self.report({"ERROR"}, f"fraccloth: {error}")
+        return {"CANCELLED"}
+
+    def execute(self, context):
+        """Bakes every frame at once (scripts, background Blender)."""
+        import fraccloth
+
+        job = None
         try:
-            cache = None
-            for f, cloth, local in simulate(context, obj, others):
-                if cache is None:
-                    cache = fraccloth.Cache(path, fmt, cloth, float(scene.frame_start), fps, frames)
-                cache.write_positions(local)
-            cache.close()
+            job = self._start(context)
+            while not job.step():
+                pass
         except (fraccloth.Error, ValueError) as e:
-            # No cache that looks complete is left behind.
-            if cache is not None:
-                try:
-                    cache.close()
-                except fraccloth.Error:
-                    pass
-            if os.path.exists(path):
-                os.remove(path)
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
-        finally:
-            scene.frame_set(current)
-        mod = obj.modifiers.new("fraccloth", "MESH_CACHE")
-        mod.cache_format = s.cache_format
-        mod.filepath = path
-        mod.time_mode = "FRAME"
-        mod.play_mode = "SCENE"
-        mod.frame_start = float(scene.frame_start)
-        mod.interpolation = "NONE"
-        self.report({"INFO"}, f"fraccloth: baked {frames} frames to {path}")
+            return self._fail(job, e)
+        self.report({"INFO"}, f"fraccloth: baked {job.frames} frames to {job.path}")
         return {"FINISHED"}
+
+    def invoke(self, context, event):
+        """From the interface: a frame per timer tick, progress on the cursor and in the status
+        bar, Esc cancels."""
+        import fraccloth
+
+        if context.window is None or bpy.app.background:
+            return self.execute(context)
+        try:
+            self._job = self._start(context)
+        except (fraccloth.Error, ValueError) as e:
+            return self._fail(None, e)
+        wm = context.window_manager
+        wm.progress_begin(0, self._job.frames)
+        self._timer = wm.event_timer_add(0.001, window=context.window)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def _end(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+
+    def modal(self, context, event):
+        import fraccloth
+
+        job = self._job
+        if event.type == "ESC":
+            self._end(context)
+            job.cancel()
+            self.report({"WARNING"}, "fraccloth: bake cancelled; no cache written")
+            return {"CANCELLED"}
+        if event.type != "TIMER":
+            return {"RUNNING_MODAL"}
+        try:
+            finished = job.step()
+        except (fraccloth.Error, ValueError) as e:
+            self._end(context)
+            return self._fail(job, e)
+        context.window_manager.progress_update(job.done)
+        context.workspace.status_text_set(f"fraccloth: baking frame {job.done} of {job.frames} (Esc cancels)")
+        if finished:
+            self._end(context)
+            self.report({"INFO"}, f"fraccloth: baked {job.frames} frames to {job.path}")
+            return {"FINISHED"}
+        return {"RUNNING_MODAL"}
 
 
 class FRACCLOTH_PT_panel(bpy.types.Panel):

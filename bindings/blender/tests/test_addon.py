@@ -212,3 +212,37 @@ def test_two_cloths_bake_to_their_own_caches(addon, tmp_path):
     paths = [Path(o.modifiers["fraccloth"].filepath) for o in (first, second)]
     assert paths[0] != paths[1] and all(p.exists() for p in paths)
     assert paths[1].stem == "Second_towel"
+
+
+def test_a_cancelled_bake_leaves_no_cache(addon, tmp_path):
+    # The job the interface's modal bake runs a frame per timer tick, cancelled half-way (what Esc
+    # does): no cache file, no modifier, the scene back at its frame.
+    cloth, others = make_scene(tmp_path, "PC2")
+    scene = bpy.context.scene
+    scene.frame_set(5)
+    job = addon.BakeJob(bpy.context, cloth, others)
+    for _ in range(10):
+        assert job.step() is False
+    assert Path(job.path).exists()  # partly written
+    job.cancel()
+    assert not Path(job.path).exists()
+    assert cloth.modifiers.get("fraccloth") is None
+    assert scene.frame_current == 5
+    # Run to the end, the same job attaches a complete cache.
+    job = addon.BakeJob(bpy.context, cloth, others)
+    while not job.step():
+        pass
+    assert job.done == 24 and Path(job.path).exists()
+    assert cloth.modifiers.get("fraccloth") is not None and scene.frame_current == 5
+
+
+def test_a_failed_bake_reports_and_leaves_no_cache(addon, tmp_path):
+    cloth, _ = make_scene(tmp_path, "PC2")
+    s = cloth.fraccloth
+    s.auto_step = False
+    s.integrator = "EXPLICIT"
+    s.time_step = 0.05  # far above explicit Euler's bound: a step is refused
+    with pytest.raises(RuntimeError, match="unstable"):
+        bpy.ops.fraccloth.bake()
+    assert not Path(str(tmp_path / "cloth") + ".pc2").exists()
+    assert cloth.modifiers.get("fraccloth") is None
