@@ -52,6 +52,8 @@ int main(int argc, char** argv) {
         } catch (const fraccloth::Error& e) {
             std::printf("error %d %s\n", static_cast<int>(e.status()), e.what());
         }
+        // The index buffer and normals a renderer draws with.
+        std::printf("mesh %zu %zu\n", cloth.triangles().size(), cloth.normals().size());
         // The state in double precision round-trips exactly.
         std::vector<double> x64 = cloth.positions_f64();
         std::vector<double> v64 = cloth.velocities_f64();

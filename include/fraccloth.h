@@ -767,6 +767,28 @@ FcClothDesc fc_cloth_desc_default(void);
 FcStatus fc_cloth_desc_preset(uint32_t preset, FcClothDesc *out_desc);
 
 /**
+ * Copies the triangles (three vertex indices each, counter-clockwise seen from the side the
+ * normals point to; quads of a mesh split on one diagonal, grids as the OBJ and caches write
+ * them) into `indices`; `index_count` must be 3 * `fc_cloth_triangle_count`. The buffer does
+ * not change while the cloth lives: read it once.
+ *
+ * # Safety
+ * `cloth` NULL or live; `indices` NULL or `index_count` writable `uint32_t`.
+ */
+FcStatus fc_cloth_get_triangles(const FcCloth *cloth, uint32_t *indices, size_t index_count);
+
+/**
+ * Writes the unit normal of every vertex at the current positions into `xyz` (float triples;
+ * `float_count` = 3 * vertex_count): the area-weighted sum of its triangles' normals, pointing to
+ * the side from which they wind counter-clockwise (+z for a fresh grid); (0, 0, 0) for a vertex
+ * whose triangles have collapsed. For smooth shading of the cloth as it is now.
+ *
+ * # Safety
+ * `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
+ */
+FcStatus fc_cloth_get_normals(const FcCloth *cloth, float *xyz, size_t float_count);
+
+/**
  * Creates a cloth from a mesh at rest: `vertex_count` positions (xyz floats, m) and
  * `index_count` corner indices, `face_size` (3: triangles, 4: quads with corners in order
  * around the face) per face. Writes the handle to `*out_cloth` only on success.

@@ -212,6 +212,28 @@ impl Cloth {
     pub fn positions(&self) -> &[Vec3] {
         &self.x
     }
+    /// Writes the unit vertex normal of every vertex at the current positions into `out` (one
+    /// per vertex): the area-weighted sum of its triangles' normals, on the side the triangles
+    /// wind counter-clockwise; zero for a vertex whose triangles have no area. Fails with
+    /// out-of-memory (nothing written) when the per-triangle buffer cannot be allocated.
+    pub fn vertex_normals(&self, out: &mut [Vec3]) -> Result<(), Error> {
+        if out.len() != self.vertex_count() {
+            return Err(Error::invalid(format!(
+                "expected {} normals, got room for {}",
+                self.vertex_count(),
+                out.len()
+            )));
+        }
+        let t = &self.topology;
+        let mut faces = Vec::new();
+        faces
+            .try_reserve_exact(t.triangles.len())
+            .map_err(|_| Error::out_of_memory(format!("no memory for {} face normals", t.triangles.len())))?;
+        faces.resize(t.triangles.len(), Vec3::zeros());
+        forces::vertex_normals_with(&self.x, &t.triangles, &t.vertex_triangles, false, &mut faces, out);
+        Ok(())
+    }
+
     /// Velocities, m/s.
     pub fn velocities(&self) -> &[Vec3] {
         &self.v

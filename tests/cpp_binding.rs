@@ -79,6 +79,8 @@ fn cpp_wrapper_runs_the_swing_like_the_c_abi() {
     let err = line(&out, "error ");
     assert_eq!(err[0], "2");
     assert!(out.contains("dt must be finite"), "{out}");
+    // Index buffer (2 * 60 * 40 triangles) and one normal per vertex.
+    assert_eq!(line(&out, "mesh "), vec!["14400", "7503"]);
     // The double-precision state round-trips exactly.
     assert_eq!(line(&out, "exact "), vec!["1"]);
     // A moved-from handle is empty.

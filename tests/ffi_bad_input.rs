@@ -224,6 +224,20 @@ fn bad_descriptions_are_rejected_without_output() {
         assert!(!message().is_empty());
         assert_eq!(out, sentinel, "{what}: output written on error");
     }
+    // No mass at all: the message says which two fields to set.
+    let mut d = base;
+    d.total_mass = 0.0;
+    d.areal_density = 0.0;
+    let mut out = null_mut();
+    assert_eq!(
+        unsafe { fc_cloth_create_grid(&d, &mut out) },
+        FC_ERROR_INVALID_ARGUMENT
+    );
+    assert!(
+        message().contains("no mass") && message().contains("areal_density"),
+        "{}",
+        message()
+    );
     let mut out = null_mut();
     assert_eq!(
         unsafe { fc_cloth_create_grid(null(), &mut out) },

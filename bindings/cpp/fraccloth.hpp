@@ -159,6 +159,18 @@ public:
     }
     void set_positions(span<const float> xyz) { check(fc_cloth_set_positions(handle_, xyz.data(), xyz.size())); }
     void set_velocities(span<const float> xyz) { check(fc_cloth_set_velocities(handle_, xyz.data(), xyz.size())); }
+    /// The index buffer: three vertex indices per triangle, fixed for the cloth's life.
+    std::vector<uint32_t> triangles() const {
+        std::vector<uint32_t> idx(3 * fc_cloth_triangle_count(handle_));
+        check(fc_cloth_get_triangles(handle_, idx.data(), idx.size()));
+        return idx;
+    }
+    /// Unit vertex normals at the current positions, three floats per vertex.
+    std::vector<float> normals() const {
+        std::vector<float> xyz(3 * vertex_count());
+        check(fc_cloth_get_normals(handle_, xyz.data(), xyz.size()));
+        return xyz;
+    }
     /// The state in double precision, exactly (undo stacks, replicas, references).
     std::vector<double> positions_f64() const {
         std::vector<double> xyz(3 * vertex_count());

@@ -87,7 +87,17 @@ pub unsafe extern "C" fn fc_cloth_create_grid(
     out_cloth: *mut *mut FcCloth,
 ) -> FcStatus {
     // SAFETY: forwarded caller promises.
-    unsafe { create(desc, out_cloth, |d| Ok(d.grid_spec().build()?)) }
+    unsafe {
+        create(desc, out_cloth, |d| {
+            if !(d.total_mass > 0.0) && !(d.areal_density.is_finite() && d.areal_density > 0.0) {
+                return Err(FfiError::invalid(format!(
+                    "the cloth has no mass: total_mass is {} (so areal_density is used) and areal_density is {}; set total_mass (kg) > 0, or areal_density (kg/m^2) > 0",
+                    d.total_mass, d.areal_density
+                )));
+            }
+            Ok(d.grid_spec().build()?)
+        })
+    }
 }
 
 /// The shared path of the constructors: checks `out`, reads the description, builds the

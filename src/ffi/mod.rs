@@ -3,7 +3,7 @@
 //! One file per header area: [`status`] (status codes, last error, the panic
 //! boundary), [`desc`] (the description struct and its defaults), [`cloth`]
 //! (lifetime, pins, positions, stepping), [`mesh`] (cloths from meshes), [`collider`]
-//! (colliders), [`cache`] (PC2 / MDD / OBJ writers), [`state`] (positions and velocities in
+//! (colliders), [`cache`] (PC2 / MDD / OBJ writers), [`geometry`] (index buffer, normals), [`state`] (positions and velocities in
 //! double precision, velocities in float), [`version`].
 //!
 //! Rules every export follows:
@@ -21,6 +21,7 @@ pub mod cache;
 pub mod cloth;
 pub mod collider;
 pub mod desc;
+pub mod geometry;
 pub mod mesh;
 pub mod snapshot;
 pub mod state;
@@ -30,6 +31,7 @@ pub use cache::*;
 pub use cloth::*;
 pub use collider::*;
 pub use desc::*;
+pub use geometry::*;
 pub use mesh::*;
 pub use snapshot::*;
 pub use state::*;

@@ -33,7 +33,7 @@ pub use assemble::add_spring_values;
 pub use body::{body_acceleration, body_force};
 pub use contact::{apply_friction, friction_active, Capsule, Collider, Plane, Sphere};
 pub use jacobian::{linearise, Linearisation, SpringBlock};
-pub use normals::vertex_normals;
+pub use normals::{vertex_normals, vertex_normals_with};
 pub use pass::{
     for_each_tile, total_forces, total_forces_with, ForceInput, ForceScratch, SpringInputs, TileTotals,
 };

@@ -165,6 +165,8 @@ _SIGNATURES = {
     "fc_cloth_get_positions": (_c.c_int, [_P, _F3, _c.c_size_t]),
     "fc_cloth_get_velocities": (_c.c_int, [_P, _F3, _c.c_size_t]),
     "fc_cloth_set_velocities": (_c.c_int, [_P, _F3, _c.c_size_t]),
+    "fc_cloth_get_triangles": (_c.c_int, [_P, _U32P, _c.c_size_t]),
+    "fc_cloth_get_normals": (_c.c_int, [_P, _F3, _c.c_size_t]),
     "fc_cloth_get_positions_f64": (_c.c_int, [_P, _D3, _c.c_size_t]),
     "fc_cloth_set_positions_f64": (_c.c_int, [_P, _D3, _c.c_size_t]),
     "fc_cloth_get_velocities_f64": (_c.c_int, [_P, _D3, _c.c_size_t]),
@@ -353,6 +355,21 @@ class Cloth:
         """Sets every velocity (m/s) exactly, in double precision; the history is kept."""
         a = _doubles(xyz)
         _check(library.fc_cloth_set_velocities_f64(self._h, _dp(a), a.size))
+
+    def triangles(self) -> np.ndarray:
+        """The index buffer: (t, 3) uint32 vertex indices, counter-clockwise seen from the side
+        the normals point to. Fixed for the cloth's life."""
+        t = library.fc_cloth_triangle_count(self._h)
+        out = np.empty((t, 3), dtype=np.uint32)
+        _check(library.fc_cloth_get_triangles(self._h, _up(out), out.size))
+        return out
+
+    @property
+    def normals(self) -> np.ndarray:
+        """Unit vertex normals at the current positions, float32, shape (n, 3)."""
+        out = np.empty((self.vertex_count, 3), dtype=np.float32)
+        _check(library.fc_cloth_get_normals(self._h, _fp(out), out.size))
+        return out
 
     def positions_f64(self) -> np.ndarray:
         """Positions (m), exactly: float64, shape (n, 3)."""

@@ -113,6 +113,10 @@ def test_second_order_integrators_strain_springs_and_exact_state():
         assert np.isfinite(cloth.positions_f64()).all()
         with pytest.raises(fraccloth.Error):
             cloth.velocities = np.full((77, 3), np.nan)
+        tris = cloth.triangles()
+        assert tris.shape == (2 * 10 * 6, 3) and tris.max() == 76
+        n = cloth.normals
+        assert n.shape == (77, 3) and np.allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-6)
 
 
 def test_errors_raise_and_leave_the_cloth_alone():

@@ -1,0 +1,77 @@
+//! What a renderer needs every frame besides positions: the index buffer and vertex normals.
+
+use super::cloth::{check_float_count, handle, FcCloth};
+use super::status::{guard, FcStatus, FfiError};
+use crate::Vec3;
+
+/// Copies the triangles (three vertex indices each, counter-clockwise seen from the side the
+/// normals point to; quads of a mesh split on one diagonal, grids as the OBJ and caches write
+/// them) into `indices`; `index_count` must be 3 * `fc_cloth_triangle_count`. The buffer does
+/// not change while the cloth lives: read it once.
+///
+/// # Safety
+/// `cloth` NULL or live; `indices` NULL or `index_count` writable `uint32_t`.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_triangles(
+    cloth: *const FcCloth,
+    indices: *mut u32,
+    index_count: usize,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle(cloth) }?;
+        let triangles = &cloth.topology().triangles;
+        if index_count != 3 * triangles.len() {
+            return Err(FfiError::invalid(format!(
+                "index_count must be 3 * triangle_count = {}, got {index_count}",
+                3 * triangles.len()
+            )));
+        }
+        if indices.is_null() {
+            return Err(FfiError::null("indices"));
+        }
+        // SAFETY: non-NULL and the caller promises `index_count` writable values.
+        let out = unsafe { std::slice::from_raw_parts_mut(indices, index_count) };
+        for (o, t) in out.chunks_exact_mut(3).zip(triangles) {
+            o.copy_from_slice(t);
+        }
+        Ok(())
+    })
+}
+
+/// Writes the unit normal of every vertex at the current positions into `xyz` (float triples;
+/// `float_count` = 3 * vertex_count): the area-weighted sum of its triangles' normals, pointing to
+/// the side from which they wind counter-clockwise (+z for a fresh grid); (0, 0, 0) for a vertex
+/// whose triangles have collapsed. For smooth shading of the cloth as it is now.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_normals(
+    cloth: *const FcCloth,
+    xyz: *mut f32,
+    float_count: usize,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle(cloth) }?;
+        check_float_count(cloth, float_count)?;
+        if xyz.is_null() {
+            return Err(FfiError::null("xyz"));
+        }
+        let mut normals = Vec::new();
+        normals
+            .try_reserve_exact(cloth.vertex_count())
+            .map_err(|_| FfiError::from(crate::Error::out_of_memory("no memory for the normals")))?;
+        normals.resize(cloth.vertex_count(), Vec3::zeros());
+        cloth.vertex_normals(&mut normals)?;
+        // SAFETY: non-NULL and the caller promises `float_count` writable floats.
+        let out = unsafe { std::slice::from_raw_parts_mut(xyz, float_count) };
+        for (o, n) in out.chunks_exact_mut(3).zip(&normals) {
+            o[0] = n.x as f32;
+            o[1] = n.y as f32;
+            o[2] = n.z as f32;
+        }
+        Ok(())
+    })
+}
