@@ -89,7 +89,9 @@ pub unsafe extern "C" fn fc_cloth_create_grid(
     // SAFETY: forwarded caller promises.
     unsafe {
         create(desc, out_cloth, |d| {
-            if !(d.total_mass > 0.0) && !(d.areal_density.is_finite() && d.areal_density > 0.0) {
+            let by_total = d.total_mass > 0.0;
+            let by_area = d.areal_density.is_finite() && d.areal_density > 0.0;
+            if !by_total && !by_area {
                 return Err(FfiError::invalid(format!(
                     "the cloth has no mass: total_mass is {} (so areal_density is used) and areal_density is {}; set total_mass (kg) > 0, or areal_density (kg/m^2) > 0",
                     d.total_mass, d.areal_density
