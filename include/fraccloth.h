@@ -750,6 +750,35 @@ FcStatus fc_cloth_remove_collider(FcCloth *cloth, uint32_t id);
 FcStatus fc_cloth_get_sphere(const FcCloth *cloth, uint32_t id, float *center, float *radius);
 
 /**
+ * Reads plane `id`: a point on it (3 floats, m), its unit normal (3 floats) and its velocity
+ * (3 floats, m/s). Any output may be NULL. `FC_ERROR_OUT_OF_RANGE` if `id` is not a plane.
+ *
+ * # Safety
+ * `cloth` NULL or live; each output NULL or 3 writable floats.
+ */
+FcStatus fc_cloth_get_plane(const FcCloth *cloth,
+                            uint32_t id,
+                            float *point,
+                            float *normal,
+                            float *velocity);
+
+/**
+ * Reads capsule `id`: its segment's ends `a` and `b` (3 floats each, m), radius (m) and
+ * velocity (3 floats, m/s). Any output may be NULL. `FC_ERROR_OUT_OF_RANGE` if `id` is not a
+ * capsule.
+ *
+ * # Safety
+ * `cloth` NULL or live; `a`, `b`, `velocity` NULL or 3 writable floats; `radius` NULL or
+ * writable.
+ */
+FcStatus fc_cloth_get_capsule(const FcCloth *cloth,
+                              uint32_t id,
+                              float *a,
+                              float *b,
+                              float *radius,
+                              float *velocity);
+
+/**
  * The default description: a 61 x 41 grid of 1 cm spacing (0.6 m x 0.4 m, 0.24 kg)
  * with the paper's fractional forces (Eq. 2-5), the accurate SOE history (tolerance
  * 1e-3) and explicit Euler. `fc_cloth_desc_preset(FC_PRESET_FRACTIONAL_PAPER, ...)`

@@ -175,6 +175,39 @@ fn colliders_by_id() {
             fc_cloth_set_capsule(c, capsule, a.as_ptr(), b.as_ptr(), 0.0, null()),
             FC_ERROR_INVALID_ARGUMENT
         );
+        // Read back: the plane as set (normal unit, velocity v), the capsule as added.
+        let (mut gp, mut gn, mut gv) = ([9f32; 3], [9f32; 3], [9f32; 3]);
+        assert_eq!(
+            fc_cloth_get_plane(c, plane, gp.as_mut_ptr(), gn.as_mut_ptr(), gv.as_mut_ptr()),
+            FC_OK
+        );
+        assert_eq!((gp, gn, gv), (p, n, v));
+        let (mut ga, mut gb, mut gr, mut gcv) = ([9f32; 3], [9f32; 3], 9f32, [9f32; 3]);
+        assert_eq!(
+            fc_cloth_get_capsule(
+                c,
+                capsule,
+                ga.as_mut_ptr(),
+                gb.as_mut_ptr(),
+                &mut gr,
+                gcv.as_mut_ptr()
+            ),
+            FC_OK
+        );
+        assert_eq!((ga, gb, gr, gcv), (a, b, 0.01, [0.0; 3]));
+        // NULL outputs are skipped; the wrong kind or id is out of range.
+        assert_eq!(
+            fc_cloth_get_plane(c, plane, null_mut(), null_mut(), null_mut()),
+            FC_OK
+        );
+        assert_eq!(
+            fc_cloth_get_capsule(c, plane, null_mut(), null_mut(), null_mut(), null_mut()),
+            FC_ERROR_OUT_OF_RANGE
+        );
+        assert_eq!(
+            fc_cloth_get_plane(c, 42, null_mut(), null_mut(), null_mut()),
+            FC_ERROR_OUT_OF_RANGE
+        );
         assert_eq!(fc_cloth_remove_collider(c, plane), FC_OK);
         assert_eq!(
             fc_cloth_set_plane(c, plane, p.as_ptr(), n.as_ptr(), null()),

@@ -266,4 +266,86 @@ pub unsafe extern "C" fn fc_cloth_get_sphere(
     })
 }
 
+/// Writes `v` as 3 floats to `out` when it is not NULL.
+///
+/// # Safety
+/// `out` NULL or 3 writable floats.
+unsafe fn put3(out: *mut f32, v: &crate::Vec3) {
+    if !out.is_null() {
+        // SAFETY: non-NULL; the caller promises 3 writable floats.
+        let o = unsafe { std::slice::from_raw_parts_mut(out, 3) };
+        o.copy_from_slice(&[v.x as f32, v.y as f32, v.z as f32]);
+    }
+}
+
+/// Reads plane `id`: a point on it (3 floats, m), its unit normal (3 floats) and its velocity
+/// (3 floats, m/s). Any output may be NULL. `FC_ERROR_OUT_OF_RANGE` if `id` is not a plane.
+///
+/// # Safety
+/// `cloth` NULL or live; each output NULL or 3 writable floats.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_plane(
+    cloth: *const FcCloth,
+    id: u32,
+    point: *mut f32,
+    normal: *mut f32,
+    velocity: *mut f32,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle(cloth) }?;
+        let Some(Collider::Plane(p)) = cloth.collider(id) else {
+            return Err(FfiError {
+                status: FcStatus::FC_ERROR_OUT_OF_RANGE,
+                message: format!("no plane with id {id}"),
+            });
+        };
+        // SAFETY: forwarded caller promises.
+        unsafe {
+            put3(point, &p.point);
+            put3(normal, &p.normal);
+            put3(velocity, &p.velocity);
+        }
+        Ok(())
+    })
+}
+
+/// Reads capsule `id`: its segment's ends `a` and `b` (3 floats each, m), radius (m) and
+/// velocity (3 floats, m/s). Any output may be NULL. `FC_ERROR_OUT_OF_RANGE` if `id` is not a
+/// capsule.
+///
+/// # Safety
+/// `cloth` NULL or live; `a`, `b`, `velocity` NULL or 3 writable floats; `radius` NULL or
+/// writable.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_capsule(
+    cloth: *const FcCloth,
+    id: u32,
+    a: *mut f32,
+    b: *mut f32,
+    radius: *mut f32,
+    velocity: *mut f32,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle(cloth) }?;
+        let Some(Collider::Capsule(c)) = cloth.collider(id) else {
+            return Err(FfiError {
+                status: FcStatus::FC_ERROR_OUT_OF_RANGE,
+                message: format!("no capsule with id {id}"),
+            });
+        };
+        // SAFETY: forwarded caller promises.
+        unsafe {
+            put3(a, &c.a);
+            put3(b, &c.b);
+            put3(velocity, &c.velocity);
+            if !radius.is_null() {
+                *radius = c.radius as f32;
+            }
+        }
+        Ok(())
+    })
+}
+
 use super::cloth::FcCloth;
