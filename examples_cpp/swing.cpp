@@ -52,6 +52,10 @@ int main(int argc, char** argv) {
         } catch (const fraccloth::Error& e) {
             std::printf("error %d %s\n", static_cast<int>(e.status()), e.what());
         }
+        // Colliders read back.
+        const uint32_t rod = cloth.add_capsule({0.0f, -0.5f, 0.2f}, {0.1f, -0.5f, 0.2f}, 0.02f);
+        std::printf("capsule %.3g %.3g\n", static_cast<double>(cloth.capsule(rod).radius), static_cast<double>(cloth.capsule(rod).b[0]));
+        cloth.remove_collider(rod);
         // The index buffer and normals a renderer draws with.
         std::printf("mesh %zu %zu\n", cloth.triangles().size(), cloth.normals().size());
         // The state in double precision round-trips exactly.

@@ -214,6 +214,25 @@ public:
         check(fc_cloth_set_collider_friction(handle_, id, friction));
     }
     void remove_collider(uint32_t id) { check(fc_cloth_remove_collider(handle_, id)); }
+    /// Colliders read back (m, m/s); throw with FC_ERROR_OUT_OF_RANGE for an id of another kind.
+    struct Sphere { Vec3f center; float radius; };
+    struct Plane { Vec3f point, normal, velocity; };
+    struct Capsule { Vec3f a, b; float radius; Vec3f velocity; };
+    Sphere sphere(uint32_t id) const {
+        Sphere s{};
+        check(fc_cloth_get_sphere(handle_, id, s.center.data(), &s.radius));
+        return s;
+    }
+    Plane plane(uint32_t id) const {
+        Plane p{};
+        check(fc_cloth_get_plane(handle_, id, p.point.data(), p.normal.data(), p.velocity.data()));
+        return p;
+    }
+    Capsule capsule(uint32_t id) const {
+        Capsule c{};
+        check(fc_cloth_get_capsule(handle_, id, c.a.data(), c.b.data(), &c.radius, c.velocity.data()));
+        return c;
+    }
 
     void write_obj(const std::string& path) const { check(fc_cloth_write_obj(handle_, path.c_str())); }
 

@@ -184,6 +184,9 @@ _SIGNATURES = {
     "fc_cloth_set_capsule": (_c.c_int, [_P, _c.c_uint32, _F3, _F3, _c.c_float, _F3]),
     "fc_cloth_set_collider_friction": (_c.c_int, [_P, _c.c_uint32, _c.c_float]),
     "fc_cloth_remove_collider": (_c.c_int, [_P, _c.c_uint32]),
+    "fc_cloth_get_sphere": (_c.c_int, [_P, _c.c_uint32, _F3, _c.POINTER(_c.c_float)]),
+    "fc_cloth_get_plane": (_c.c_int, [_P, _c.c_uint32, _F3, _F3, _F3]),
+    "fc_cloth_get_capsule": (_c.c_int, [_P, _c.c_uint32, _F3, _F3, _c.POINTER(_c.c_float), _F3]),
     "fc_cloth_write_obj": (_c.c_int, [_P, _c.c_char_p]),
     "fc_cache_open": (
         _c.c_int,
@@ -438,6 +441,25 @@ class Cloth:
 
     def set_capsule(self, id: int, a, b, radius: float, velocity=None) -> None:
         _check(library.fc_cloth_set_capsule(self._h, id, _fp(_vec3(a)), _fp(_vec3(b)), radius, _vel(velocity)))
+
+    def sphere(self, id: int):
+        """Sphere `id` as (centre (3,), radius), m."""
+        c, r = np.empty(3, dtype=np.float32), ctypes.c_float()
+        _check(library.fc_cloth_get_sphere(self._h, id, _fp(c), ctypes.byref(r)))
+        return c, r.value
+
+    def plane(self, id: int):
+        """Plane `id` as (point, unit normal, velocity), each (3,): m, -, m/s."""
+        p, n, v = (np.empty(3, dtype=np.float32) for _ in range(3))
+        _check(library.fc_cloth_get_plane(self._h, id, _fp(p), _fp(n), _fp(v)))
+        return p, n, v
+
+    def capsule(self, id: int):
+        """Capsule `id` as (a, b, radius, velocity): segment ends (3,) m, radius m, velocity m/s."""
+        a, b, v = (np.empty(3, dtype=np.float32) for _ in range(3))
+        r = ctypes.c_float()
+        _check(library.fc_cloth_get_capsule(self._h, id, _fp(a), _fp(b), ctypes.byref(r), _fp(v)))
+        return a, b, r.value, v
 
     def set_collider_friction(self, id: int, friction: float) -> None:
         _check(library.fc_cloth_set_collider_friction(self._h, id, friction))

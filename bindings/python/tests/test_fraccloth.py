@@ -113,6 +113,17 @@ def test_second_order_integrators_strain_springs_and_exact_state():
         assert np.isfinite(cloth.positions_f64()).all()
         with pytest.raises(fraccloth.Error):
             cloth.velocities = np.full((77, 3), np.nan)
+        ball = cloth.add_sphere([0.0, -0.1, 0.2], 0.05)
+        centre, radius = cloth.sphere(ball)
+        assert np.allclose(centre, [0.0, -0.1, 0.2]) and radius == pytest.approx(0.05)
+        wall = cloth.add_plane([0.0, -1.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.1, 0.0])
+        point, normal, velocity = cloth.plane(wall)
+        assert np.allclose(normal, [0.0, 1.0, 0.0]) and np.allclose(velocity, [0.0, 0.1, 0.0])
+        rod = cloth.add_capsule([0.0, 0.0, 0.1], [0.1, 0.0, 0.1], 0.01)
+        a, b, r, v = cloth.capsule(rod)
+        assert np.allclose(b, [0.1, 0.0, 0.1]) and r == pytest.approx(0.01)
+        with pytest.raises(fraccloth.Error):
+            cloth.capsule(wall)
         tris = cloth.triangles()
         assert tris.shape == (2 * 10 * 6, 3) and tris.max() == 76
         n = cloth.normals
