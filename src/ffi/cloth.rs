@@ -275,36 +275,44 @@ pub unsafe extern "C" fn fc_cloth_set_positions(
     })
 }
 
-fn write_triples(values: &[Vec3], out: &mut [f32]) {
+/// Writes `values` as triples into `out`, each component converted by `convert`.
+pub(crate) fn write_triples<T>(values: &[Vec3], out: &mut [T], convert: fn(f64) -> T) {
     for (o, v) in out.chunks_exact_mut(3).zip(values) {
-        o[0] = v.x as f32;
-        o[1] = v.y as f32;
-        o[2] = v.z as f32;
+        o[0] = convert(v.x);
+        o[1] = convert(v.y);
+        o[2] = convert(v.z);
     }
 }
 
-/// Copies `values(cloth)` into the caller's float buffer after the usual checks.
+/// Copies `values(cloth)` into the caller's buffer of `count` values (float or double) after
+/// the usual checks.
 ///
 /// # Safety
-/// `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
-unsafe fn copy_out(
+/// `cloth` NULL or live; `xyz` NULL or `count` writable values.
+pub(crate) unsafe fn copy_out<T>(
     cloth: *const FcCloth,
-    xyz: *mut f32,
-    float_count: usize,
+    xyz: *mut T,
+    count: usize,
     values: fn(&Cloth) -> &[Vec3],
+    convert: fn(f64) -> T,
 ) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { handle(cloth) }?;
-        check_float_count(cloth, float_count)?;
+        check_float_count(cloth, count)?;
         if xyz.is_null() {
             return Err(FfiError::null("xyz"));
         }
-        // SAFETY: non-NULL and the caller promises `float_count` writable floats.
-        let out = unsafe { std::slice::from_raw_parts_mut(xyz, float_count) };
-        write_triples(values(cloth), out);
+        // SAFETY: non-NULL and the caller promises `count` writable values.
+        let out = unsafe { std::slice::from_raw_parts_mut(xyz, count) };
+        write_triples(values(cloth), out, convert);
         Ok(())
     })
+}
+
+/// f64 to the ABI's float.
+pub(crate) fn to_f32(x: f64) -> f32 {
+    x as f32
 }
 
 /// Copies every vertex position (m) into `xyz` as float triples; `float_count` must be 3 * vertex_count.
@@ -318,7 +326,7 @@ pub unsafe extern "C" fn fc_cloth_get_positions(
     float_count: usize,
 ) -> FcStatus {
     // SAFETY: forwarded caller promises.
-    unsafe { copy_out(cloth, xyz, float_count, Cloth::positions) }
+    unsafe { copy_out(cloth, xyz, float_count, Cloth::positions, to_f32) }
 }
 
 /// Copies every vertex velocity (m/s) into `xyz` as float triples; `float_count` must be 3 * vertex_count.
@@ -332,7 +340,7 @@ pub unsafe extern "C" fn fc_cloth_get_velocities(
     float_count: usize,
 ) -> FcStatus {
     // SAFETY: forwarded caller promises.
-    unsafe { copy_out(cloth, xyz, float_count, Cloth::velocities) }
+    unsafe { copy_out(cloth, xyz, float_count, Cloth::velocities, to_f32) }
 }
 
 /// Sets the uniform water current (m/s), effective from the next step.

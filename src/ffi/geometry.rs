@@ -1,6 +1,6 @@
 //! What a renderer needs every frame besides positions: the index buffer and vertex normals.
 
-use super::cloth::{check_float_count, handle, FcCloth};
+use super::cloth::{check_float_count, handle, to_f32, write_triples, FcCloth};
 use super::status::{guard, FcStatus, FfiError};
 use crate::Vec3;
 
@@ -67,11 +67,7 @@ pub unsafe extern "C" fn fc_cloth_get_normals(
         cloth.vertex_normals(&mut normals)?;
         // SAFETY: non-NULL and the caller promises `float_count` writable floats.
         let out = unsafe { std::slice::from_raw_parts_mut(xyz, float_count) };
-        for (o, n) in out.chunks_exact_mut(3).zip(&normals) {
-            o[0] = n.x as f32;
-            o[1] = n.y as f32;
-            o[2] = n.z as f32;
-        }
+        write_triples(&normals, out, to_f32);
         Ok(())
     })
 }

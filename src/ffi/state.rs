@@ -2,7 +2,7 @@
 //! keep their own state (an undo stack, a network replica) and for tests and references that
 //! need exact initial states. Positions and velocities in `float` are in `cloth.rs`.
 
-use super::cloth::{check_float_count, handle, handle_mut, slice_in, FcCloth};
+use super::cloth::{check_float_count, copy_out, handle_mut, slice_in, FcCloth};
 use super::status::{guard, FcStatus, FfiError};
 use crate::{Cloth, Vec3};
 
@@ -46,32 +46,6 @@ unsafe fn set_all<T: Copy + Into<f64>>(
         check_float_count(cloth, count)?;
         let xyz = unsafe { slice_in(xyz, count, "xyz") }?;
         Ok(set(cloth, &vectors(xyz, what)?)?)
-    })
-}
-
-/// Writes `values(cloth)` into the caller's buffer of `count` doubles after the usual checks.
-///
-/// # Safety
-/// `cloth` NULL or live; `xyz` NULL or `count` writable doubles.
-unsafe fn get_all_f64(
-    cloth: *const FcCloth,
-    xyz: *mut f64,
-    count: usize,
-    values: fn(&Cloth) -> &[Vec3],
-) -> FcStatus {
-    guard(|| {
-        // SAFETY: forwarded caller promises.
-        let cloth = unsafe { handle(cloth) }?;
-        check_float_count(cloth, count)?;
-        if xyz.is_null() {
-            return Err(FfiError::null("xyz"));
-        }
-        // SAFETY: non-NULL and the caller promises `count` writable doubles.
-        let out = unsafe { std::slice::from_raw_parts_mut(xyz, count) };
-        for (o, v) in out.chunks_exact_mut(3).zip(values(cloth)) {
-            o.copy_from_slice(v.as_slice());
-        }
-        Ok(())
     })
 }
 
@@ -131,7 +105,7 @@ pub unsafe extern "C" fn fc_cloth_get_positions_f64(
     double_count: usize,
 ) -> FcStatus {
     // SAFETY: forwarded caller promises.
-    unsafe { get_all_f64(cloth, xyz, double_count, Cloth::positions) }
+    unsafe { copy_out(cloth, xyz, double_count, Cloth::positions, |x| x) }
 }
 
 /// Copies every vertex velocity (m/s) into `xyz` as double triples, exactly; `double_count`
@@ -146,5 +120,5 @@ pub unsafe extern "C" fn fc_cloth_get_velocities_f64(
     double_count: usize,
 ) -> FcStatus {
     // SAFETY: forwarded caller promises.
-    unsafe { get_all_f64(cloth, xyz, double_count, Cloth::velocities) }
+    unsafe { copy_out(cloth, xyz, double_count, Cloth::velocities, |x| x) }
 }
