@@ -1,7 +1,5 @@
 //! `fc_cache_write_positions`: frames the host gives, checked, and read back exactly.
 
-mod common;
-
 use std::ffi::CString;
 
 use fraccloth::export::read_cache;
@@ -10,7 +8,8 @@ use fraccloth::ffi::*;
 
 #[test]
 fn host_positions_are_written_as_given_and_bad_ones_refused() {
-    let dir = common::scratch_dir("cache-positions");
+    let dir = std::env::temp_dir().join(format!("fraccloth-cache-positions-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("host.pc2");
     let mut d = fc_cloth_desc_default();
     d.width = 4;
@@ -61,4 +60,5 @@ fn host_positions_are_written_as_given_and_bad_ones_refused() {
             .collect();
         assert_eq!(&flat, want);
     }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -44,8 +44,8 @@ pub(crate) unsafe fn handle_mut<'a>(cloth: *mut FcCloth) -> Result<&'a mut Cloth
         .ok_or_else(|| FfiError::null("cloth"))
 }
 
-/// Converts float xyz triples to vectors, rejecting NaN and infinities.
-pub(crate) fn triples(xyz: &[f32], what: &str) -> Result<Vec<Vec3>, FfiError> {
+/// Converts xyz triples (float or double) to vectors, rejecting NaN and infinities.
+pub(crate) fn triples<T: Copy + Into<f64>>(xyz: &[T], what: &str) -> Result<Vec<Vec3>, FfiError> {
     let mut out = Vec::new();
     out.try_reserve_exact(xyz.len() / 3).map_err(|_| {
         FfiError::from(crate::Error::out_of_memory(format!(
@@ -54,13 +54,14 @@ pub(crate) fn triples(xyz: &[f32], what: &str) -> Result<Vec<Vec3>, FfiError> {
         )))
     })?;
     for (k, c) in xyz.chunks_exact(3).enumerate() {
-        if !c.iter().all(|v| v.is_finite()) {
+        let v = Vec3::new(c[0].into(), c[1].into(), c[2].into());
+        if !v.iter().all(|x| x.is_finite()) {
             return Err(FfiError::invalid(format!(
                 "{what} {k} is not finite: ({}, {}, {})",
-                c[0], c[1], c[2]
+                v.x, v.y, v.z
             )));
         }
-        out.push(Vec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])));
+        out.push(v);
     }
     Ok(out)
 }

@@ -2,31 +2,9 @@
 //! keep their own state (an undo stack, a network replica) and for tests and references that
 //! need exact initial states. Positions and velocities in `float` are in `cloth.rs`.
 
-use super::cloth::{check_float_count, copy_out, handle_mut, slice_in, FcCloth};
-use super::status::{guard, FcStatus, FfiError};
+use super::cloth::{check_float_count, copy_out, handle_mut, slice_in, triples, FcCloth};
+use super::status::{guard, FcStatus};
 use crate::{Cloth, Vec3};
-
-/// The vectors of `xyz` (triples), rejecting NaN and infinities; allocation fallible.
-fn vectors<T: Copy + Into<f64>>(xyz: &[T], what: &str) -> Result<Vec<Vec3>, FfiError> {
-    let mut out = Vec::new();
-    out.try_reserve_exact(xyz.len() / 3).map_err(|_| {
-        FfiError::from(crate::Error::out_of_memory(format!(
-            "no memory for {} {what}s",
-            xyz.len() / 3
-        )))
-    })?;
-    for (k, c) in xyz.chunks_exact(3).enumerate() {
-        let v = Vec3::new(c[0].into(), c[1].into(), c[2].into());
-        if !v.iter().all(|x| x.is_finite()) {
-            return Err(FfiError::invalid(format!(
-                "{what} {k} is not finite: ({}, {}, {})",
-                v.x, v.y, v.z
-            )));
-        }
-        out.push(v);
-    }
-    Ok(out)
-}
 
 /// Reads `float_count` values of the caller's after the usual checks and hands the vectors to
 /// `set`.
@@ -45,7 +23,7 @@ unsafe fn set_all<T: Copy + Into<f64>>(
         let cloth = unsafe { handle_mut(cloth) }?;
         check_float_count(cloth, count)?;
         let xyz = unsafe { slice_in(xyz, count, "xyz") }?;
-        Ok(set(cloth, &vectors(xyz, what)?)?)
+        Ok(set(cloth, &triples(xyz, what)?)?)
     })
 }
 
