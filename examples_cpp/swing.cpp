@@ -52,6 +52,11 @@ int main(int argc, char** argv) {
         } catch (const fraccloth::Error& e) {
             std::printf("error %d %s\n", static_cast<int>(e.status()), e.what());
         }
+        // The description reads back and changes between steps.
+        FcClothDesc now = cloth.desc();
+        now.bend_stiffness = 2.0 * now.bend_stiffness;
+        cloth.set_desc(now);
+        std::printf("desc %u %.3g\n", cloth.desc().width, cloth.desc().bend_stiffness);
         // Colliders read back.
         const uint32_t rod = cloth.add_capsule({0.0f, -0.5f, 0.2f}, {0.1f, -0.5f, 0.2f}, 0.02f);
         std::printf("capsule %.3g %.3g\n", static_cast<double>(cloth.capsule(rod).radius), static_cast<double>(cloth.capsule(rod).b[0]));

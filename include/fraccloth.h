@@ -796,6 +796,32 @@ FcClothDesc fc_cloth_desc_default(void);
 FcStatus fc_cloth_desc_preset(uint32_t preset, FcClothDesc *out_desc);
 
 /**
+ * Fills `*out_desc` with the cloth's description now: every coefficient, the history, the
+ * integrator and solver settings as the cloth steps with them (an added mass given as
+ * `added_mass_coefficient` comes back resolved into `added_mass`, the coefficient 0). The grid
+ * fields describe the cloth as built: `width` and `height` (0 for a mesh), `spacing` (the
+ * distance between vertices 0 and 1 of a grid; 0 for a mesh), `total_mass` (the sum of the
+ * particle masses) and `areal_density` (that mass over the cloth's area).
+ *
+ * # Safety
+ * `cloth` NULL or live; `out_desc` NULL or writable.
+ */
+FcStatus fc_cloth_get_desc(const FcCloth *cloth, FcClothDesc *out_desc);
+
+/**
+ * Changes a cloth's coefficients, integrator, `max_speed`, `max_substep` and solver settings
+ * between steps from `*desc` (typically `fc_cloth_get_desc`'s, edited); positions, velocities,
+ * pins, colliders, history and time are kept. The grid fields (`width`, `height`, `spacing`,
+ * `total_mass`, `areal_density`) are not read. Refused with `FC_ERROR_INVALID_ARGUMENT` and a
+ * message, changing nothing, for a bad value, a different history (`history_*` fields), or a
+ * model whose fractional terms are switched on or off against the cloth's creation.
+ *
+ * # Safety
+ * `cloth` NULL or live; `desc` NULL or a valid description.
+ */
+FcStatus fc_cloth_set_desc(FcCloth *cloth, const FcClothDesc *desc);
+
+/**
  * Copies the triangles (three vertex indices each, counter-clockwise seen from the side the
  * normals point to; quads of a mesh split on one diagonal, grids as the OBJ and caches write
  * them) into `indices`; `index_count` must be 3 * `fc_cloth_triangle_count`. The buffer does

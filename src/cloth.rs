@@ -197,6 +197,49 @@ impl Cloth {
     pub fn vertex_count(&self) -> usize {
         self.x.len()
     }
+
+    /// Changes the cloth's coefficients, integrator, speed limit, substep and solver settings
+    /// between steps; the state (positions, velocities, pins, colliders, history, time) is kept.
+    /// The history cannot change: `config.scheme` must be the cloth's, and a model that needs a
+    /// history (fractional terms; rotation-invariant fractional springs) must need the same
+    /// histories as the one the cloth was built with. All or nothing: on an error nothing changes.
+    pub fn reconfigure(&mut self, mut config: ClothConfig) -> Result<(), Error> {
+        config.model.validate()?;
+        check_positive("max_speed", config.max_speed)?;
+        if config.max_speed >= MAX_COORDINATE {
+            return Err(Error::invalid(format!(
+                "max_speed must be below {MAX_COORDINATE:e} m/s (the float range), got {}",
+                config.max_speed
+            )));
+        }
+        check_solver(&config.solver)?;
+        if !(config.max_substep.is_finite() && config.max_substep >= 0.0) {
+            return Err(Error::invalid(format!(
+                "max_substep must be finite and >= 0, got {}",
+                config.max_substep
+            )));
+        }
+        let old = &self.config;
+        if config.scheme != old.scheme {
+            return Err(Error::invalid(format!(
+                "the history scheme cannot change after creation ({} -> {}); create a new cloth",
+                old.scheme.name(),
+                config.scheme.name()
+            )));
+        }
+        let needs = |m: &Model| (m.uses_half_derivative(), m.uses_strain_history());
+        if needs(&config.model) != needs(&old.model) {
+            return Err(Error::invalid(
+                "the model's fractional terms (history drag, fractional springs) must be on or off as when the cloth was created: the history it keeps was sized then; create a new cloth, or set a coefficient to a tiny value instead of 0",
+            ));
+        }
+        let water = &mut config.model.water;
+        water.added_mass = water.added_mass_for(config.model.water_density, self.topology.width());
+        water.added_mass_coefficient = 0.0;
+        check_non_negative("added_mass (with added_mass_coefficient)", water.added_mass)?;
+        self.config = config;
+        Ok(())
+    }
     pub fn topology(&self) -> &Topology {
         &self.topology
     }

@@ -80,6 +80,7 @@ fn cpp_wrapper_runs_the_swing_like_the_c_abi() {
     assert_eq!(err[0], "2");
     assert!(out.contains("dt must be finite"), "{out}");
     assert_eq!(line(&out, "capsule "), vec!["0.02", "0.1"]);
+    assert_eq!(line(&out, "desc "), vec!["61", "1"]);
     // Index buffer (2 * 60 * 40 triangles) and one normal per vertex.
     assert_eq!(line(&out, "mesh "), vec!["14400", "7503"]);
     // The double-precision state round-trips exactly.

@@ -159,6 +159,13 @@ public:
     }
     void set_positions(span<const float> xyz) { check(fc_cloth_set_positions(handle_, xyz.data(), xyz.size())); }
     void set_velocities(span<const float> xyz) { check(fc_cloth_set_velocities(handle_, xyz.data(), xyz.size())); }
+    /// The description now; `set_desc` changes coefficients between steps (not the history).
+    FcClothDesc desc() const {
+        FcClothDesc d = fc_cloth_desc_default();
+        check(fc_cloth_get_desc(handle_, &d));
+        return d;
+    }
+    void set_desc(const FcClothDesc& d) { check(fc_cloth_set_desc(handle_, &d)); }
     /// The index buffer: three vertex indices per triangle, fixed for the cloth's life.
     std::vector<uint32_t> triangles() const {
         std::vector<uint32_t> idx(3 * fc_cloth_triangle_count(handle_));

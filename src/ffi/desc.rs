@@ -187,7 +187,7 @@ fn v3(a: [f64; 3]) -> Vec3 {
 }
 
 impl FcClothDesc {
-    fn from_model(model: &Model, config: &ClothConfig) -> Self {
+    pub(crate) fn from_model(model: &Model, config: &ClothConfig) -> Self {
         use crate::history::{DEFAULT_SOE_HORIZON, DEFAULT_SOE_MIN_DT, DEFAULT_SOE_TOLERANCE};
         let (mut tol, mut horizon, mut min_dt) =
             (DEFAULT_SOE_TOLERANCE, DEFAULT_SOE_HORIZON, DEFAULT_SOE_MIN_DT);
@@ -417,5 +417,64 @@ pub unsafe extern "C" fn fc_cloth_desc_preset(preset: u32, out_desc: *mut FcClot
         // SAFETY: checked non-NULL; the caller promises it is writable.
         unsafe { *out_desc = FcClothDesc::from_model(&model, &config) };
         Ok(())
+    })
+}
+
+/// Fills `*out_desc` with the cloth's description now: every coefficient, the history, the
+/// integrator and solver settings as the cloth steps with them (an added mass given as
+/// `added_mass_coefficient` comes back resolved into `added_mass`, the coefficient 0). The grid
+/// fields describe the cloth as built: `width` and `height` (0 for a mesh), `spacing` (the
+/// distance between vertices 0 and 1 of a grid; 0 for a mesh), `total_mass` (the sum of the
+/// particle masses) and `areal_density` (that mass over the cloth's area).
+///
+/// # Safety
+/// `cloth` NULL or live; `out_desc` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_desc(
+    cloth: *const super::FcCloth,
+    out_desc: *mut FcClothDesc,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { super::cloth::handle(cloth) }?;
+        if out_desc.is_null() {
+            return Err(FfiError::null("out_desc"));
+        }
+        let t = cloth.topology();
+        let mut d = FcClothDesc::from_model(cloth.model(), cloth.config());
+        let (w, h) = t.grid.unwrap_or((0, 0));
+        d.width = w;
+        d.height = h;
+        d.spacing = match t.grid {
+            Some(_) if t.vertex_count() > 1 => (t.rest_positions[1] - t.rest_positions[0]).norm() as f32,
+            _ => 0.0,
+        };
+        d.total_mass = t.masses.iter().sum();
+        let area: f64 = t.areas.iter().sum();
+        d.areal_density = if area > 0.0 { d.total_mass / area } else { 0.0 };
+        // SAFETY: checked non-NULL; the caller promises it is writable.
+        unsafe { *out_desc = d };
+        Ok(())
+    })
+}
+
+/// Changes a cloth's coefficients, integrator, `max_speed`, `max_substep` and solver settings
+/// between steps from `*desc` (typically `fc_cloth_get_desc`'s, edited); positions, velocities,
+/// pins, colliders, history and time are kept. The grid fields (`width`, `height`, `spacing`,
+/// `total_mass`, `areal_density`) are not read. Refused with `FC_ERROR_INVALID_ARGUMENT` and a
+/// message, changing nothing, for a bad value, a different history (`history_*` fields), or a
+/// model whose fractional terms are switched on or off against the cloth's creation.
+///
+/// # Safety
+/// `cloth` NULL or live; `desc` NULL or a valid description.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_desc(cloth: *mut super::FcCloth, desc: *const FcClothDesc) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let cloth = unsafe { super::cloth::handle_mut(cloth) }?;
+        let desc = unsafe { desc.as_ref() }.ok_or_else(|| FfiError::null("desc"))?;
+        let mut config = desc.config()?;
+        config.accept_unconverged = cloth.config().accept_unconverged;
+        Ok(cloth.reconfigure(config)?)
     })
 }

@@ -166,6 +166,8 @@ _SIGNATURES = {
     "fc_cloth_get_velocities": (_c.c_int, [_P, _F3, _c.c_size_t]),
     "fc_cloth_set_velocities": (_c.c_int, [_P, _F3, _c.c_size_t]),
     "fc_cloth_get_triangles": (_c.c_int, [_P, _U32P, _c.c_size_t]),
+    "fc_cloth_get_desc": (_c.c_int, [_P, _c.POINTER(FcClothDesc)]),
+    "fc_cloth_set_desc": (_c.c_int, [_P, _c.POINTER(FcClothDesc)]),
     "fc_cloth_get_normals": (_c.c_int, [_P, _F3, _c.c_size_t]),
     "fc_cloth_get_positions_f64": (_c.c_int, [_P, _D3, _c.c_size_t]),
     "fc_cloth_set_positions_f64": (_c.c_int, [_P, _D3, _c.c_size_t]),
@@ -358,6 +360,19 @@ class Cloth:
         """Sets every velocity (m/s) exactly, in double precision; the history is kept."""
         a = _doubles(xyz)
         _check(library.fc_cloth_set_velocities_f64(self._h, _dp(a), a.size))
+
+    @property
+    def desc(self) -> FcClothDesc:
+        """The cloth's description now (coefficients, history, integrator, solver; the grid as
+        built). Assign an edited one to change coefficients between steps (the history cannot
+        change; the grid fields are not read)."""
+        d = FcClothDesc()
+        _check(library.fc_cloth_get_desc(self._h, ctypes.byref(d)))
+        return d
+
+    @desc.setter
+    def desc(self, d: FcClothDesc) -> None:
+        _check(library.fc_cloth_set_desc(self._h, ctypes.byref(d)))
 
     def triangles(self) -> np.ndarray:
         """The index buffer: (t, 3) uint32 vertex indices, counter-clockwise seen from the side

@@ -124,6 +124,14 @@ def test_second_order_integrators_strain_springs_and_exact_state():
         assert np.allclose(b, [0.1, 0.0, 0.1]) and r == pytest.approx(0.01)
         with pytest.raises(fraccloth.Error):
             cloth.capsule(wall)
+        d = cloth.desc
+        assert d.width == 11 and d.spring_damping_mode == fraccloth.SPRING_DAMPING_FRACTIONAL_STRAIN
+        d.stretch_stiffness = 20.0
+        cloth.desc = d
+        assert cloth.desc.stretch_stiffness == 20.0
+        d.history_scheme = fraccloth.HISTORY_FULL
+        with pytest.raises(fraccloth.Error):
+            cloth.desc = d
         tris = cloth.triangles()
         assert tris.shape == (2 * 10 * 6, 3) and tris.max() == 76
         n = cloth.normals
