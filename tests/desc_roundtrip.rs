@@ -99,7 +99,8 @@ fn coefficients_change_between_steps_and_bad_changes_change_nothing() {
     // Refused, naming the reason, and nothing changes.
     let before = get(a);
     let x = positions(a);
-    let cases: Vec<(&str, Box<dyn Fn(&mut FcClothDesc)>)> = vec![
+    type Change = Box<dyn Fn(&mut FcClothDesc)>;
+    let cases: Vec<(&str, Change)> = vec![
         (
             "history",
             Box::new(|d| d.history_scheme = FcHistoryScheme::FC_HISTORY_FULL as u32),
