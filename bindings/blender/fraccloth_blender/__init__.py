@@ -5,8 +5,9 @@ Physics > fraccloth panel (Properties editor, Physics tab). "Bake underwater clo
 - vertices of the vertex group named in "Pin group" are pinned with their group weight
   (1 = held in place, less = a soft pin);
 - every other selected object is a collider: a flat one (one dimension near zero) is an
-  infinite plane through its origin along its local Z axis, any other a sphere of half its
-  largest dimension around its origin; "Collider friction" applies to them all;
+  infinite plane through its origin along its local Z axis, a long one (longest dimension over
+  twice the next) a capsule along that axis, any other a sphere of half its largest dimension
+  around its origin; "Collider friction" applies to them all;
 - the scene's frame range is baked at the scene's frame rate, each frame split into steps of
   "Time step"; the result is written to a PC2 (or MDD) point cache by the fraccloth library and
   attached with a Mesh Cache modifier.
@@ -136,17 +137,27 @@ class FracclothSettings(bpy.types.PropertyGroup):
 
 
 def _world_specs(others):
-    """(kind, args) for every collider object, in world coordinates, at the current frame: a
-    flat object (one dimension below 1e-6 of the largest) is a plane through its origin along its
-    local z axis, anything else a sphere around its origin whose radius is half its largest
-    dimension."""
+    """(kind, args) for every collider object, in world coordinates, at the current frame, fitted
+    to its dimensions (its bounding box in its own axes): a flat object (one dimension below 1e-6
+    of the largest) is a plane through its origin along its local z axis; a long one (its largest
+    dimension more than twice the next) a capsule along that axis through its origin, as long as
+    the object, its radius half the next dimension; anything else a sphere around its origin whose
+    radius is half its largest dimension."""
     specs = []
     for o in others:
         dims = o.dimensions
         center = o.matrix_world.translation.copy()
-        if min(dims) < 1e-6 * max(max(dims), 1e-9):
+        order = sorted(range(3), key=lambda k: dims[k])
+        if dims[order[0]] < 1e-6 * max(max(dims), 1e-9):
             normal = (o.matrix_world.to_3x3() @ Vector((0.0, 0.0, 1.0))).normalized()
             specs.append(("plane", tuple(center), tuple(normal)))
+        elif dims[order[2]] > 2.0 * dims[order[1]]:
+            axis = Vector((0.0, 0.0, 0.0))
+            axis[order[2]] = 1.0
+            radius = 0.5 * dims[order[1]]
+            direction = (o.matrix_world.to_3x3() @ axis).normalized()
+            half = 0.5 * dims[order[2]] - radius
+            specs.append(("capsule", tuple(center - half * direction), tuple(center + half * direction), radius))
         else:
             specs.append(("sphere", tuple(center), 0.5 * max(dims)))
     return specs
@@ -293,6 +304,8 @@ def build_cloth(context, obj, others):
     for spec in _world_specs(others):
         if spec[0] == "plane":
             cid = cloth.add_plane(spec[1], spec[2])
+        elif spec[0] == "capsule":
+            cid = cloth.add_capsule(spec[1], spec[2], spec[3])
         else:
             cid = cloth.add_sphere(spec[1], spec[2])
         cloth.set_collider_friction(cid, s.friction)
@@ -341,6 +354,8 @@ def _simulate(context, obj, others):
                 velocity = (np.array(new[1]) - np.array(old[1])) / frame_dt
                 if new[0] == "plane":
                     cloth.set_plane(cid, new[1], new[2], velocity)
+                elif new[0] == "capsule":
+                    cloth.set_capsule(cid, new[1], new[2], new[3], velocity)
                 else:
                     cloth.set_sphere(cid, new[1], new[2], velocity)
             previous = now

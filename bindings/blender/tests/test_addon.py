@@ -4,6 +4,7 @@ the evaluated mesh back at several frames and compare it with the library's own 
 Run with a Python that has `bpy` and the `fraccloth` package installed (see .ci/blender).
 """
 
+import math
 import sys
 from pathlib import Path
 
@@ -246,3 +247,43 @@ def test_a_failed_bake_reports_and_leaves_no_cache(addon, tmp_path):
         bpy.ops.fraccloth.bake()
     assert not Path(str(tmp_path / "cloth") + ".pc2").exists()
     assert cloth.modifiers.get("fraccloth") is None
+
+
+def test_a_long_object_is_a_capsule_that_holds_the_cloth(addon, tmp_path):
+    # A bar (a cylinder 0.5 m long, 6 cm thick) parallel to the pinned edge under the middle of
+    # the cloth, rising through where the cloth falls: it is fitted as a capsule, and it lifts the
+    # cloth without passing through it.
+    cloth, _ = make_scene(tmp_path, "PC2")
+    edge = np.array([math.cos(0.3), math.sin(0.3), 0.0])  # the pinned edge's direction
+    inward = np.array([math.sin(0.3), -math.cos(0.3), 0.0])  # from the edge into the cloth
+    hinge = np.array([0.1, -0.2, 0.2]) - 0.15 * inward
+    centre = hinge + 0.15 * inward + np.array([0.0, 0.0, -0.1])
+    bpy.ops.mesh.primitive_cylinder_add(radius=0.03, depth=0.5, location=tuple(centre), rotation=(0.0, math.pi / 2, 0.3))
+    bar = bpy.context.active_object
+    specs = addon._world_specs([bar])
+    assert specs[0][0] == "capsule"
+    a, b, r = np.array(specs[0][1]), np.array(specs[0][2]), specs[0][3]
+    assert r == pytest.approx(0.03, rel=1e-3) and np.linalg.norm(b - a) == pytest.approx(0.44, rel=1e-3)
+    assert abs((b - a) @ edge) > 0.43  # along the edge
+    bar.keyframe_insert("location", frame=1)
+    bar.location.z = 0.35
+    bar.keyframe_insert("location", frame=24)
+    bpy.context.scene.frame_set(1)
+    for o in bpy.context.selected_objects:
+        o.select_set(False)
+    bar.select_set(True)
+    cloth.select_set(True)
+    bpy.context.view_layer.objects.active = cloth
+    assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+    margin = cloth.fraccloth.collision_margin
+    closest = np.inf
+    for frame in range(1, 25):
+        x = world(cloth, frame)
+        spec = addon._world_specs([bar])[0]
+        a, b = np.array(spec[1]), np.array(spec[2])
+        # Distance to the segment a-b.
+        t = np.clip(((x - a) @ (b - a)) / ((b - a) @ (b - a)), 0.0, 1.0)
+        d = np.linalg.norm(x - (a + t[:, None] * (b - a)), axis=1)
+        assert d.min() >= r - margin - 1e-4, f"frame {frame}: {r - d.min():.4f} m inside the bar"
+        closest = min(closest, d.min())
+    assert closest < r + margin, closest  # it did reach the bar (contacts act at the vertices)
