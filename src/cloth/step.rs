@@ -60,6 +60,10 @@ pub(super) struct StepScratch {
     pub pin_start: Vec<Vec3>,
     /// Fully pinned particles, ascending.
     pub hard_pins: Vec<u32>,
+    /// Goals of the pins (in `pin_list` order) for the first half step of an extrapolated
+    /// step, used instead of `pin_goals`' when `mid_goal_set` (`extrapolate.rs`).
+    pub mid_goal: Vec<Vec3>,
+    pub mid_goal_set: bool,
     /// Vertex normals of the proposed state (with added mass only).
     pub normals_new: Vec<Vec3>,
     /// Rotation-invariant fractional springs only (`forces/strain.rs`): each spring's rate of
@@ -173,6 +177,12 @@ impl Cloth {
     /// there from where a multi-substep call started.
     fn pin_goals(&mut self, fraction: Option<f64>) {
         let s = &mut self.scratch;
+        if s.mid_goal_set {
+            for (k, &i) in self.pin_list.iter().enumerate() {
+                s.goal[i as usize] = s.mid_goal[k];
+            }
+            return;
+        }
         for (k, &i) in self.pin_list.iter().enumerate() {
             let i = i as usize;
             s.goal[i] = match fraction {
@@ -202,6 +212,12 @@ impl Cloth {
         let hard_pins = &s.hard_pins;
         let rate = forces::spring_rate(&self.config.model);
         let current = self.config.model.current;
+        // A hard pin's step velocity is its goal's secant, the velocity half a step ahead. The
+        // second-order integrators give the history (and this step's D^{1/2}) the pin's velocity
+        // at the start of the step instead, the mean of that secant and the last one: the
+        // history keeps every sample, so a first-order error in them would never be extrapolated
+        // away. The first-order integrators keep the secant (and their bits).
+        let central_pins = self.config.integrator.is_extrapolated();
         // A tile walk transposes its own spring inputs; only other topologies need them here.
         let arrays = self.topology.tiled.is_none();
         let (sx, sq) = s.force_pass.spring_arrays(if arrays { n } else { 0 });
@@ -253,7 +269,11 @@ impl Cloth {
                 for &i in pins.iter().take_while(|&&i| (i as usize) < hi) {
                     let (p, k) = (i as usize, i as usize - first);
                     v_step[k] = (goal[p] - x[k]) / h;
-                    v_rel[k] = v_step[k] - current;
+                    v_rel[k] = if central_pins {
+                        0.5 * (v[k] + v_step[k]) - current
+                    } else {
+                        v_step[k] - current
+                    };
                 }
                 if let Some(past) = &past {
                     // SAFETY: every particle once; tiles start on multiples of TILE and
