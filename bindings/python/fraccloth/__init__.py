@@ -102,7 +102,9 @@ def _struct_from_header(text: str, name: str):
         if fm.group(3):
             ctype = ctype * int(fm.group(3))
         fields.append((fm.group(2), ctype))
-    return type(name, (ctypes.Structure,), {"_fields_": fields})
+    # No instance dictionary: assigning a field the struct does not have (a typo such as
+    # `desc.sping_damping = 0.5`) raises AttributeError instead of being silently kept aside.
+    return type(name, (ctypes.Structure,), {"_fields_": fields, "__slots__": ()})
 
 
 def _enum_values(text: str) -> dict:

@@ -138,6 +138,14 @@ def test_second_order_integrators_strain_springs_and_exact_state():
         assert n.shape == (77, 3) and np.allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-6)
 
 
+def test_a_misspelt_description_field_raises():
+    d = fraccloth.default_desc()
+    with pytest.raises(AttributeError):
+        d.sping_damping = 0.5
+    d.spring_damping = 0.5
+    assert d.spring_damping == 0.5
+
+
 def test_errors_raise_and_leave_the_cloth_alone():
     with fraccloth.Cloth.grid() as cloth:
         before = cloth.positions
