@@ -67,6 +67,32 @@ fn check_dt(dt: f64) -> Result<(), Error> {
     }
 }
 
+/// Checks every setting of `config` for a cloth of width `width` (m) and resolves an added mass
+/// given as a coefficient into kg/m^2, once ([`crate::model::Water::added_mass_coefficient`]).
+fn checked_config(mut config: ClothConfig, width: f64) -> Result<ClothConfig, Error> {
+    config.model.validate()?;
+    let water = &mut config.model.water;
+    water.added_mass = water.added_mass_for(config.model.water_density, width);
+    water.added_mass_coefficient = 0.0;
+    check_non_negative("added_mass (with added_mass_coefficient)", water.added_mass)?;
+    check_positive("max_speed", config.max_speed)?;
+    if config.max_speed >= MAX_COORDINATE {
+        return Err(Error::invalid(format!(
+            "max_speed must be below {MAX_COORDINATE:e} m/s (the float range), got {}",
+            config.max_speed
+        )));
+    }
+    config.scheme.validate()?;
+    check_solver(&config.solver)?;
+    if !(config.max_substep.is_finite() && config.max_substep >= 0.0) {
+        return Err(Error::invalid(format!(
+            "max_substep must be finite and >= 0, got {}",
+            config.max_substep
+        )));
+    }
+    Ok(config)
+}
+
 fn check_solver(s: &SolverSettings) -> Result<(), Error> {
     if !(s.tolerance.is_finite() && s.tolerance > 0.0) || s.max_iterations == 0 {
         return Err(Error::invalid(format!(
@@ -124,28 +150,8 @@ pub struct Cloth {
 
 impl Cloth {
     /// Builds a cloth at rest in its rest positions.
-    pub fn new(topology: Topology, mut config: ClothConfig) -> Result<Self, Error> {
-        config.model.validate()?;
-        // An added mass given as a coefficient becomes kg/m^2 for this cloth's width, once.
-        let water = &mut config.model.water;
-        water.added_mass = water.added_mass_for(config.model.water_density, topology.width());
-        water.added_mass_coefficient = 0.0;
-        check_non_negative("added_mass (with added_mass_coefficient)", water.added_mass)?;
-        check_positive("max_speed", config.max_speed)?;
-        if config.max_speed >= MAX_COORDINATE {
-            return Err(Error::invalid(format!(
-                "max_speed must be below {MAX_COORDINATE:e} m/s (the float range), got {}",
-                config.max_speed
-            )));
-        }
-        config.scheme.validate()?;
-        check_solver(&config.solver)?;
-        if !(config.max_substep.is_finite() && config.max_substep >= 0.0) {
-            return Err(Error::invalid(format!(
-                "max_substep must be finite and >= 0, got {}",
-                config.max_substep
-            )));
-        }
+    pub fn new(topology: Topology, config: ClothConfig) -> Result<Self, Error> {
+        let config = checked_config(config, topology.width())?;
         let n = topology.vertex_count();
         let scheme = if config.model.uses_half_derivative() {
             config.scheme
@@ -203,22 +209,8 @@ impl Cloth {
     /// The history cannot change: `config.scheme` must be the cloth's, and a model that needs a
     /// history (fractional terms; rotation-invariant fractional springs) must need the same
     /// histories as the one the cloth was built with. All or nothing: on an error nothing changes.
-    pub fn reconfigure(&mut self, mut config: ClothConfig) -> Result<(), Error> {
-        config.model.validate()?;
-        check_positive("max_speed", config.max_speed)?;
-        if config.max_speed >= MAX_COORDINATE {
-            return Err(Error::invalid(format!(
-                "max_speed must be below {MAX_COORDINATE:e} m/s (the float range), got {}",
-                config.max_speed
-            )));
-        }
-        check_solver(&config.solver)?;
-        if !(config.max_substep.is_finite() && config.max_substep >= 0.0) {
-            return Err(Error::invalid(format!(
-                "max_substep must be finite and >= 0, got {}",
-                config.max_substep
-            )));
-        }
+    pub fn reconfigure(&mut self, config: ClothConfig) -> Result<(), Error> {
+        let config = checked_config(config, self.topology.width())?;
         let old = &self.config;
         if config.scheme != old.scheme {
             return Err(Error::invalid(format!(
@@ -233,13 +225,10 @@ impl Cloth {
                 "the model's fractional terms (history drag, fractional springs) must be on or off as when the cloth was created: the history it keeps was sized then; create a new cloth, or set a coefficient to a tiny value instead of 0",
             ));
         }
-        let water = &mut config.model.water;
-        water.added_mass = water.added_mass_for(config.model.water_density, self.topology.width());
-        water.added_mass_coefficient = 0.0;
-        check_non_negative("added_mass (with added_mass_coefficient)", water.added_mass)?;
         self.config = config;
         Ok(())
     }
+
     pub fn topology(&self) -> &Topology {
         &self.topology
     }
