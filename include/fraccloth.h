@@ -15,7 +15,7 @@
 #include <stdint.h>
 
 #define FC_VERSION_MAJOR 0
-#define FC_VERSION_MINOR 3
+#define FC_VERSION_MINOR 4
 #define FC_VERSION_PATCH 0
 /* Equals fc_version() of the library this header belongs to. */
 #define FC_VERSION (FC_VERSION_MAJOR * 1000000 + FC_VERSION_MINOR * 1000 + FC_VERSION_PATCH)
@@ -196,11 +196,24 @@ typedef struct FcCloth FcCloth;
 
 /**
  * Description of a cloth. Units are SI (m, kg, s, N). Obtain with
- * `fc_cloth_desc_default()` and change fields as needed.
+ * `fc_cloth_desc_default()` (or `fc_cloth_desc_preset`) and change fields as needed.
  *
- * Drag coefficients act per particle; the defaults suit a spacing of 1 cm.
+ * **Evolution rule.** Fields are only ever added at the end, and `struct_size` comes first.
+ * `fc_cloth_desc_default`, `fc_cloth_desc_preset` and `fc_cloth_get_desc` are inline in this
+ * header and set `struct_size = sizeof(FcClothDesc)` as this header knows it. The library reads
+ * (and writes) only the fields that fit in `struct_size` and gives any later field its default,
+ * so a host built against this header keeps working with later libraries. A `struct_size` of 0,
+ * not a multiple of 8, or larger than the library knows (a host built against a newer header
+ * than the library) is refused with `FC_ERROR_INVALID_ARGUMENT` and a message.
+ *
+ * Drag coefficients without `_per_area` act per particle; the defaults suit a spacing of 1 cm.
  */
 typedef struct {
+  /**
+   * Size of this struct in the host's header, bytes: `sizeof(FcClothDesc)`. Set by
+   * `fc_cloth_desc_default` and `fc_cloth_desc_preset`; keep it when copying.
+   */
+  uint32_t struct_size;
   /**
    * Grid columns (>= 2). Vertex (column i, row j) has index j * width + i; row 0 is the top edge.
    */
@@ -779,34 +792,32 @@ FcStatus fc_cloth_get_capsule(const FcCloth *cloth,
                               float *velocity);
 
 /**
- * The default description: a 61 x 41 grid of 1 cm spacing (0.6 m x 0.4 m, 0.24 kg)
- * with the paper's fractional forces (Eq. 2-5), the accurate SOE history (tolerance
- * 1e-3) and explicit Euler. `fc_cloth_desc_preset(FC_PRESET_FRACTIONAL_PAPER, ...)`
- * gives the paper's exact configuration (u = 3).
- */
-FcClothDesc fc_cloth_desc_default(void);
-
-/**
- * Fills `*out_desc` with a preset (an `FcPreset` value) on the default grid.
- * Returns `FC_ERROR_INVALID_ARGUMENT` for an unknown preset.
+ * Fills `*out_desc` (a struct of `struct_size` bytes: `sizeof(FcClothDesc)`) with the
+ * defaults, `struct_size` included. What the header's inline `fc_cloth_desc_default` calls.
+ * `FC_ERROR_INVALID_ARGUMENT` for a size the library cannot serve (see `FcClothDesc`).
  *
  * # Safety
- * `out_desc` must be NULL or point to writable memory for one `FcClothDesc`.
+ * `out_desc` must be NULL or point to `struct_size` writable bytes.
  */
-FcStatus fc_cloth_desc_preset(uint32_t preset, FcClothDesc *out_desc);
+FcStatus fc_cloth_desc_init(FcClothDesc *out_desc, size_t struct_size);
 
 /**
- * Fills `*out_desc` with the cloth's description now: every coefficient, the history, the
- * integrator and solver settings as the cloth steps with them (an added mass given as
- * `added_mass_coefficient` comes back resolved into `added_mass`, the coefficient 0). The grid
- * fields describe the cloth as built: `width` and `height` (0 for a mesh), `spacing` (the
- * distance between vertices 0 and 1 of a grid; 0 for a mesh), `total_mass` (the sum of the
- * particle masses) and `areal_density` (that mass over the cloth's area).
+ * `fc_cloth_desc_preset` for a struct of `struct_size` bytes (what the header's inline
+ * `fc_cloth_desc_preset` calls with `sizeof(FcClothDesc)`).
  *
  * # Safety
- * `cloth` NULL or live; `out_desc` NULL or writable.
+ * `out_desc` must be NULL or point to `struct_size` writable bytes.
  */
-FcStatus fc_cloth_get_desc(const FcCloth *cloth, FcClothDesc *out_desc);
+FcStatus fc_cloth_desc_preset_sized(uint32_t preset, FcClothDesc *out_desc, size_t struct_size);
+
+/**
+ * `fc_cloth_get_desc` for a struct of `struct_size` bytes (what the header's inline
+ * `fc_cloth_get_desc` calls with `sizeof(FcClothDesc)`).
+ *
+ * # Safety
+ * `cloth` NULL or live; `out_desc` NULL or `struct_size` writable bytes.
+ */
+FcStatus fc_cloth_get_desc_sized(const FcCloth *cloth, FcClothDesc *out_desc, size_t struct_size);
 
 /**
  * Changes a cloth's coefficients, integrator, `max_speed`, `max_substep` and solver settings
@@ -965,4 +976,38 @@ uint32_t fc_version(void);
 }  // extern "C"
 #endif  // __cplusplus
 
+/**
+ * The default description, `struct_size = sizeof(FcClothDesc)`: a 61 x 41 grid of 1 cm spacing
+ * (0.6 m x 0.4 m, 0.24 kg) with the paper's fractional forces (Eq. 2-5), the accurate SOE
+ * history (tolerance 1e-3) and explicit Euler. `fc_cloth_desc_preset(FC_PRESET_FRACTIONAL_PAPER,
+ * ...)` gives the paper's exact configuration (u = 3). Inline: calls `fc_cloth_desc_init`.
+ */
+static inline FcClothDesc fc_cloth_desc_default(void) {
+#ifdef __cplusplus
+  FcClothDesc desc = {};
+#else
+  FcClothDesc desc = {0};
+#endif
+  /* If the library is older than this header, init refuses and the size stays, so
+     fc_cloth_create_grid refuses this description with the same message. */
+  desc.struct_size = (uint32_t)sizeof(FcClothDesc);
+  (void)fc_cloth_desc_init(&desc, sizeof(FcClothDesc));
+  return desc;
+}
+
+/**
+ * Fills `*out_desc` with a preset (an `FcPreset` value) on the default grid, `struct_size` set.
+ * `FC_ERROR_INVALID_ARGUMENT` for an unknown preset. Inline: calls `fc_cloth_desc_preset_sized`.
+ */
+static inline FcStatus fc_cloth_desc_preset(uint32_t preset, FcClothDesc *out_desc) {
+  return fc_cloth_desc_preset_sized(preset, out_desc, sizeof(FcClothDesc));
+}
+
+/**
+ * Fills `*out_desc` with the cloth's description now (see `fc_cloth_get_desc_sized`), as this
+ * header's struct. Inline: calls `fc_cloth_get_desc_sized`.
+ */
+static inline FcStatus fc_cloth_get_desc(const FcCloth *cloth, FcClothDesc *out_desc) {
+  return fc_cloth_get_desc_sized(cloth, out_desc, sizeof(FcClothDesc));
+}
 #endif  /* FRACCLOTH_H */

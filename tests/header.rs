@@ -17,6 +17,8 @@ fn generate() -> String {
          /* Equals fc_version() of the library this header belongs to. */\n\
          #define FC_VERSION (FC_VERSION_MAJOR * 1000000 + FC_VERSION_MINOR * 1000 + FC_VERSION_PATCH)\n"
     ));
+    // cbindgen writes its trailer after the include guard; the inline functions belong inside.
+    let trailer = config.trailer.take().unwrap_or_default();
     let bindings = cbindgen::Builder::new()
         .with_crate(root)
         .with_config(config)
@@ -24,7 +26,10 @@ fn generate() -> String {
         .expect("cbindgen generates the header");
     let mut out = Vec::new();
     bindings.write(&mut out);
-    String::from_utf8(out).expect("header is UTF-8")
+    let header = String::from_utf8(out).expect("header is UTF-8");
+    let guard_end = "#endif  /* FRACCLOTH_H */";
+    assert!(header.contains(guard_end), "cbindgen's include guard changed");
+    header.replacen(guard_end, &format!("{}\n{guard_end}", trailer.trim_end()), 1)
 }
 
 #[test]

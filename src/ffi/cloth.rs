@@ -118,9 +118,9 @@ pub(crate) unsafe fn create(
             return Err(FfiError::null("out_cloth"));
         }
         // SAFETY: the caller promises a valid description or NULL.
-        let desc = unsafe { desc.as_ref() }.ok_or_else(|| FfiError::null("desc"))?;
+        let desc = unsafe { super::desc_size::read_desc(desc) }?;
         let config = desc.config()?;
-        let cloth = Cloth::new(topology(desc)?, config)?;
+        let cloth = Cloth::new(topology(&desc)?, config)?;
         let raw = Box::into_raw(Box::new(FcCloth { cloth }));
         // SAFETY: checked non-NULL; the caller promises it is writable.
         unsafe { *out = raw };

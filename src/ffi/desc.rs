@@ -13,6 +13,7 @@ use crate::model::{Model, RegularDrag, SpringDamping};
 use crate::topology::GridSpec;
 use crate::Vec3;
 
+use super::desc_size::{read_desc, write_desc, DESC_SIZE};
 use super::status::{guard, FcStatus, FfiError};
 
 /// Values of `FcClothDesc::history_scheme`: how D^{1/2}x is evaluated.
@@ -82,12 +83,23 @@ pub enum FcPreset {
 }
 
 /// Description of a cloth. Units are SI (m, kg, s, N). Obtain with
-/// `fc_cloth_desc_default()` and change fields as needed.
+/// `fc_cloth_desc_default()` (or `fc_cloth_desc_preset`) and change fields as needed.
 ///
-/// Drag coefficients act per particle; the defaults suit a spacing of 1 cm.
+/// **Evolution rule.** Fields are only ever added at the end, and `struct_size` comes first.
+/// `fc_cloth_desc_default`, `fc_cloth_desc_preset` and `fc_cloth_get_desc` are inline in this
+/// header and set `struct_size = sizeof(FcClothDesc)` as this header knows it. The library reads
+/// (and writes) only the fields that fit in `struct_size` and gives any later field its default,
+/// so a host built against this header keeps working with later libraries. A `struct_size` of 0,
+/// not a multiple of 8, or larger than the library knows (a host built against a newer header
+/// than the library) is refused with `FC_ERROR_INVALID_ARGUMENT` and a message.
+///
+/// Drag coefficients without `_per_area` act per particle; the defaults suit a spacing of 1 cm.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FcClothDesc {
+    /// Size of this struct in the host's header, bytes: `sizeof(FcClothDesc)`. Set by
+    /// `fc_cloth_desc_default` and `fc_cloth_desc_preset`; keep it when copying.
+    pub struct_size: u32,
     /// Grid columns (>= 2). Vertex (column i, row j) has index j * width + i; row 0 is the top edge.
     pub width: u32,
     /// Grid rows (>= 2).
@@ -205,6 +217,7 @@ impl FcClothDesc {
             }
         };
         Self {
+            struct_size: DESC_SIZE as u32,
             width: 61,
             height: 41,
             spacing: 0.01,
@@ -381,43 +394,73 @@ pub extern "C" fn fc_cloth_desc_default() -> FcClothDesc {
     FcClothDesc::from_model(&config.model, &config)
 }
 
+/// Fills `*out_desc` (a struct of `struct_size` bytes: `sizeof(FcClothDesc)`) with the
+/// defaults, `struct_size` included. What the header's inline `fc_cloth_desc_default` calls.
+/// `FC_ERROR_INVALID_ARGUMENT` for a size the library cannot serve (see `FcClothDesc`).
+///
+/// # Safety
+/// `out_desc` must be NULL or point to `struct_size` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_desc_init(out_desc: *mut FcClothDesc, struct_size: usize) -> FcStatus {
+    // SAFETY: forwarded caller promise.
+    guard(|| unsafe { write_desc(out_desc, struct_size, &fc_cloth_desc_default()) })
+}
+
+/// `fc_cloth_desc_preset` for a struct of `struct_size` bytes (what the header's inline
+/// `fc_cloth_desc_preset` calls with `sizeof(FcClothDesc)`).
+///
+/// # Safety
+/// `out_desc` must be NULL or point to `struct_size` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_desc_preset_sized(
+    preset: u32,
+    out_desc: *mut FcClothDesc,
+    struct_size: usize,
+) -> FcStatus {
+    guard(|| {
+        let desc = preset_desc(preset)?;
+        // SAFETY: forwarded caller promise.
+        unsafe { write_desc(out_desc, struct_size, &desc) }
+    })
+}
+
 /// Fills `*out_desc` with a preset (an `FcPreset` value) on the default grid.
-/// Returns `FC_ERROR_INVALID_ARGUMENT` for an unknown preset.
+/// Returns `FC_ERROR_INVALID_ARGUMENT` for an unknown preset. Writes this library's whole
+/// struct: for binders of other languages; the C header's inline version is sized.
 ///
 /// # Safety
 /// `out_desc` must be NULL or point to writable memory for one `FcClothDesc`.
 #[no_mangle]
 pub unsafe extern "C" fn fc_cloth_desc_preset(preset: u32, out_desc: *mut FcClothDesc) -> FcStatus {
-    guard(|| {
-        if out_desc.is_null() {
-            return Err(FfiError::null("out_desc"));
-        }
-        let scheme = if preset == 0 {
-            Scheme::PAPER
+    // SAFETY: forwarded caller promise.
+    unsafe { fc_cloth_desc_preset_sized(preset, out_desc, DESC_SIZE) }
+}
+
+/// The description of a preset (an `FcPreset` value) on the default grid.
+fn preset_desc(preset: u32) -> Result<FcClothDesc, FfiError> {
+    let scheme = if preset == 0 {
+        Scheme::PAPER
+    } else {
+        Scheme::DEFAULT
+    };
+    let model = match preset {
+        0 => Model::fractional(),
+        1 => Model::regular(RegularDrag::ViscousAndNormal),
+        2 => Model::regular(RegularDrag::Viscous),
+        3 => Model::regular(RegularDrag::Normal),
+        4 => Model::underwater(),
+        x => return Err(FfiError::invalid(format!("preset {x} is not an FcPreset value"))),
+    };
+    let config = ClothConfig {
+        scheme,
+        integrator: if preset == 4 {
+            Integrator::SymplecticEuler
         } else {
-            Scheme::DEFAULT
-        };
-        let model = match preset {
-            0 => Model::fractional(),
-            1 => Model::regular(RegularDrag::ViscousAndNormal),
-            2 => Model::regular(RegularDrag::Viscous),
-            3 => Model::regular(RegularDrag::Normal),
-            4 => Model::underwater(),
-            x => return Err(FfiError::invalid(format!("preset {x} is not an FcPreset value"))),
-        };
-        let config = ClothConfig {
-            scheme,
-            integrator: if preset == 4 {
-                Integrator::SymplecticEuler
-            } else {
-                Integrator::ExplicitEuler
-            },
-            ..ClothConfig::default()
-        };
-        // SAFETY: checked non-NULL; the caller promises it is writable.
-        unsafe { *out_desc = FcClothDesc::from_model(&model, &config) };
-        Ok(())
-    })
+            Integrator::ExplicitEuler
+        },
+        ..ClothConfig::default()
+    };
+    Ok(FcClothDesc::from_model(&model, &config))
 }
 
 /// Fills `*out_desc` with the cloth's description now: every coefficient, the history, the
@@ -434,12 +477,24 @@ pub unsafe extern "C" fn fc_cloth_get_desc(
     cloth: *const super::FcCloth,
     out_desc: *mut FcClothDesc,
 ) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { fc_cloth_get_desc_sized(cloth, out_desc, DESC_SIZE) }
+}
+
+/// `fc_cloth_get_desc` for a struct of `struct_size` bytes (what the header's inline
+/// `fc_cloth_get_desc` calls with `sizeof(FcClothDesc)`).
+///
+/// # Safety
+/// `cloth` NULL or live; `out_desc` NULL or `struct_size` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_desc_sized(
+    cloth: *const super::FcCloth,
+    out_desc: *mut FcClothDesc,
+    struct_size: usize,
+) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promise.
         let cloth = unsafe { super::cloth::handle(cloth) }?;
-        if out_desc.is_null() {
-            return Err(FfiError::null("out_desc"));
-        }
         let t = cloth.topology();
         let mut d = FcClothDesc::from_model(cloth.model(), cloth.config());
         let (w, h) = t.grid.unwrap_or((0, 0));
@@ -452,9 +507,8 @@ pub unsafe extern "C" fn fc_cloth_get_desc(
         d.total_mass = t.masses.iter().sum();
         let area: f64 = t.areas.iter().sum();
         d.areal_density = if area > 0.0 { d.total_mass / area } else { 0.0 };
-        // SAFETY: checked non-NULL; the caller promises it is writable.
-        unsafe { *out_desc = d };
-        Ok(())
+        // SAFETY: forwarded caller promise.
+        unsafe { write_desc(out_desc, struct_size, &d) }
     })
 }
 
@@ -472,7 +526,7 @@ pub unsafe extern "C" fn fc_cloth_set_desc(cloth: *mut super::FcCloth, desc: *co
     guard(|| {
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { super::cloth::handle_mut(cloth) }?;
-        let desc = unsafe { desc.as_ref() }.ok_or_else(|| FfiError::null("desc"))?;
+        let desc = unsafe { read_desc(desc) }?;
         let mut config = desc.config()?;
         config.accept_unconverged = cloth.config().accept_unconverged;
         Ok(cloth.reconfigure(config)?)

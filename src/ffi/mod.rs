@@ -1,7 +1,7 @@
 //! The C ABI: a thin, checked, panic-safe shell over [`crate::Cloth`].
 //!
 //! One file per header area: [`status`] (status codes, last error, the panic
-//! boundary), [`desc`] (the description struct and its defaults), [`cloth`]
+//! boundary), [`desc`] (the description struct and its defaults), [`desc_size`] (its `struct_size` rule), [`cloth`]
 //! (lifetime, pins, positions, stepping), [`mesh`] (cloths from meshes), [`collider`]
 //! (colliders), [`cache`] (PC2 / MDD / OBJ writers), [`geometry`] (index buffer, normals), [`state`] (positions and velocities in
 //! double precision, velocities in float), [`version`].
@@ -21,6 +21,7 @@ pub mod cache;
 pub mod cloth;
 pub mod collider;
 pub mod desc;
+pub mod desc_size;
 pub mod geometry;
 pub mod mesh;
 pub mod snapshot;
