@@ -1,12 +1,15 @@
 /* hello.c: create a cloth, pin its top row, step one second, print a corner.
- * Build: cc -std=c99 -Iinclude examples_c/hello.c -Ltarget/release -lfraccloth -lm */
+ * Build (after scripts/install.sh; see the README's "Building a C program"):
+ *   cc -std=c99 examples_c/hello.c $(pkg-config --cflags --libs fraccloth) -lm */
 #include <stdio.h>
 #include <stdlib.h>
 #include "fraccloth.h"
 
 int main(void) {
-    if (fc_version() != FC_VERSION) {
-        fprintf(stderr, "header %d does not match library %u\n", FC_VERSION, fc_version());
+    /* The same major version, and a library no older than this header. */
+    if (fc_version() / 1000000 != FC_VERSION_MAJOR || fc_version() < FC_VERSION) {
+        fprintf(stderr, "header %d needs a library of the same major version, not older; got %u\n",
+                FC_VERSION, fc_version());
         return 1;
     }
     FcClothDesc desc = fc_cloth_desc_default(); /* the paper's fractional cloth, 61 x 41 */

@@ -122,4 +122,12 @@ fn build_lib_now() {
         .status()
         .expect("cargo runs");
     assert!(status.success());
+    // The library's SONAME is libfraccloth.so.MAJOR (build.rs): a program linked with
+    // -lfraccloth asks the loader for that name, which cargo does not create. The install
+    // makes the same link (scripts/install.sh).
+    let dir = exe.parent().and_then(Path::parent).expect("target dir");
+    let link = dir.join(format!("libfraccloth.so.{}", env!("CARGO_PKG_VERSION_MAJOR")));
+    if dir.join("libfraccloth.so").exists() && std::fs::symlink_metadata(&link).is_err() {
+        std::os::unix::fs::symlink("libfraccloth.so", &link).expect("SONAME link");
+    }
 }

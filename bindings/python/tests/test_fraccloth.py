@@ -28,7 +28,13 @@ def compile_c(source: str, tmp_path: Path) -> Path:
     # The header packaged with the library (identical to include/fraccloth.h).
     shutil.copy2(lib_dir() / "fraccloth.h" if (lib_dir() / "fraccloth.h").exists() else REPO / "include" / "fraccloth.h",
                  header_dir / "fraccloth.h")
-    lib = Path(fraccloth.library._name)
+    # The library's SONAME is libfraccloth.so.MAJOR: give the loader that name beside the program.
+    lib = tmp_path / "libfraccloth.so"
+    if not lib.exists():
+        lib.symlink_to(Path(fraccloth.library._name).resolve())
+    soname = tmp_path / f"libfraccloth.so.{fraccloth.version().split('.')[0]}"
+    if not soname.exists():
+        soname.symlink_to(lib.name)
     subprocess.run(
         [cc, "-std=c99", "-Wall", "-Wextra", "-Werror", "-I", str(header_dir), str(REPO / "examples_c" / source),
          "-o", str(exe), str(lib), f"-Wl,-rpath,{lib.parent}", "-lm"],
