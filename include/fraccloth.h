@@ -968,6 +968,30 @@ FcStatus fc_cloth_get_positions_f64(const FcCloth *cloth, double *xyz, size_t do
 FcStatus fc_cloth_get_velocities_f64(const FcCloth *cloth, double *xyz, size_t double_count);
 
 /**
+ * Chooses the threads `fc_cloth_step` runs on; the result is bit for bit the same for every
+ * choice.
+ * - `0` (the default): the library's shared pool (size from `RAYON_NUM_THREADS`, else one
+ *   thread per core). Cloths under 16,000 particles step on the calling thread anyway.
+ * - `1`: every pass on the calling thread, whatever the cloth's size. For a host with its own
+ *   job system: step different cloths from different jobs (one handle per thread at a time),
+ *   and no thread but the caller's is used.
+ * - `n >= 2` (at most 256): a pool of `n` threads owned by this cloth, started now; the calling
+ *   thread waits for each step. `FC_ERROR_INVALID_ARGUMENT` if the threads cannot be started.
+ *
+ * # Safety
+ * `cloth` NULL or live.
+ */
+FcStatus fc_cloth_set_threads(FcCloth *cloth, uint32_t threads);
+
+/**
+ * The value last given to `fc_cloth_set_threads` (0 by default, and for NULL).
+ *
+ * # Safety
+ * `cloth` NULL or live.
+ */
+uint32_t fc_cloth_get_threads(const FcCloth *cloth);
+
+/**
  * `major * 1000000 + minor * 1000 + patch`; equals `FC_VERSION` of the header the host compiled against.
  */
 uint32_t fc_version(void);

@@ -20,6 +20,7 @@ use crate::forces::{self, Collider, Plane, Sphere};
 use crate::history::{History, Scheme};
 use crate::integrate::{Integrator, SolverSettings, SolverStats};
 use crate::model::Model;
+use crate::parallel::Threads;
 use crate::topology::Topology;
 use crate::Vec3;
 
@@ -146,6 +147,8 @@ pub struct Cloth {
     /// The whole step of an extrapolated integrator, beside its two half steps.
     probe: Rollback,
     solver_stats: SolverStats,
+    /// Where the step runs (`plumbing/parallel.rs`).
+    threads: Threads,
 }
 
 impl Cloth {
@@ -195,6 +198,7 @@ impl Cloth {
             rollback: Rollback::default(),
             probe: Rollback::default(),
             solver_stats: SolverStats::default(),
+            threads: Threads::default(),
             topology,
             config,
         })
@@ -544,6 +548,25 @@ impl Cloth {
     /// line to their targets over the whole call. Atomic over the whole call: if any
     /// substep fails, the cloth is restored to its state before the call.
     pub fn step_substeps(&mut self, dt: f64, substeps: u32) -> Result<(), Error> {
+        match &self.threads {
+            Threads::Shared => self.step_substeps_here(dt, substeps),
+            threads => threads.clone().run(|| self.step_substeps_here(dt, substeps)),
+        }
+    }
+
+    /// Which threads the step runs on: 0 = the shared pool (default), 1 = the calling thread,
+    /// n >= 2 = the cloth's own pool of n threads. The result does not depend on it.
+    pub fn set_threads(&mut self, count: u32) -> Result<(), Error> {
+        self.threads = Threads::with_count(count).map_err(Error::invalid)?;
+        Ok(())
+    }
+
+    /// The count given to [`Cloth::set_threads`] (0 by default).
+    pub fn threads(&self) -> u32 {
+        self.threads.count()
+    }
+
+    fn step_substeps_here(&mut self, dt: f64, substeps: u32) -> Result<(), Error> {
         check_dt(dt)?;
         if substeps == 0 || substeps > MAX_SUBSTEPS {
             return Err(Error::invalid(format!(

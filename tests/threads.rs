@@ -109,3 +109,30 @@ fn bitwise_identical_for_1_2_and_8_threads() {
         assert!(moved > (W * H) as usize, "{moved}");
     }
 }
+
+/// A cloth's own thread setting (`Cloth::set_threads`, `fc_cloth_set_threads`): the calling
+/// thread only, its own pool of 3, and the shared pool give the same bits.
+#[test]
+fn per_cloth_threads_give_the_same_bits() {
+    let steps = |threads: u32| -> Vec<u64> {
+        let mut c = cloth(Variant::Fractional, Scheme::DEFAULT, Integrator::SymplecticEuler);
+        c.set_threads(threads).unwrap();
+        assert_eq!(c.threads(), threads);
+        for _ in 0..20 {
+            c.step(5e-4).unwrap();
+        }
+        c.positions()
+            .iter()
+            .chain(c.velocities())
+            .flat_map(|p| p.iter().map(|x| x.to_bits()))
+            .collect()
+    };
+    // Inside a pool of 4 so that the shared setting really spreads the work.
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap();
+    let shared = pool.install(|| steps(0));
+    assert_eq!(pool.install(|| steps(1)), shared, "calling thread only");
+    assert_eq!(steps(3), shared, "the cloth's own pool of 3");
+    let mut c = cloth(Variant::Fractional, Scheme::DEFAULT, Integrator::SymplecticEuler);
+    assert!(c.set_threads(100_000).is_err());
+    assert_eq!(c.threads(), 0, "a refused setting changes nothing");
+}

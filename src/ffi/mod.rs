@@ -4,7 +4,7 @@
 //! boundary), [`desc`] (the description struct and its defaults), [`desc_size`] (its `struct_size` rule), [`cloth`]
 //! (lifetime, pins, positions, stepping), [`mesh`] (cloths from meshes), [`collider`]
 //! (colliders), [`cache`] (PC2 / MDD / OBJ writers), [`geometry`] (index buffer, normals), [`state`] (positions and velocities in
-//! double precision, velocities in float), [`version`].
+//! double precision, velocities in float), [`threads`] (where a step runs), [`version`].
 //!
 //! Rules every export follows:
 //! - it runs inside a panic boundary; a panic becomes `FC_ERROR_PANIC`;
@@ -26,6 +26,7 @@ pub mod geometry;
 pub mod mesh;
 pub mod snapshot;
 pub mod state;
+pub mod threads;
 pub mod version;
 
 pub use cache::*;
@@ -37,4 +38,5 @@ pub use mesh::*;
 pub use snapshot::*;
 pub use state::*;
 pub use status::*;
+pub use threads::*;
 pub use version::*;

@@ -8,7 +8,10 @@
 //! Small cloths stay on the calling thread: below [`MIN_PARALLEL`] particles a step takes a
 //! few tens of microseconds and handing chunks to other threads costs more than it saves.
 //! Threads come from rayon's current pool: the global pool (`RAYON_NUM_THREADS`), or a pool
-//! the host installs around the call.
+//! the host installs around the call, unless a cloth says otherwise ([`Threads`]).
+
+use std::cell::Cell;
+use std::sync::Arc;
 
 use rayon::prelude::*;
 
@@ -26,7 +29,75 @@ pub const MIN_PARALLEL: usize = 16_000;
 
 /// Whether a cloth of `n` particles should spread its passes over the pool.
 pub fn worth_it(n: usize) -> bool {
-    n >= MIN_PARALLEL && rayon::current_num_threads() > 1
+    n >= MIN_PARALLEL && !ON_CALLER.with(Cell::get) && rayon::current_num_threads() > 1
+}
+
+thread_local! {
+    /// Set while a step of a [`Threads::Caller`] cloth runs on this thread.
+    static ON_CALLER: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Largest thread count a cloth's own pool may have.
+pub const MAX_THREADS: u32 = 256;
+
+/// Which threads a cloth's step runs on. The result is the same bits for every choice (the
+/// chunks never depend on the thread count); only where the work runs changes.
+#[derive(Clone, Debug, Default)]
+pub enum Threads {
+    /// rayon's current pool: the global one (`RAYON_NUM_THREADS`) or one the caller installed.
+    /// Cloths under [`MIN_PARALLEL`] particles stay on the calling thread. The default.
+    #[default]
+    Shared,
+    /// Every pass on the calling thread, whatever the cloth's size: for a host that runs
+    /// cloths on its own threads (its job system) and wants no other thread touched.
+    Caller,
+    /// The cloth's own pool of this many threads; the calling thread waits for the step.
+    Own(Arc<rayon::ThreadPool>),
+}
+
+impl Threads {
+    /// `0` = [`Threads::Shared`], `1` = [`Threads::Caller`], `n >= 2` = a new pool of `n`
+    /// threads (started now; an error if the system cannot start them).
+    pub fn with_count(count: u32) -> Result<Self, String> {
+        match count {
+            0 => Ok(Self::Shared),
+            1 => Ok(Self::Caller),
+            n if n > MAX_THREADS => Err(format!("thread count must be at most {MAX_THREADS}, got {n}")),
+            n => rayon::ThreadPoolBuilder::new()
+                .num_threads(n as usize)
+                .thread_name(|i| format!("fraccloth-{i}"))
+                .build()
+                .map(|p| Self::Own(Arc::new(p)))
+                .map_err(|e| format!("cannot start {n} threads: {e}")),
+        }
+    }
+
+    /// The count [`Threads::with_count`] was given.
+    pub fn count(&self) -> u32 {
+        match self {
+            Self::Shared => 0,
+            Self::Caller => 1,
+            Self::Own(p) => p.current_num_threads() as u32,
+        }
+    }
+
+    /// Runs `f` (a step) on these threads.
+    pub fn run<T: Send>(&self, f: impl FnOnce() -> T + Send) -> T {
+        match self {
+            Self::Shared => f(),
+            Self::Caller => {
+                struct Restore(bool);
+                impl Drop for Restore {
+                    fn drop(&mut self) {
+                        ON_CALLER.with(|c| c.set(self.0));
+                    }
+                }
+                let _restore = Restore(ON_CALLER.with(|c| c.replace(true)));
+                f()
+            }
+            Self::Own(pool) => pool.install(f),
+        }
+    }
 }
 
 /// Calls `f(first_index, chunk)` on consecutive chunks of `a` of `chunk` elements, in
@@ -183,6 +254,21 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn threads_choose_where_work_runs() {
+        assert!(
+            !Threads::Caller.run(|| worth_it(10 * MIN_PARALLEL)),
+            "a Caller step never spreads"
+        );
+        assert!(!ON_CALLER.with(Cell::get), "the flag is restored after the step");
+        let own = Threads::with_count(3).expect("pool");
+        assert_eq!(own.count(), 3);
+        assert_eq!(own.run(rayon::current_num_threads), 3);
+        assert!(own.run(|| worth_it(MIN_PARALLEL)));
+        assert!(Threads::with_count(MAX_THREADS + 1).is_err());
+        assert_eq!(Threads::with_count(0).map(|t| t.count()), Ok(0));
+    }
 
     #[test]
     fn chunks_cover_every_element_once_with_its_index() {
