@@ -968,6 +968,15 @@ FcStatus fc_cloth_get_positions_f64(const FcCloth *cloth, double *xyz, size_t do
 FcStatus fc_cloth_get_velocities_f64(const FcCloth *cloth, double *xyz, size_t double_count);
 
 /**
+ * `fc_cloth_set_current` from a double triple (m/s), exactly as the description's
+ * `current` holds it.
+ *
+ * # Safety
+ * `cloth` NULL or live; `xyz` NULL or 3 readable doubles.
+ */
+FcStatus fc_cloth_set_current_f64(FcCloth *cloth, const double *xyz);
+
+/**
  * Chooses the threads `fc_cloth_step` runs on; the result is bit for bit the same for every
  * choice.
  * - `0` (the default): the library's shared pool (size from `RAYON_NUM_THREADS`, else one

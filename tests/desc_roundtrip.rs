@@ -147,3 +147,27 @@ fn coefficients_change_between_steps_and_bad_changes_change_nothing() {
         fc_cloth_destroy(b);
     }
 }
+
+/// `fc_cloth_set_current_f64` sets the current exactly as the description holds it; the float
+/// call rounds it to float.
+#[test]
+fn the_current_in_double_precision_reads_back_exactly() {
+    let c = create(&fc_cloth_desc_default());
+    let exact = [0.1f64, -0.2, 0.3];
+    assert_eq!(unsafe { fc_cloth_set_current_f64(c, exact.as_ptr()) }, FC_OK);
+    assert_eq!(get(c).current, exact);
+    let float = [0.1f32, -0.2, 0.3];
+    assert_eq!(unsafe { fc_cloth_set_current(c, float.as_ptr()) }, FC_OK);
+    assert_eq!(get(c).current, float.map(f64::from));
+    let bad = [f64::NAN, 0.0, 0.0];
+    assert_eq!(
+        unsafe { fc_cloth_set_current_f64(c, bad.as_ptr()) },
+        FC_ERROR_INVALID_ARGUMENT
+    );
+    assert_eq!(
+        get(c).current,
+        float.map(f64::from),
+        "a refused current changes nothing"
+    );
+    unsafe { fc_cloth_destroy(c) };
+}

@@ -78,15 +78,25 @@ inline void check(FcStatus status) {
 /// A 3-vector of floats (m, or m/s).
 using Vec3f = std::array<float, 3>;
 
-/// Description with the library's defaults (a 61 x 41 grid of 1 cm, fractional model, SOE history).
+/// The library's version, `major * 1000000 + minor * 1000 + patch` (FC_VERSION of its header).
+inline uint32_t version() noexcept { return fc_version(); }
+
+/// Description with the library's defaults (a 61 x 41 grid of 1 cm, fractional model, SOE
+/// history); `struct_size` is this header's `sizeof(FcClothDesc)`.
 inline FcClothDesc default_desc() { return fc_cloth_desc_default(); }
 
 /// Description of a preset (an FcPreset value).
 inline FcClothDesc preset_desc(FcPreset preset) {
-    FcClothDesc d;
+    FcClothDesc d = fc_cloth_desc_default();
     check(fc_cloth_desc_preset(static_cast<uint32_t>(preset), &d));
     return d;
 }
+
+/// What the last implicit solve did.
+struct SolverStats {
+    uint32_t iterations = 0;  ///< CG iterations
+    double residual = 0.0;    ///< final relative residual
+};
 
 /// One simulated cloth. Move-only; the handle is freed by the destructor.
 class Cloth {
@@ -124,7 +134,46 @@ public:
     FcCloth* get() const noexcept { return handle_; }
 
     std::size_t vertex_count() const noexcept { return fc_cloth_vertex_count(handle_); }
+    std::size_t triangle_count() const noexcept { return fc_cloth_triangle_count(handle_); }
+    /// Simulated time, s.
     double time() const noexcept { return fc_cloth_time(handle_); }
+    /// Exponential modes of the SOE history per particle (0 for other schemes).
+    uint32_t history_mode_count() const noexcept { return fc_cloth_history_mode_count(handle_); }
+    /// Bytes of history kept per particle now.
+    std::size_t history_bytes_per_particle() const noexcept {
+        return fc_cloth_history_bytes_per_particle(handle_);
+    }
+
+    /// Where steps run: 0 the shared pool (default), 1 the calling thread only, n >= 2 a pool of
+    /// the cloth's own. The result is the same for each.
+    void set_threads(uint32_t threads) { check(fc_cloth_set_threads(handle_, threads)); }
+    uint32_t threads() const noexcept { return fc_cloth_get_threads(handle_); }
+
+    /// The implicit solver's CG tolerance (relative residual) and iteration cap.
+    void set_solver(double tolerance, uint32_t max_iterations) {
+        check(fc_cloth_set_solver(handle_, tolerance, max_iterations));
+    }
+    SolverStats solver_stats() const {
+        SolverStats s;
+        check(fc_cloth_get_solver_stats(handle_, &s.iterations, &s.residual));
+        return s;
+    }
+    /// Accept (true) or refuse (false, the default) implicit steps whose solver did not converge.
+    void set_solver_accept_unconverged(bool accept) {
+        check(fc_cloth_set_solver_accept_unconverged(handle_, accept ? 1 : 0));
+    }
+
+    /// The cloth's whole state as a checked binary snapshot (restore with load_snapshot).
+    std::vector<unsigned char> save_snapshot() const {
+        std::vector<unsigned char> bytes(fc_cloth_snapshot_size(handle_));
+        std::size_t written = 0;
+        check(fc_cloth_save_snapshot(handle_, bytes.data(), bytes.size(), &written));
+        bytes.resize(written);
+        return bytes;
+    }
+    void load_snapshot(span<const unsigned char> bytes) {
+        check(fc_cloth_load_snapshot(handle_, bytes.data(), bytes.size()));
+    }
 
     void set_pinned(span<const uint32_t> indices) { check(fc_cloth_set_pinned(handle_, indices.data(), indices.size())); }
     void set_pin_weights(span<const float> weights) {
@@ -140,7 +189,12 @@ public:
         }
         check(fc_cloth_set_pin_targets(handle_, indices.data(), xyz.data(), indices.size()));
     }
+    /// The uniform water current, m/s, from the next step.
     void set_current(const Vec3f& current) { check(fc_cloth_set_current(handle_, current.data())); }
+    /// The current in double precision, exactly as the description holds it.
+    void set_current(const std::array<double, 3>& current) {
+        check(fc_cloth_set_current_f64(handle_, current.data()));
+    }
 
     void step(double dt) { check(fc_cloth_step(handle_, dt)); }
     void step_substeps(double dt, uint32_t substeps) { check(fc_cloth_step_substeps(handle_, dt, substeps)); }
@@ -271,6 +325,8 @@ public:
 
     /// Appends the cloth's current positions as the next frame.
     void write_frame(const Cloth& cloth) { check(fc_cache_write_frame(handle_, cloth.get())); }
+    /// Appends a frame of positions the host gives (3 floats per vertex, m).
+    void write_positions(span<const float> xyz) { check(fc_cache_write_positions(handle_, xyz.data(), xyz.size())); }
     /// Completes the file; throws if that fails. The handle is gone either way.
     void close() { check(fc_cache_close(std::exchange(handle_, nullptr))); }
 

@@ -47,9 +47,16 @@ pub fn compile_c_with(source: &str, flags: &[&str], out_dir: &Path) -> PathBuf {
 /// Compiles one C++ file from `examples_cpp/` against `bindings/cpp/fraccloth.hpp` with
 /// `c++ -std=c++17 -Wall -Wextra -Werror`.
 pub fn compile_cpp(source: &str, out_dir: &Path) -> PathBuf {
+    compile_cpp_with(source, &[], out_dir)
+}
+
+/// As [`compile_cpp`], with extra flags (e.g. more warnings).
+pub fn compile_cpp_with(source: &str, flags: &[&str], out_dir: &Path) -> PathBuf {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let include = format!("-I{}", root.join("bindings").join("cpp").display());
-    compile("c++", &["-std=c++17", &include], "examples_cpp", source, out_dir)
+    let mut all = vec!["-std=c++17", include.as_str()];
+    all.extend_from_slice(flags);
+    compile("c++", &all, "examples_cpp", source, out_dir)
 }
 
 fn compile(compiler: &str, flags: &[&str], dir: &str, source: &str, out_dir: &Path) -> PathBuf {
