@@ -1,9 +1,11 @@
 """Tests of the Python bindings: against the C example's output, numpy round trips, errors,
 meshes, colliders and caches."""
 
+import ctypes
 import os
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -202,3 +204,55 @@ def test_description_layout_matches_the_library():
     p = fraccloth.preset_desc(fraccloth.PRESET_FRACTIONAL_PAPER)
     assert (p.history_scheme, p.history_u) == (fraccloth.HISTORY_TRUNCATED, 3)
     assert fraccloth.version().count(".") == 2
+
+
+def test_generated_abi_matches_the_header():
+    script = REPO / "scripts" / "gen_python_abi.py"
+    if not script.exists():
+        pytest.skip("not in the repository")
+    subprocess.run([sys.executable, str(script), "--check"], check=True)
+
+
+def test_the_package_parses_as_python_3_8():
+    import ast
+
+    for path in Path(fraccloth.__file__).parent.glob("*.py"):
+        ast.parse(path.read_text(), filename=str(path), feature_version=(3, 8))
+
+
+def test_a_description_without_struct_size_is_refused_with_a_message():
+    d = fraccloth.FcClothDesc()  # all zero: not from default_desc()
+    with pytest.raises(fraccloth.Error) as e:
+        fraccloth.Cloth.grid(d)
+    assert "struct_size" in e.value.message
+    assert fraccloth.default_desc().struct_size == ctypes.sizeof(fraccloth.FcClothDesc)
+
+
+def test_snapshots_threads_and_solver():
+    desc = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
+    desc.width, desc.height, desc.spacing = 15, 11, 0.02
+    with fraccloth.Cloth.grid(desc) as cloth:
+        cloth.set_pinned(range(15))
+        cloth.threads = 1
+        assert cloth.threads == 1
+        cloth.set_current([0.0, 0.0, 0.1])
+        assert list(cloth.desc.current) == [0.0, 0.0, 0.1]
+        cloth.step(1e-3)
+        snap = cloth.save_snapshot()
+        cloth.step(1e-3)
+        after = cloth.positions_f64()
+        cloth.load_snapshot(snap)
+        cloth.step(1e-3)
+        assert np.array_equal(cloth.positions_f64(), after)
+        with pytest.raises(fraccloth.Error):
+            cloth.load_snapshot(snap[:-1])
+        d = cloth.desc
+        d.integrator = fraccloth.INTEGRATOR_IMPLICIT_EULER
+        cloth.desc = d
+        cloth.set_solver(1e-8, 300)
+        cloth.set_solver_accept_unconverged(False)
+        cloth.step(1.0 / 60.0)
+        stats = cloth.solver_stats()
+        assert stats.iterations > 0 and stats.residual <= 1e-8
+        assert cloth.triangle_count == cloth.triangles().shape[0] == 2 * 14 * 10
+        assert cloth.history_bytes_per_particle == 0
