@@ -492,7 +492,8 @@ FcStatus fc_cloth_create_grid(const FcClothDesc *desc, FcCloth **out_cloth);
  * Frees a cloth. NULL is fine. Using the handle afterwards is the host's bug.
  *
  * # Safety
- * `cloth` must be NULL or a handle from `fc_cloth_create_grid` not yet destroyed.
+ * `cloth` must be NULL or a handle from `fc_cloth_create_grid` or `fc_cloth_create_mesh` not yet
+ * destroyed.
  */
 void fc_cloth_destroy(FcCloth *cloth);
 

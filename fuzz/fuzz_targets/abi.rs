@@ -87,6 +87,8 @@ fn desc(b: &mut Bytes<'_>) -> FcClothDesc {
         8 => d.collision_margin = b.f64(),
         9 => d.total_mass = b.f64(),
         10 => d.solver_max_iterations = u32::from(b.u8()),
+        // Any size: one beyond the library's is refused before anything is read past it.
+        11 => d.struct_size = b.u32(),
         _ => {}
     }
     if d.width > 32 && u64::from(d.width) * u64::from(d.height.max(2)) < (1 << 24) {
@@ -94,7 +96,7 @@ fn desc(b: &mut Bytes<'_>) -> FcClothDesc {
     }
     d.history_scheme = u32::from(b.u8() % 5);
     d.history_u = u32::from(b.u8());
-    d.integrator = u32::from(b.u8() % 4);
+    d.integrator = u32::from(b.u8() % 6);
     d.spring_damping_mode = u32::from(b.u8() % 4);
     d.max_substep = if b.u8() % 4 == 0 { 1e-3 } else { 0.0 };
     d

@@ -131,7 +131,8 @@ pub(crate) unsafe fn create(
 /// Frees a cloth. NULL is fine. Using the handle afterwards is the host's bug.
 ///
 /// # Safety
-/// `cloth` must be NULL or a handle from `fc_cloth_create_grid` not yet destroyed.
+/// `cloth` must be NULL or a handle from `fc_cloth_create_grid` or `fc_cloth_create_mesh` not yet
+/// destroyed.
 #[no_mangle]
 pub unsafe extern "C" fn fc_cloth_destroy(cloth: *mut FcCloth) {
     guard_value((), || {
