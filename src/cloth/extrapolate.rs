@@ -45,12 +45,21 @@ impl Cloth {
         self.advance(h, f1)?;
         probe.restore(self);
         // Two half steps. At the middle a soft pin's goal is half-way along its straight path; a
-        // hard pin's is on the parabola through its last position (from its velocity, the last
-        // step's secant), its position and its goal: `5/8 x_n + 3/8 x_{n+1} + h/8 v_n`, third-order
-        // accurate where the straight line is second-order, which would leave the half steps'
-        // pin velocities with a first-order error that both runs share and no extrapolation
-        // removes.
+        // hard pin's is on a parabola, third-order accurate where the straight line is
+        // second-order, which would leave the half steps' pin velocities with a first-order error
+        // that both runs share and no extrapolation removes. Extrapolated symplectic Euler: the
+        // parabola through the pin's position with its velocity there (exact to second order:
+        // the extrapolation below makes a pin's velocity the parabola's slope at the end of the
+        // step) and its goal, `3/4 x_n + 1/4 x_{n+1} + h/4 v_n`. Extrapolated implicit Euler: the
+        // parabola through the last position (its velocity read as the last step's secant), the
+        // position and the goal, `5/8 x_n + 3/8 x_{n+1} + h/8 v_n` (which leaves a pin's stored
+        // velocity h/6 behind; that integrator measured best so, docs/accuracy.md).
         let fmid = 0.5 * (f0 + f1.unwrap_or(1.0));
+        let (wx, wend, wv) = if self.config.integrator.is_implicit() {
+            (0.625, 0.375, 0.125)
+        } else {
+            (0.75, 0.25, 0.25)
+        };
         let s = &mut self.scratch;
         s.mid_goal.clear();
         for (k, &i) in self.pin_list.iter().enumerate() {
@@ -58,7 +67,7 @@ impl Cloth {
             let along = |f: f64| s.pin_start[k] + f * (self.pin_target[i] - s.pin_start[k]);
             let end = f1.map_or(self.pin_target[i], along);
             s.mid_goal.push(if self.pinned[i] {
-                0.625 * self.x[i] + 0.375 * end + (0.125 * h) * self.v[i]
+                wx * self.x[i] + wend * end + (wv * h) * self.v[i]
             } else {
                 along(fmid)
             });
@@ -67,7 +76,10 @@ impl Cloth {
         let first = self.advance(0.5 * h, Some(fmid));
         self.scratch.mid_goal_set = false;
         first?;
-        self.advance(0.5 * h, f1)?;
+        self.scratch.second_half = true;
+        let second = self.advance(0.5 * h, f1);
+        self.scratch.second_half = false;
+        second?;
         for (x, whole) in self.x.iter_mut().zip(&probe.x) {
             *x = 2.0 * *x - whole;
         }

@@ -64,6 +64,8 @@ pub(super) struct StepScratch {
     /// step, used instead of `pin_goals`' when `mid_goal_set` (`extrapolate.rs`).
     pub mid_goal: Vec<Vec3>,
     pub mid_goal_set: bool,
+    /// Set during the second half step of an extrapolated step (`extrapolate.rs`).
+    pub second_half: bool,
     /// Vertex normals of the proposed state (with added mass only).
     pub normals_new: Vec<Vec3>,
     /// Rotation-invariant fractional springs only (`forces/strain.rs`): each spring's rate of
@@ -213,11 +215,18 @@ impl Cloth {
         let rate = forces::spring_rate(&self.config.model);
         let current = self.config.model.current;
         // A hard pin's step velocity is its goal's secant, the velocity half a step ahead. The
-        // second-order integrators give the history (and this step's D^{1/2}) the pin's velocity
-        // at the start of the step instead, the mean of that secant and the last one: the
-        // history keeps every sample, so a first-order error in them would never be extrapolated
-        // away. The first-order integrators keep the secant (and their bits).
-        let central_pins = self.config.integrator.is_extrapolated();
+        // second-order integrators give the history (and this step's D^{1/2}) a velocity without
+        // that first-order offset instead: the history keeps every sample, so an error in them
+        // would never be extrapolated away. Extrapolated symplectic Euler takes, as for every
+        // free particle, the velocity at the start of the (half) step: the pin's stored velocity,
+        // which its extrapolation makes exact to second order, or in the second half step the
+        // mean of the two half steps' secants (the parabola's slope at the middle). Extrapolated
+        // implicit Euler takes the mean of the last secant and this one. The first-order
+        // integrators keep the secant (and their bits).
+        let integrator = self.config.integrator;
+        let central_pins = integrator.is_extrapolated();
+        let start_pins = central_pins && !integrator.is_implicit();
+        let second_half = s.second_half;
         // A tile walk transposes its own spring inputs; only other topologies need them here.
         let arrays = self.topology.tiled.is_none();
         let (sx, sq) = s.force_pass.spring_arrays(if arrays { n } else { 0 });
@@ -269,7 +278,9 @@ impl Cloth {
                 for &i in pins.iter().take_while(|&&i| (i as usize) < hi) {
                     let (p, k) = (i as usize, i as usize - first);
                     v_step[k] = (goal[p] - x[k]) / h;
-                    v_rel[k] = if central_pins {
+                    v_rel[k] = if start_pins && !second_half {
+                        v[k] - current
+                    } else if central_pins {
                         0.5 * (v[k] + v_step[k]) - current
                     } else {
                         v_step[k] - current
