@@ -189,7 +189,7 @@ typedef enum {
 typedef struct FcCache FcCache;
 
 /**
- * Opaque handle to one simulated cloth. Create with `fc_cloth_create_grid`,
+ * Opaque handle to one simulated cloth. Create with `fc_cloth_create_grid` or `fc_cloth_create_mesh`,
  * free with `fc_cloth_destroy`.
  */
 typedef struct FcCloth FcCloth;

@@ -45,21 +45,13 @@ impl Cloth {
         self.advance(h, f1)?;
         probe.restore(self);
         // Two half steps. At the middle a soft pin's goal is half-way along its straight path; a
-        // hard pin's is on a parabola, third-order accurate where the straight line is
-        // second-order, which would leave the half steps' pin velocities with a first-order error
-        // that both runs share and no extrapolation removes. Extrapolated symplectic Euler: the
-        // parabola through the pin's position with its velocity there (exact to second order:
-        // the extrapolation below makes a pin's velocity the parabola's slope at the end of the
-        // step) and its goal, `3/4 x_n + 1/4 x_{n+1} + h/4 v_n`. Extrapolated implicit Euler: the
-        // parabola through the last position (its velocity read as the last step's secant), the
-        // position and the goal, `5/8 x_n + 3/8 x_{n+1} + h/8 v_n` (which leaves a pin's stored
-        // velocity h/6 behind; that integrator measured best so, docs/accuracy.md).
+        // hard pin's is on the parabola through its last position (from its velocity, the last
+        // step's secant), its position and its goal: `5/8 x_n + 3/8 x_{n+1} + h/8 v_n`, third-order
+        // accurate where the straight line is second-order, which would leave the half steps'
+        // pin velocities with a first-order error that both runs share and no extrapolation
+        // removes.
         let fmid = 0.5 * (f0 + f1.unwrap_or(1.0));
-        let (wx, wend, wv) = if self.config.integrator.is_implicit() {
-            (0.625, 0.375, 0.125)
-        } else {
-            (0.75, 0.25, 0.25)
-        };
+
         let s = &mut self.scratch;
         s.mid_goal.clear();
         for (k, &i) in self.pin_list.iter().enumerate() {
@@ -67,7 +59,7 @@ impl Cloth {
             let along = |f: f64| s.pin_start[k] + f * (self.pin_target[i] - s.pin_start[k]);
             let end = f1.map_or(self.pin_target[i], along);
             s.mid_goal.push(if self.pinned[i] {
-                wx * self.x[i] + wend * end + (wv * h) * self.v[i]
+                0.625 * self.x[i] + 0.375 * end + (0.125 * h) * self.v[i]
             } else {
                 along(fmid)
             });
@@ -76,15 +68,24 @@ impl Cloth {
         let first = self.advance(0.5 * h, Some(fmid));
         self.scratch.mid_goal_set = false;
         first?;
-        self.scratch.second_half = true;
-        let second = self.advance(0.5 * h, f1);
-        self.scratch.second_half = false;
-        second?;
+        self.advance(0.5 * h, f1)?;
         for (x, whole) in self.x.iter_mut().zip(&probe.x) {
             *x = 2.0 * *x - whole;
         }
         for (v, whole) in self.v.iter_mut().zip(&probe.v) {
             *v = 2.0 * *v - whole;
+        }
+        if !self.config.integrator.is_implicit() {
+            // Symplectic: a hard pin keeps the whole step's secant, the slope of its path half a
+            // step back, which is what the next step's mid goal and history sample read it as.
+            // (Extrapolating it too would feed the last velocity into the next through the mid
+            // goal, a recurrence whose error after a kink in the path never dies out.)
+            for &i in &self.pin_list {
+                let i = i as usize;
+                if self.pinned[i] {
+                    self.v[i] = probe.v[i];
+                }
+            }
         }
         self.steps = steps + 1;
         let max2 = self.config.max_speed * self.config.max_speed;

@@ -64,8 +64,6 @@ pub(super) struct StepScratch {
     /// step, used instead of `pin_goals`' when `mid_goal_set` (`extrapolate.rs`).
     pub mid_goal: Vec<Vec3>,
     pub mid_goal_set: bool,
-    /// Set during the second half step of an extrapolated step (`extrapolate.rs`).
-    pub second_half: bool,
     /// Vertex normals of the proposed state (with added mass only).
     pub normals_new: Vec<Vec3>,
     /// Rotation-invariant fractional springs only (`forces/strain.rs`): each spring's rate of
@@ -215,18 +213,17 @@ impl Cloth {
         let rate = forces::spring_rate(&self.config.model);
         let current = self.config.model.current;
         // A hard pin's step velocity is its goal's secant, the velocity half a step ahead. The
-        // second-order integrators give the history (and this step's D^{1/2}) a velocity without
-        // that first-order offset instead: the history keeps every sample, so an error in them
-        // would never be extrapolated away. Extrapolated symplectic Euler takes, as for every
-        // free particle, the velocity at the start of the (half) step: the pin's stored velocity,
-        // which its extrapolation makes exact to second order, or in the second half step the
-        // mean of the two half steps' secants (the parabola's slope at the middle). Extrapolated
-        // implicit Euler takes the mean of the last secant and this one. The first-order
-        // integrators keep the secant (and their bits).
+        // second-order integrators give the history (and this step's D^{1/2}) the slope of the
+        // pin's path at the start of the (half) step instead: the history keeps every sample, so
+        // a first-order error in them would never be extrapolated away. Its stored velocity is
+        // read as the last secant, half a step back (what extrapolated symplectic Euler leaves
+        // it; extrapolated implicit Euler extrapolates it and measured best so), giving the mean
+        // of it and this secant; in the first half step, whose secant reaches only a quarter
+        // step ahead, `(S_prev + 2 S_1) / 3`. The first-order integrators keep the secant.
         let integrator = self.config.integrator;
         let central_pins = integrator.is_extrapolated();
         let start_pins = central_pins && !integrator.is_implicit();
-        let second_half = s.second_half;
+        let first_half = s.mid_goal_set;
         // A tile walk transposes its own spring inputs; only other topologies need them here.
         let arrays = self.topology.tiled.is_none();
         let (sx, sq) = s.force_pass.spring_arrays(if arrays { n } else { 0 });
@@ -278,8 +275,10 @@ impl Cloth {
                 for &i in pins.iter().take_while(|&&i| (i as usize) < hi) {
                     let (p, k) = (i as usize, i as usize - first);
                     v_step[k] = (goal[p] - x[k]) / h;
-                    v_rel[k] = if start_pins && !second_half {
-                        v[k] - current
+                    v_rel[k] = if start_pins && first_half {
+                        // The slope at the start from the last whole secant (a step back) and
+                        // this half step's: p'(0) = S_prev / 3 + 2 S_1 / 3 on a parabola.
+                        (v[k] + 2.0 * v_step[k]) / 3.0 - current
                     } else if central_pins {
                         0.5 * (v[k] + v_step[k]) - current
                     } else {

@@ -5,7 +5,7 @@ use crate::{Cloth, Vec3};
 use super::desc::FcClothDesc;
 use super::status::{guard, guard_value, FcStatus, FfiError};
 
-/// Opaque handle to one simulated cloth. Create with `fc_cloth_create_grid`,
+/// Opaque handle to one simulated cloth. Create with `fc_cloth_create_grid` or `fc_cloth_create_mesh`,
 /// free with `fc_cloth_destroy`.
 pub struct FcCloth {
     pub(crate) cloth: Cloth,
