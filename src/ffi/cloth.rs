@@ -351,6 +351,15 @@ pub unsafe extern "C" fn fc_cloth_get_velocities(
 /// `cloth` NULL or live; `xyz` NULL or 3 readable floats.
 #[no_mangle]
 pub unsafe extern "C" fn fc_cloth_set_current(cloth: *mut FcCloth, xyz: *const f32) -> FcStatus {
+    // SAFETY: forwarded caller promises.
+    unsafe { set_current_from(cloth, xyz) }
+}
+
+/// `fc_cloth_set_current` from three values of either precision.
+///
+/// # Safety
+/// `cloth` NULL or live; `xyz` NULL or 3 readable values.
+pub(crate) unsafe fn set_current_from<T: Copy + Into<f64>>(cloth: *mut FcCloth, xyz: *const T) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { handle_mut(cloth) }?;

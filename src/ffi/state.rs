@@ -108,11 +108,6 @@ pub unsafe extern "C" fn fc_cloth_get_velocities_f64(
 /// `cloth` NULL or live; `xyz` NULL or 3 readable doubles.
 #[no_mangle]
 pub unsafe extern "C" fn fc_cloth_set_current_f64(cloth: *mut FcCloth, xyz: *const f64) -> FcStatus {
-    guard(|| {
-        // SAFETY: forwarded caller promises.
-        let cloth = unsafe { handle_mut(cloth) }?;
-        let xyz = unsafe { slice_in(xyz, 3, "xyz") }?;
-        let c = triples(xyz, "current")?;
-        Ok(cloth.set_current(c[0])?)
-    })
+    // SAFETY: forwarded caller promises.
+    unsafe { super::cloth::set_current_from(cloth, xyz) }
 }
