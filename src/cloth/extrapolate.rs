@@ -51,7 +51,6 @@ impl Cloth {
         // pin velocities with a first-order error that both runs share and no extrapolation
         // removes.
         let fmid = 0.5 * (f0 + f1.unwrap_or(1.0));
-
         let s = &mut self.scratch;
         s.mid_goal.clear();
         for (k, &i) in self.pin_list.iter().enumerate() {
