@@ -625,27 +625,21 @@ impl Cloth {
         Ok(())
     }
 
-    /// Total mechanical energy (J): kinetic (with the water's added mass for normal motion,
-    /// `1/2 m_a (v . n)^2`) + spring + potential of the net weight in water.
+    /// Total mechanical energy (J): kinetic with the water's inertia (`1/2 v^T M v`,
+    /// [`forces::Inertia`]) + spring + potential of the net weight in water.
     pub fn energy(&self) -> f64 {
         let m = &self.config.model;
-        let mut e = 0.0;
-        for ((x, v), &mass) in self.x.iter().zip(&self.v).zip(&self.topology.masses) {
-            e += 0.5 * mass * v.norm_squared() - forces::body_force(m, mass).dot(x);
-        }
-        for (v, &area) in self.v.iter().zip(&self.topology.areas) {
-            if m.water.entrained_mass != 0.0 {
-                e += 0.5 * forces::entrained_mass(m, area) * v.norm_squared();
-            }
-        }
+        let t = &self.topology;
+        let mut normals = vec![Vec3::zeros(); self.x.len()];
         if m.water.added_mass != 0.0 {
-            let mut normals = vec![Vec3::zeros(); self.x.len()];
-            forces::vertex_normals(&self.x, &self.topology.triangles, &mut normals);
-            for ((v, n), &area) in self.v.iter().zip(&normals).zip(&self.topology.areas) {
-                e += 0.5 * forces::added_mass(m, area) * v.dot(n).powi(2);
-            }
+            forces::vertex_normals(&self.x, &t.triangles, &mut normals);
         }
-        for s in &self.topology.springs {
+        let mut e = 0.0;
+        for (i, (x, v)) in self.x.iter().zip(&self.v).enumerate() {
+            let inertia = forces::Inertia::of(m, t.masses[i], t.areas[i], normals[i]);
+            e += inertia.kinetic_energy(v) - forces::body_force(m, t.masses[i]).dot(x);
+        }
+        for s in &t.springs {
             let k = m.stiffness(s.kind);
             let d = (self.x[s.i as usize] - self.x[s.j as usize]).norm() - s.rest;
             e += 0.5 * k * d * d;

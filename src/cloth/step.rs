@@ -371,9 +371,9 @@ impl Cloth {
             let r = tile.p0..tile.p0 + tile.force[0].len();
             // SAFETY: each tile is handed over once and tiles are disjoint.
             let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
-            // With added mass the step needs M^{-1} f: the effective force of `added_mass.rs`.
+            // With the water's inertia the step needs M^{-1} f (`forces/inertia.rs`).
             let mut effective;
-            let force = match (forces::has_added_inertia(model), tile.normals) {
+            let force = match (forces::carries_water(model), tile.normals) {
                 (true, Some(n)) => {
                     let len = r.len();
                     effective = [[0.0; TILE]; 3];
@@ -470,25 +470,24 @@ impl Cloth {
     }
 
     /// With added mass, the normal turning over the step must not create kinetic energy: a
-    /// particle whose kinetic energy `1/2 (m |v|^2 + m_a (v . n)^2)` is larger with the new
-    /// normal than with the step's is slowed to the step's (never sped up). The water's added
-    /// mass depends on the normal, and solving `M(n) a = f` alone does not conserve energy as n
-    /// turns (`forces/added_mass.rs`).
+    /// particle whose kinetic energy is larger with the new normal than with the step's is
+    /// slowed to the step's (never sped up). The water's added mass depends on the normal, and
+    /// solving `M(n) a = f` alone does not conserve energy as n turns (`forces/inertia.rs`).
     fn added_mass_energy(&mut self) {
         let m = &self.config.model;
         if m.water.added_mass == 0.0 {
             return;
         }
-        let entrained = |i: usize| forces::entrained_mass(m, self.topology.areas[i]);
+        let t = &self.topology;
         let s = &mut self.scratch;
         s.normals_new.resize(s.x_new.len(), Vec3::zeros());
-        forces::vertex_normals(&s.x_new, &self.topology.triangles, &mut s.normals_new);
+        forces::vertex_normals(&s.x_new, &t.triangles, &mut s.normals_new);
         let old = s.force_pass.normals();
         for i in 0..s.v_new.len() {
-            let (v, mass) = (s.v_new[i], self.topology.masses[i] + entrained(i));
-            let ma = forces::added_mass(m, self.topology.areas[i]);
-            let t_old = mass * v.norm_squared() + ma * v.dot(&old[i]).powi(2);
-            let t_new = mass * v.norm_squared() + ma * v.dot(&s.normals_new[i]).powi(2);
+            let v = s.v_new[i];
+            let inertia = forces::Inertia::of(m, t.masses[i], t.areas[i], old[i]);
+            let t_old = inertia.twice_kinetic(&v);
+            let t_new = inertia.twice_kinetic_along(&v, &s.normals_new[i]);
             if t_new > t_old && t_new > 0.0 {
                 s.v_new[i] = v * (t_old / t_new).sqrt();
             }

@@ -54,10 +54,9 @@ pub struct Linearisation {
     pub damping: Vec<Matrix3<f64>>,
     /// Per-particle `-df/dx`.
     pub stiffness: Vec<Matrix3<f64>>,
-    /// Per-particle added mass for normal motion, the unit normal it acts along, and the
-    /// entrained mass (empty when the model has none): the mass matrix is
-    /// `(m + m_e) I + m_a n n^T`.
-    pub added_mass: Vec<(f64, Vec3, f64)>,
+    /// Per-particle inertia at the start of the step (empty when the model carries no water:
+    /// the mass matrix is then `m I`).
+    pub inertia: Vec<super::Inertia>,
 }
 
 fn outer(a: &Vec3) -> Matrix3<f64> {
@@ -117,11 +116,10 @@ pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Li
         out.damping[i] = b.damping;
         out.stiffness[i] = b.stiffness;
     }
-    out.added_mass.clear();
-    if super::has_added_inertia(m) {
-        out.added_mass.extend((0..n).map(|i| {
-            let a = input.topology.areas[i];
-            (super::added_mass(m, a), normals[i], super::entrained_mass(m, a))
-        }));
+    out.inertia.clear();
+    if super::carries_water(m) {
+        let t = input.topology;
+        out.inertia
+            .extend((0..n).map(|i| super::Inertia::of(m, t.masses[i], t.areas[i], normals[i])));
     }
 }

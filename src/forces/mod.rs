@@ -8,17 +8,17 @@
 //! | `drag.rs` | Eq. 3 viscous, Eq. 4 history, and normal drag |
 //! | `contact.rs` | collider contacts and friction |
 //! | `strain.rs` | the rotation-invariant fractional spring: D^{1/2} of each spring's elongation |
-//! | `added_mass.rs` | the water's added mass for normal motion (an inertia: Sherman-Morrison) |
+//! | `inertia.rs` | a particle's inertia: its mass and the water it carries (the mass matrix, its inverse, its energy) |
 //! | `terms.rs` | the list of per-particle terms, what each reads, its Jacobian block |
 //! | `jacobian.rs` | the linearised forces of the implicit integrator |
 //! | `pass.rs` | the force pass: spring sums plus terms, tile by tile |
 //! | `tiles.rs`, `inputs.rs`, `assemble.rs`, `normals.rs` | how the pass sums springs and reads its inputs |
 
-mod added_mass;
 mod assemble;
 mod body;
 mod contact;
 mod drag;
+mod inertia;
 mod inputs;
 mod jacobian;
 mod normals;
@@ -28,7 +28,7 @@ pub mod strain;
 pub(crate) mod terms;
 mod tiles;
 
-pub use added_mass::{added_mass, effective_forces, entrained_mass, has_added_inertia};
+pub use inertia::{carries_water, effective_forces, Inertia};
 pub use assemble::add_spring_values;
 pub use body::{body_acceleration, body_force};
 pub use contact::{apply_friction, friction_active, Capsule, Collider, Plane, Sphere};

@@ -256,7 +256,7 @@ const CONTACTS: Term = Term {
 /// force, reads the normals too).
 pub fn reads(m: &Model, colliders: bool) -> Reads {
     let mass = Reads {
-        normals: super::has_added_inertia(m),
+        normals: super::carries_water(m),
         ..Reads::NONE
     };
     TERMS

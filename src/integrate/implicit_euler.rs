@@ -6,8 +6,8 @@
 //! `D^{1/2}x = w0 v + H`: `w0` enters `C` as damping, `H` (the past, lagged by one step)
 //! stays in `f_n` as a known force. Pinned particles are filtered out of the solve (their
 //! velocity is prescribed). The system is solved matrix-free by block-Jacobi
-//! preconditioned CG ([`super::cg`]). The water's added mass for normal motion enters `M` as
-//! `m_a n n^T` per particle (`forces/added_mass.rs`), in the product and the preconditioner.
+//! preconditioned CG ([`super::cg`]). The water's inertia enters `M` per particle
+//! ([`crate::forces::Inertia`]), in the product and the preconditioner.
 //!
 //! Unconditionally stable for the linearised cloth; first order in time.
 
@@ -81,8 +81,8 @@ fn apply_system(
         for (k, o) in chunk.iter_mut().enumerate() {
             let i = first + k;
             *o = inp.masses[i] * p[i] + h * (lin.damping[i] * p[i]) + h * h * (lin.stiffness[i] * p[i]);
-            if let Some((ma, n, me)) = lin.added_mass.get(i) {
-                *o += *me * p[i] + (ma * n.dot(&p[i])) * n;
+            if let Some(inertia) = lin.inertia.get(i) {
+                *o += inertia.water_times(&p[i]);
             }
         }
         add_spring_values(inp.topology, first, values, -1.0, chunk);
@@ -155,8 +155,8 @@ pub fn implicit_euler(
         for (k, m) in chunk.iter_mut().enumerate() {
             let i = first + k;
             *m = inp.masses[i] * Matrix3::identity() + h * lin.damping[i] + h * h * lin.stiffness[i];
-            if let Some((ma, n, me)) = lin.added_mass.get(i) {
-                *m += *me * Matrix3::identity() + *ma * (n * n.transpose());
+            if let Some(inertia) = lin.inertia.get(i) {
+                *m += inertia.water_matrix();
             }
         }
         add_spring_values(t, first, matrices, 1.0, chunk);
