@@ -156,7 +156,8 @@ impl Cloth {
     pub fn new(topology: Topology, config: ClothConfig) -> Result<Self, Error> {
         let config = checked_config(config, topology.width())?;
         let n = topology.vertex_count();
-        let scheme = if config.model.uses_half_derivative() {
+        let memories = forces::memories(&config.model);
+        let scheme = if memories.particles {
             config.scheme
         } else {
             Scheme::Off
@@ -185,7 +186,7 @@ impl Cloth {
             friction: Vec::new(),
             history: History::new(scheme, n)?,
             strain_history: History::new(
-                if config.model.uses_strain_history() {
+                if memories.springs {
                     config.scheme
                 } else {
                     Scheme::Off
@@ -223,8 +224,7 @@ impl Cloth {
                 config.scheme.name()
             )));
         }
-        let needs = |m: &Model| (m.uses_half_derivative(), m.uses_strain_history());
-        if needs(&config.model) != needs(&old.model) {
+        if forces::memories(&config.model) != forces::memories(&old.model) {
             return Err(Error::invalid(
                 "the model's fractional terms (history drag, fractional springs) must be on or off as when the cloth was created: the history it keeps was sized then; create a new cloth, or set a coefficient to a tiny value instead of 0",
             ));

@@ -112,19 +112,6 @@ impl Water {
 }
 
 impl Model {
-    /// True when some term needs D^{1/2}x, so a history must be kept.
-    pub fn uses_half_derivative(&self) -> bool {
-        self.history_drag != 0.0
-            || self.water.history_drag != 0.0
-            || (self.spring_damping_mode == SpringDamping::Fractional && self.spring_damping != 0.0)
-    }
-
-    /// True when the springs damp the half-derivative of their elongation, so a history per
-    /// spring must be kept ([`SpringDamping::FractionalStrain`]).
-    pub fn uses_strain_history(&self) -> bool {
-        self.spring_damping_mode == SpringDamping::FractionalStrain && self.spring_damping != 0.0
-    }
-
     /// Damping constant of a spring family: `spring_damping` times the family's scale.
     pub fn spring_damping_of(&self, kind: SpringKind) -> f64 {
         self.spring_damping * self.spring_damping_scale[kind as usize]

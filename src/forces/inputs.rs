@@ -1,7 +1,7 @@
 //! What a tile walk ([`super::tiles`]) reads of the particles, as component arrays, for the
 //! particles around the walk's current tile only: positions and the rate the spring damping
 //! acts on (for the springs), and the velocities and half-derivatives a tile's drag and
-//! integrator read (for [`super::accumulate_tiles_soa`]).
+//! integrator read (for the force pass's tiles, [`super::for_each_tile`]).
 //!
 //! The spring kernel reads each particle about sixteen times per step (two ends of eight runs on
 //! a grid), and the drag and integrator loops are several times faster on component arrays than

@@ -9,6 +9,7 @@
 //! | `contact.rs` | collider contacts and friction |
 //! | `strain.rs` | the rotation-invariant fractional spring: D^{1/2} of each spring's elongation |
 //! | `inertia.rs` | a particle's inertia: its mass and the water it carries (the mass matrix, its inverse, its energy) |
+//! | `memories.rs` | which half-derivative histories a model keeps, derived from what its terms read |
 //! | `terms.rs` | the list of per-particle terms, what each reads, its Jacobian block |
 //! | `jacobian.rs` | the linearised forces of the implicit integrator |
 //! | `pass.rs` | the force pass: spring sums plus terms, tile by tile |
@@ -21,6 +22,7 @@ mod drag;
 mod inertia;
 mod inputs;
 mod jacobian;
+mod memories;
 mod normals;
 mod pass;
 mod springs;
@@ -28,11 +30,12 @@ pub mod strain;
 pub(crate) mod terms;
 mod tiles;
 
-pub use inertia::{carries_water, effective_forces, Inertia};
 pub use assemble::add_spring_values;
 pub use body::{body_acceleration, body_force};
 pub use contact::{apply_friction, friction_active, Capsule, Collider, Plane, Sphere};
+pub use inertia::{carries_water, effective_forces, Inertia};
 pub use jacobian::{linearise, Linearisation, SpringBlock};
+pub use memories::{memories, Memories};
 pub use normals::{vertex_normals, vertex_normals_with};
 pub use pass::{
     for_each_tile, total_forces, total_forces_with, ForceInput, ForceScratch, SpringInputs, TileTotals,

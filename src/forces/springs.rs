@@ -25,7 +25,6 @@ use crate::topology::{for_each_piece, SpringKind, SpringRun};
 #[derive(Clone, Copy)]
 pub(super) struct Params<'a> {
     pub stiffness: [f64; 3],
-    /// Damping coefficient, 0 when the springs are undamped.
     /// Damping constant of each family (stretch, shear, bend); 0 when the springs are undamped.
     pub kd: [f64; 3],
     /// Positions, one array per component.
@@ -177,7 +176,6 @@ fn run_kernel<'a, const UNIFORM: bool>(
     };
     let rest_at = |t: usize| if UNIFORM { uniform_rest } else { rest[t] };
     let kd = p.kd[p.kinds[first_spring] as usize];
-    // Out-of-range squared lengths (see `inverse_length`) fall back to the exact kernel.
     // A squared length outside `[SEED_MIN, SEED_MAX]` (see `inverse_length`), or NaN: the slice
     // is done again exactly.
     let mut outside = false;

@@ -98,10 +98,12 @@ pub struct Blocks {
 
 /// A per-particle force term.
 pub struct Term {
-    /// What it is, for people reading the list.
-    #[allow(dead_code)]
+    /// What it is, for people reading the list (and the tests' messages).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub name: &'static str,
-    /// Whether the term is on for this model (with or without colliders present).
+    /// Whether the term is on for this model (with or without colliders present). What it
+    /// reads is then kept for it: [`Reads::half_derivative`] alone decides whether the cloth
+    /// keeps a history (`memories.rs`).
     pub on: fn(&Model, bool) -> bool,
     pub reads: Reads,
     /// Adds the term's forces (N) on the tile's particles to `f`.
@@ -290,4 +292,129 @@ pub fn linearise_all(c: &Context<'_>, p: &Particle<'_>) -> Blocks {
         }
     }
     b
+}
+
+#[cfg(test)]
+mod tests {
+    //! Each term's Jacobian block against a central difference of its force.
+    use super::*;
+    use crate::forces::Plane;
+    use crate::model::RegularDrag;
+
+    /// One particle as a tile: its force from `add` at position `x`, velocity `v` and
+    /// D^{1/2}x = `w0 v + past`.
+    fn force(c: &Context<'_>, term: &Term, x: Vec3, v: Vec3, w0: f64, past: Vec3, n: Vec3) -> Vec3 {
+        let half = w0 * v + past;
+        let (xs, vs, hs) = (
+            [[x.x], [x.y], [x.z]],
+            [[v.x], [v.y], [v.z]],
+            [[half.x], [half.y], [half.z]],
+        );
+        let normals = [n];
+        let tile = Tile {
+            x: [&xs[0], &xs[1], &xs[2]],
+            v: [&vs[0], &vs[1], &vs[2]],
+            half: Some([&hs[0], &hs[1], &hs[2]]),
+            normals: Some(&normals),
+            masses: &[2e-4],
+            areas: &[1.5e-4],
+        };
+        let mut f = [[0.0], [0.0], [0.0]];
+        let [a, b, d] = &mut f;
+        (term.add)(c, &tile, [a, b, d]);
+        Vec3::new(f[0][0], f[1][0], f[2][0])
+    }
+
+    /// `-df/du` at u = 0 by central differences, `f(u)` the force with the position or the
+    /// velocity shifted by u.
+    fn minus_jacobian(f: impl Fn(Vec3) -> Vec3) -> Matrix3<f64> {
+        let mut j = Matrix3::zeros();
+        for a in 0..3 {
+            let e = 1e-7 * Vec3::ith(a, 1.0);
+            j.set_column(a, &(-(f(e) - f(-e)) / 2e-7));
+        }
+        j
+    }
+
+    #[test]
+    fn every_terms_blocks_match_a_central_difference_of_its_force() {
+        // Every coefficient on, a current, and a plane the particle is inside the margin of.
+        let mut m = Model::regular(RegularDrag::ViscousAndNormal);
+        m.history_drag = 2e-3;
+        m.water.viscous_drag = 3.0;
+        m.water.history_drag = 4.0;
+        m.water.normal_drag = 5.0;
+        m.water.form_drag = 1.2;
+        m.water.skin_drag = 0.7;
+        m.current = Vec3::new(0.05, -0.02, 0.01);
+        let plane = Collider::Plane(Plane {
+            point: Vec3::new(0.0, -0.004, 0.0),
+            normal: Vec3::new(0.1, 1.0, 0.2).normalize(),
+            velocity: Vec3::new(0.0, 0.3, 0.0),
+        });
+        let colliders = [plane];
+        let c = Context {
+            model: &m,
+            gravity: crate::forces::body_acceleration(&m),
+            colliders: &colliders,
+        };
+        let x = Vec3::new(0.001, 0.0, 0.002);
+        let v = Vec3::new(0.11, -0.23, 0.31);
+        let n = Vec3::new(0.2, -0.3, 0.9).normalize();
+        let w0 = 0.37;
+        let mut checked = 0;
+        for term in TERMS.iter().filter(|t| (t.on)(&m, true)) {
+            let mut b = Blocks {
+                damping: Matrix3::zeros(),
+                stiffness: Matrix3::zeros(),
+            };
+            if let Some(lin) = term.linearise {
+                let p = Particle {
+                    x: &x,
+                    v: &v,
+                    normal: &n,
+                    w0,
+                    area: 1.5e-4,
+                };
+                lin(&c, &p, &mut b);
+            }
+            // The history drag reads D^{1/2}x = w0 v + H. Its block keeps the part along the
+            // relative velocity and drops the part across it (which would make the system
+            // non-symmetric): exact when the past H is zero and D^{1/2}x lies along the
+            // velocity, and checked there along the velocity only.
+            let history = term.reads.half_derivative;
+            // With the current, D^{1/2}x (of the displacement relative to the water) is
+            // w0 v_rel when the past is -w0 times the current.
+            let past = if history {
+                -w0 * m.current
+            } else {
+                Vec3::new(0.01, 0.02, -0.03)
+            };
+            let jv = minus_jacobian(|u| force(&c, term, x, v + u, w0, past, n));
+            let jx = minus_jacobian(|u| force(&c, term, x + u, v, w0, past, n));
+            let (jv, damping) = if history {
+                let u = (v - m.current).normalize();
+                let along = |a: &Matrix3<f64>| Matrix3::from_element((u.transpose() * a * u)[0]);
+                (along(&jv), along(&b.damping))
+            } else {
+                (jv, b.damping)
+            };
+            let scale = jv.norm().max(damping.norm()).max(1e-12);
+            assert!(
+                (jv - damping).norm() < 1e-6 * scale,
+                "{}: -df/dv\n{jv}\nagainst its damping block\n{damping}",
+                term.name
+            );
+            let scale = jx.norm().max(b.stiffness.norm()).max(1e-12);
+            assert!(
+                (jx - b.stiffness).norm() < 1e-6 * scale,
+                "{}: -df/dx\n{jx}\nagainst its stiffness block\n{}",
+                term.name,
+                b.stiffness
+            );
+            checked += 1;
+        }
+        // Weight, viscous, history, normal, form and skin drag and contacts: all on.
+        assert_eq!(checked, TERMS.len());
+    }
 }

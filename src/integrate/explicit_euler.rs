@@ -13,7 +13,7 @@ crate::simd_dispatch! { pub fn explicit_euler_soa(s: &StepInput<'_>, x_new: &mut
 #[inline(always)]
 fn explicit_euler_soa_kernel(s: &StepInput<'_>, x_new: &mut [Vec3], v_new: &mut [Vec3]) -> bool {
     let h = s.h;
-    // x += h v and v += (h / m) f, both from the old state: as in the `Vec3` kernel above.
+    // x += h v and v += (h / m) f, both from the old state.
     step_soa_with(s, x_new, v_new, |x, v, f, hm| {
         (
             std::array::from_fn(|c| x[c] + h * v[c]),

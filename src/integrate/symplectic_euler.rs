@@ -13,7 +13,7 @@ crate::simd_dispatch! { pub fn symplectic_euler_soa(s: &StepInput<'_>, x_new: &m
 #[inline(always)]
 fn symplectic_euler_soa_kernel(s: &StepInput<'_>, x_new: &mut [Vec3], v_new: &mut [Vec3]) -> bool {
     let h = s.h;
-    // v += (h / m) f, then x += h v_new: as in the `Vec3` kernel above.
+    // v += (h / m) f, then x += h v_new.
     step_soa_with(s, x_new, v_new, |x, v, f, hm| {
         let vn: [f64; 3] = std::array::from_fn(|c| v[c] + hm * f[c]);
         (std::array::from_fn(|c| x[c] + h * vn[c]), vn)
