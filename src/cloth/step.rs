@@ -64,14 +64,15 @@ pub(super) struct StepScratch {
     /// step, used instead of `pin_goals`' when `mid_goal_set` (`extrapolate.rs`).
     pub mid_goal: Vec<Vec3>,
     pub mid_goal_set: bool,
-    /// Vertex normals of the proposed state (with added mass only).
-    pub normals_new: Vec<Vec3>,
     /// Rotation-invariant fractional springs only (`forces/strain.rs`): each spring's rate of
     /// elongation at the start of the step and the past part of its D^{1/2}, packed three
-    /// springs to an entry, and the force on every particle.
+    /// springs to an entry.
     pub strain_rates: Vec<Vec3>,
     pub strain_past: Vec<Vec3>,
-    pub strain_forces: Vec<Vec3>,
+    /// Forces of the whole-cloth passes before the force pass (strain springs, the carried
+    /// water's turning forces), one per particle; empty without them.
+    pub prior_forces: Vec<Vec3>,
+    pub turning: forces::TurningScratch,
     pub force_pass: ForceScratch,
     pub implicit: ImplicitScratch,
 }
@@ -142,12 +143,12 @@ impl Cloth {
         self.pin_goals(fraction);
         let w0 = self.step_velocities(h);
         let strain_w0 = self.strain_damping();
+        self.water_turning();
         let integrated_sound = match Route::of(self.config.integrator) {
             Route::ExplicitTiles(step) => self.forces_and_explicit_step(h, strain_w0, step),
             Route::Implicit => self.forces_and_implicit_step(h, w0, strain_w0)?,
         };
         let friction = self.friction(h);
-        self.added_mass_energy();
         self.pins(h);
         self.check(h, integrated_sound && !friction)?;
         self.commit(h);
@@ -322,6 +323,7 @@ impl Cloth {
     /// spring's rate of elongation and its history (nothing without them). Returns their w0.
     fn strain_damping(&mut self) -> f64 {
         if self.strain_history.is_off() {
+            self.scratch.prior_forces.clear();
             return 0.0;
         }
         let s = &mut self.scratch;
@@ -332,7 +334,7 @@ impl Cloth {
         // SAFETY: one call covers every entry once.
         unsafe { past.past_range(0, &mut s.strain_past) };
         self.strain_history.end_step();
-        s.strain_forces.resize(self.x.len(), Vec3::zeros());
+        s.prior_forces.resize(self.x.len(), Vec3::zeros());
         forces::strain::forces(
             &self.config.model,
             &self.topology,
@@ -340,9 +342,32 @@ impl Cloth {
             w0,
             &s.strain_rates,
             &s.strain_past,
-            &mut s.strain_forces,
+            &mut s.prior_forces,
         );
         w0
+    }
+
+    /// The carried water's forces as the normals turn (`dT/dx - (dM/dt) v`,
+    /// [`forces::turning_forces`]), added to the forces before the pass; nothing without
+    /// normal added mass.
+    fn water_turning(&mut self) {
+        if self.config.model.water.added_mass == 0.0 {
+            return;
+        }
+        let (s, t) = (&mut self.scratch, &self.topology);
+        if s.prior_forces.is_empty() {
+            s.prior_forces.resize(self.x.len(), Vec3::zeros());
+        }
+        forces::turning_forces(
+            &self.config.model,
+            &self.x,
+            &s.v_rel,
+            &t.areas,
+            &t.triangles,
+            &t.vertex_triangles,
+            &mut s.turning,
+            &mut s.prior_forces,
+        );
     }
 
     /// The force pass with an explicit integrator stepping each tile in cache; returns whether
@@ -356,7 +381,7 @@ impl Cloth {
             v: &s.v_step,
             half_derivative: &s.half,
             colliders: &self.colliders,
-            strain_forces: &s.strain_forces,
+            prior_forces: &s.prior_forces,
             strain_w0,
         };
         let (masses, areas) = (&self.topology.masses, &self.topology.areas);
@@ -419,7 +444,7 @@ impl Cloth {
             v: &s.v_step,
             half_derivative: &s.half,
             colliders: &self.colliders,
-            strain_forces: &s.strain_forces,
+            prior_forces: &s.prior_forces,
             strain_w0,
         };
         forces::total_forces_with(
@@ -467,31 +492,6 @@ impl Cloth {
             &mut self.scratch.v_new,
         );
         on
-    }
-
-    /// With added mass, the normal turning over the step must not create kinetic energy: a
-    /// particle whose kinetic energy is larger with the new normal than with the step's is
-    /// slowed to the step's (never sped up). The water's added mass depends on the normal, and
-    /// solving `M(n) a = f` alone does not conserve energy as n turns (`forces/inertia.rs`).
-    fn added_mass_energy(&mut self) {
-        let m = &self.config.model;
-        if m.water.added_mass == 0.0 {
-            return;
-        }
-        let t = &self.topology;
-        let s = &mut self.scratch;
-        s.normals_new.resize(s.x_new.len(), Vec3::zeros());
-        forces::vertex_normals(&s.x_new, &t.triangles, &mut s.normals_new);
-        let old = s.force_pass.normals();
-        for i in 0..s.v_new.len() {
-            let v = s.v_new[i];
-            let inertia = forces::Inertia::of(m, t.masses[i], t.areas[i], old[i]);
-            let t_old = inertia.twice_kinetic(&v);
-            let t_new = inertia.twice_kinetic_along(&v, &s.normals_new[i]);
-            if t_new > t_old && t_new > 0.0 {
-                s.v_new[i] = v * (t_old / t_new).sqrt();
-            }
-        }
     }
 
     /// Pinned particles onto their goals (moving with their step velocity); soft pins pulled

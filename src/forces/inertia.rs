@@ -13,8 +13,13 @@
 //! Changing how the water's inertia is modelled is a change to this file.
 //!
 //! The mass matrix is taken at the start of each step (the normal of the state the forces are
-//! evaluated at); `tests/underwater.rs` checks that a free cloth with strongly anisotropic
-//! added mass does not gain energy.
+//! evaluated at). It depends on the configuration through the normals, so the equations of
+//! motion are Lagrange's for `T = 1/2 sum v_i^T M_i(x) v_i`:
+//! `M a = f + dT/dx - (dM/dt) v`. The last two terms, the forces of the carried water as the
+//! cloth turns ([`turning_forces`]), are what make the water's energy the cloth's: without
+//! them a cloth whose normals turn gains kinetic energy from nothing (the water's momentum
+//! along the old normal becomes the cloth's along the new tangent). `tests/underwater.rs`
+//! checks that a free cloth with strongly anisotropic added mass does not gain energy.
 
 use nalgebra::Matrix3;
 
@@ -131,9 +136,196 @@ pub fn effective_forces(
     }
 }
 
+/// Scratch of [`turning_forces`]: per face its normal times twice its area and that
+/// normal's rate, then per face the sum of its vertices' weights; per vertex the weight.
+#[derive(Clone, Debug, Default)]
+pub struct TurningScratch {
+    faces: Vec<Vec3>,
+    rates: Vec<Vec3>,
+    weights: Vec<Vec3>,
+}
+
+/// Adds the forces of the carried water as the normals turn, `dT/dx - (dM/dt) v`, to `out`
+/// (one per particle), for the normal added mass of `m` at positions `x` and velocities
+/// relative to the water `v`. Nothing without normal added mass.
+///
+/// With `N_i` the sum of vertex i's face normals (each twice its face's area, as
+/// [`super::vertex_normals`]), `n_i = N_i / |N_i|` and `P_i = I - n_i n_i^T`:
+/// - `(dM_i/dt) v_i = m_a,i (ndot_i (n_i . v_i) + n_i (ndot_i . v_i))`, with
+///   `ndot_i = P_i Ndot_i / |N_i|` and `Ndot_i` the sum of its faces' normals' rates;
+/// - `dT/dx_j = sum_i (dN_i/dx_j)^T w_i`, `w_i = m_a,i (n_i . v_i) P_i v_i / |N_i|`: per face
+///   `c = e1 x e2` (`e1 = x_b - x_a`, `e2 = x_c - x_a`) and `W` the sum of its vertices' w,
+///   the gradient of `W . c` is `e2 x W` at b, `W x e1` at c and minus their sum at a.
+///
+/// Both are quadratic in the velocity (no stiffness): they enter every integrator as known
+/// forces of the step's start.
+#[allow(clippy::too_many_arguments)] // the state, the mesh and the output of one pass
+pub fn turning_forces(
+    m: &Model,
+    x: &[Vec3],
+    v: &[Vec3],
+    areas: &[f64],
+    triangles: &[[u32; 3]],
+    vertex_triangles: &crate::topology::Adjacency,
+    scratch: &mut TurningScratch,
+    out: &mut [Vec3],
+) {
+    let ma = m.water.added_mass;
+    if ma == 0.0 {
+        return;
+    }
+    let TurningScratch {
+        faces,
+        rates,
+        weights,
+    } = scratch;
+    faces.clear();
+    rates.clear();
+    for t in triangles {
+        let [a, b, c] = t.map(|i| i as usize);
+        let (e1, e2) = (x[b] - x[a], x[c] - x[a]);
+        faces.push(e1.cross(&e2));
+        rates.push((v[b] - v[a]).cross(&e2) + e1.cross(&(v[c] - v[a])));
+    }
+    weights.clear();
+    for (i, o) in out.iter_mut().enumerate() {
+        let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
+        for &t in vertex_triangles.row(i) {
+            big_n += faces[t as usize];
+            big_ndot += rates[t as usize];
+        }
+        let len = big_n.norm();
+        if len == 0.0 {
+            weights.push(Vec3::zeros());
+            continue;
+        }
+        let n = big_n / len;
+        let mass = ma * areas[i];
+        let vn = n.dot(&v[i]);
+        let ndot = (big_ndot - n.dot(&big_ndot) * n) / len;
+        *o -= mass * (vn * ndot + ndot.dot(&v[i]) * n);
+        weights.push((mass * vn / len) * (v[i] - vn * n));
+    }
+    // W of every face, then each vertex gathers its faces' gradients (no scatter).
+    for (f, t) in faces.iter_mut().zip(triangles) {
+        *f = t.iter().map(|&i| weights[i as usize]).sum();
+    }
+    for (i, o) in out.iter_mut().enumerate() {
+        for &t in vertex_triangles.row(i) {
+            let [a, b, c] = triangles[t as usize];
+            let w = faces[t as usize];
+            let (e1, e2) = (x[b as usize] - x[a as usize], x[c as usize] - x[a as usize]);
+            let (gb, gc) = (e2.cross(&w), w.cross(&e1));
+            *o += if i == b as usize {
+                gb
+            } else if i == c as usize {
+                gc
+            } else {
+                -(gb + gc)
+            };
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::topology::{GridSpec, Topology};
+
+    /// A crumpled, moving patch: positions, velocities, and a model with normal added mass.
+    fn patch() -> (Topology, Vec<Vec3>, Vec<Vec3>, Model) {
+        let t = GridSpec {
+            width: 4,
+            height: 3,
+            spacing: 0.1,
+            total_mass: 0.2,
+        }
+        .build()
+        .expect("a valid grid");
+        let mut r = crate::testing::numbers(3);
+        let x = t
+            .rest_positions
+            .iter()
+            .map(|p| p + 0.03 * Vec3::new(r(), r(), r()))
+            .collect();
+        let v = (0..t.vertex_count()).map(|_| Vec3::new(r(), r(), r())).collect();
+        let mut m = Model::fractional();
+        m.water.added_mass = 30.0;
+        (t, x, v, m)
+    }
+
+    fn normals(t: &Topology, x: &[Vec3]) -> Vec<Vec3> {
+        let mut n = vec![Vec3::zeros(); x.len()];
+        super::super::vertex_normals(x, &t.triangles, &mut n);
+        n
+    }
+
+    /// The water's kinetic energy `1/2 sum m_a (v . n)^2`.
+    fn water_energy(t: &Topology, m: &Model, x: &[Vec3], v: &[Vec3]) -> f64 {
+        let n = normals(t, x);
+        (0..x.len())
+            .map(|i| 0.5 * m.water.added_mass * t.areas[i] * v[i].dot(&n[i]).powi(2))
+            .sum()
+    }
+
+    #[test]
+    fn turning_forces_are_lagranges_terms() {
+        let (t, x, v, m) = patch();
+        let mut got = vec![Vec3::zeros(); x.len()];
+        let mut s = TurningScratch::default();
+        turning_forces(
+            &m,
+            &x,
+            &v,
+            &t.areas,
+            &t.triangles,
+            &t.vertex_triangles,
+            &mut s,
+            &mut got,
+        );
+        // dT/dx by central differences of T at fixed v; (dM/dt) v by central differences
+        // of M(x + s v) v in s.
+        let eps = 1e-6;
+        let ma: Vec<f64> = t.areas.iter().map(|a| m.water.added_mass * a).collect();
+        for j in 0..x.len() {
+            let mut grad = Vec3::zeros();
+            for a in 0..3 {
+                let shifted = |s: f64| {
+                    let mut y = x.clone();
+                    y[j][a] += s * eps;
+                    water_energy(&t, &m, &y, &v)
+                };
+                grad[a] = (shifted(1.0) - shifted(-1.0)) / (2.0 * eps);
+            }
+            let m_v = |s: f64| {
+                let y: Vec<Vec3> = x.iter().zip(&v).map(|(x, v)| x + s * eps * v).collect();
+                let n = normals(&t, &y)[j];
+                ma[j] * n.dot(&v[j]) * n
+            };
+            let mdot_v = (m_v(1.0) - m_v(-1.0)) / (2.0 * eps);
+            let want = grad - mdot_v;
+            assert!(
+                (got[j] - want).norm() < 1e-6 * (1.0 + want.norm()),
+                "particle {j}: {} against {}",
+                got[j],
+                want
+            );
+        }
+        // Nothing without normal added mass.
+        let mut none = vec![Vec3::zeros(); x.len()];
+        let plain = Model::fractional();
+        turning_forces(
+            &plain,
+            &x,
+            &v,
+            &t.areas,
+            &t.triangles,
+            &t.vertex_triangles,
+            &mut s,
+            &mut none,
+        );
+        assert!(none.iter().all(|f| *f == Vec3::zeros()));
+    }
 
     fn inertia() -> Inertia {
         let mut model = Model::fractional();

@@ -211,7 +211,7 @@ mod tests {
                 v,
                 half_derivative: &half,
                 colliders: &[],
-                strain_forces: &strain_forces,
+                prior_forces: &strain_forces,
                 strain_w0: self.w0,
             };
             let mut f = vec![Vec3::zeros(); n];
@@ -233,7 +233,7 @@ mod tests {
                 v: &self.v,
                 half_derivative: &half,
                 colliders: &[],
-                strain_forces: &[],
+                prior_forces: &[],
                 strain_w0: self.w0,
             };
             let mut out = Linearisation::default();

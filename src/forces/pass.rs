@@ -32,9 +32,10 @@ pub struct ForceInput<'a> {
     pub half_derivative: &'a [Vec3],
     /// Colliders present this step.
     pub colliders: &'a [Collider],
-    /// Force of the rotation-invariant fractional springs on every particle (N), evaluated
-    /// before the pass (`strain.rs`); empty when the model has none.
-    pub strain_forces: &'a [Vec3],
+    /// Forces of the whole-cloth passes evaluated before this one (N, one per particle): the
+    /// rotation-invariant fractional springs (`strain.rs`) and the carried water's turning
+    /// forces ([`super::turning_forces`]); empty when the model has neither.
+    pub prior_forces: &'a [Vec3],
     /// The current-rate weight w0 of those springs' D^{1/2} (what the implicit integrator
     /// treats as their damping); 0 without them.
     pub strain_w0: f64,
@@ -146,8 +147,8 @@ where
             areas: &areas[p0..p0 + len],
         };
         let [fx, fy, fz] = s;
-        if let Some(strain) = input.strain_forces.get(p0..p0 + len) {
-            for (k, f) in strain.iter().enumerate() {
+        if let Some(prior) = input.prior_forces.get(p0..p0 + len) {
+            for (k, f) in prior.iter().enumerate() {
                 (fx[k], fy[k], fz[k]) = (fx[k] + f.x, fy[k] + f.y, fz[k] + f.z);
             }
         }

@@ -602,7 +602,7 @@ mod tests {
                 v: q,
                 half_derivative: q,
                 colliders: &[],
-                strain_forces: &[],
+                prior_forces: &[],
                 strain_w0: 0.0,
             };
             let mut f = vec![Vec3::zeros(); n];
