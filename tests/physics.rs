@@ -245,7 +245,7 @@ fn spring_damping_can_be_set_per_family() {
             v: &v,
             half_derivative: &[],
             colliders: &[],
-            strain_forces: &[],
+            prior_forces: &[],
             strain_w0: 0.0,
         };
         total_forces(&input, &mut ForceScratch::default(), &mut f);
