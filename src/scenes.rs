@@ -8,7 +8,15 @@
 //! - `sway`: the top edge is moved energetically sideways (in plane, along x):
 //!   `x(t) = A sin(2 pi f t)`, A = [`SWAY_AMPLITUDE`], f = [`SWAY_FREQUENCY`];
 //! - `sphere`: a sphere of radius [`SPHERE_RADIUS`] moves through the hanging cloth
-//!   along +z at [`SPHERE_SPEED`], starting behind it at z = [`SPHERE_START_Z`].
+//!   along +z at [`SPHERE_SPEED`], starting behind it at z = [`SPHERE_START_Z`];
+//! - `current`: the towel pinned at its top edge, still, in a current ([`CURRENT_SPEED`]
+//!   along its plane by default);
+//! - `kelp`: a buoyant strip [`KELP_WIDTH`] x [`KELP_LENGTH`] pinned at its foot, in still
+//!   water (density [`KELP_DENSITY`]: it stands up).
+//!
+//! Every scene's drive ([`Drive`]: amplitude, frequency, a fade-in and the current) can be
+//! changed ([`SceneSpec::drive`]); the pinned edge moves along the scene's axis (z, out of
+//! plane, for all but `sway`).
 //!
 //! Each comes in a `fractional` variant (the paper's model), `regular` variants (damped
 //! springs, no half-derivative) with every other parameter the same, and the `underwater`
@@ -48,21 +56,56 @@ pub const SPHERE_SPEED: f64 = 0.2;
 /// Sphere start, z in m (its centre is at x = 0, y = -0.2 m: the middle of the cloth).
 pub const SPHERE_START_Z: f64 = -0.25;
 
+/// Speed of the `current` scene's water by default, m/s (along the towel's plane, +x).
+pub const CURRENT_SPEED: f64 = 0.3;
+/// Width of the `kelp` strip, m.
+pub const KELP_WIDTH: f64 = 0.1;
+/// Length of the `kelp` strip, m.
+pub const KELP_LENGTH: f64 = 1.0;
+/// Density of the `kelp` strip, kg/m^3 (below the water's: it floats up).
+pub const KELP_DENSITY: f64 = 900.0;
+
 /// Which motion.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SceneKind {
     Swing,
     Sway,
     Sphere,
+    /// The towel, still, in a current.
+    Current,
+    /// A buoyant strip pinned at its foot.
+    Kelp,
 }
 
 impl SceneKind {
-    pub const ALL: [SceneKind; 3] = [SceneKind::Swing, SceneKind::Sway, SceneKind::Sphere];
+    pub const ALL: [SceneKind; 5] = [
+        SceneKind::Swing,
+        SceneKind::Sway,
+        SceneKind::Sphere,
+        SceneKind::Current,
+        SceneKind::Kelp,
+    ];
     pub fn name(&self) -> &'static str {
         match self {
             SceneKind::Swing => "swing",
             SceneKind::Sway => "sway",
             SceneKind::Sphere => "sphere",
+            SceneKind::Current => "current",
+            SceneKind::Kelp => "kelp",
+        }
+    }
+    /// The cloth's width and height, m.
+    pub fn extent(&self) -> (f64, f64) {
+        match self {
+            SceneKind::Kelp => (KELP_WIDTH, KELP_LENGTH),
+            _ => (CLOTH_WIDTH, CLOTH_WIDTH * 2.0 / 3.0),
+        }
+    }
+    /// Columns and rows at 1 cm spacing (the paper's 61 x 41 for the towel).
+    pub fn default_size(&self) -> (u32, u32) {
+        match self {
+            SceneKind::Kelp => (11, 101),
+            _ => (61, 41),
         }
     }
     pub fn from_name(s: &str) -> Option<Self> {
@@ -124,6 +167,72 @@ pub fn scale_drags(mut m: Model, spacing: f64) -> Model {
     m
 }
 
+/// How a scene is driven: its pinned edge moves `amplitude sin(2 pi frequency t)` along the
+/// scene's axis, faded in over `ramp` seconds (`(1 - cos(pi t / ramp)) / 2`), in water
+/// flowing at `current`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Drive {
+    /// m.
+    pub amplitude: f64,
+    /// Hz.
+    pub frequency: f64,
+    /// s; 0 starts at once (the paper's swing).
+    pub ramp: f64,
+    /// m/s.
+    pub current: Vec3,
+}
+
+impl Drive {
+    /// The drive of a built-in scene with a variant (the paper's swing is 8 cm, the underwater
+    /// preset's 4 cm, both at 0.5 Hz).
+    pub fn of(kind: SceneKind, variant: Variant) -> Drive {
+        let still = Drive {
+            amplitude: 0.0,
+            frequency: SWING_FREQUENCY,
+            ramp: 0.0,
+            current: Vec3::zeros(),
+        };
+        match kind {
+            SceneKind::Swing => Drive {
+                amplitude: if variant == Variant::Underwater {
+                    UNDERWATER_SWING_AMPLITUDE
+                } else {
+                    SWING_AMPLITUDE
+                },
+                ..still
+            },
+            SceneKind::Sway => Drive {
+                amplitude: SWAY_AMPLITUDE,
+                frequency: SWAY_FREQUENCY,
+                ..still
+            },
+            SceneKind::Sphere | SceneKind::Kelp => still,
+            SceneKind::Current => Drive {
+                current: Vec3::new(CURRENT_SPEED, 0.0, 0.0),
+                ..still
+            },
+        }
+    }
+
+    /// Offset of the pinned edge from its rest position at time `t` (s) in a scene of `kind`.
+    pub fn offset(&self, kind: SceneKind, t: f64) -> Vec3 {
+        use std::f64::consts::{PI, TAU};
+        if self.amplitude == 0.0 {
+            return Vec3::zeros();
+        }
+        let fade = if t < self.ramp {
+            0.5 * (1.0 - (PI * t / self.ramp).cos())
+        } else {
+            1.0
+        };
+        let s = fade * self.amplitude * (TAU * self.frequency * t).sin();
+        match kind {
+            SceneKind::Sway => Vec3::new(s, 0.0, 0.0),
+            _ => Vec3::new(0.0, 0.0, s),
+        }
+    }
+}
+
 /// What to build.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneSpec {
@@ -139,38 +248,53 @@ pub struct SceneSpec {
     pub dt: f64,
     /// Multiplies every spring constant (1 = the model's own); for stiffness sweeps.
     pub stiffness_scale: f64,
+    /// How the pinned edge moves and the water flows.
+    pub drive: Drive,
 }
 
 impl SceneSpec {
-    /// The paper's configuration of a scene at 61 x 41: Eq. 6 with u = 3, explicit Euler.
+    /// The paper's configuration of a scene at 61 x 41 (the kelp at 11 x 101): Eq. 6 with
+    /// u = 3, explicit Euler.
     pub fn paper(kind: SceneKind, variant: Variant) -> Self {
+        let (width, height) = kind.default_size();
         Self {
             kind,
             variant,
-            width: 61,
-            height: 41,
+            width,
+            height,
             scheme: Scheme::PAPER,
             integrator: Integrator::ExplicitEuler,
             dt: DEFAULT_DT,
             stiffness_scale: 1.0,
+            drive: Drive::of(kind, variant),
         }
     }
 
     /// Grid spacing, m.
     pub fn spacing(&self) -> f64 {
-        CLOTH_WIDTH / f64::from(self.width.max(2) - 1)
+        self.kind.extent().0 / f64::from(self.width.max(2) - 1)
     }
 
     pub fn build(&self) -> Result<Scene, Error> {
         let spacing = self.spacing();
+        // 1 kg/m^2 (the towel's 0.24 kg over 0.6 x 0.4 m) at any size.
+        let areal_density = CLOTH_MASS / (CLOTH_WIDTH * CLOTH_WIDTH * 2.0 / 3.0);
+        let (cols, rows) = (f64::from(self.width.max(2) - 1), f64::from(self.height.max(2) - 1));
         let topology = GridSpec {
             width: self.width,
             height: self.height,
             spacing,
-            total_mass: CLOTH_MASS,
+            total_mass: match self.kind {
+                SceneKind::Kelp => areal_density * cols * rows * spacing * spacing,
+                _ => CLOTH_MASS,
+            },
         }
         .build()?;
         let mut model = self.variant.model(spacing);
+        if self.kind == SceneKind::Kelp {
+            model.cloth_density = KELP_DENSITY;
+        }
+        model.current = self.drive.current;
         model.stretch_stiffness *= self.stiffness_scale;
         model.shear_stiffness *= self.stiffness_scale;
         model.bend_stiffness *= self.stiffness_scale;
@@ -181,7 +305,9 @@ impl SceneSpec {
             ..ClothConfig::default()
         };
         let mut cloth = Cloth::new(topology, config)?;
-        let top: Vec<u32> = (0..self.width).map(|i| grid_index(self.width, i, 0)).collect();
+        // The pinned edge: the top row, or the foot of the kelp.
+        let row = if self.kind == SceneKind::Kelp { self.height - 1 } else { 0 };
+        let top: Vec<u32> = (0..self.width).map(|i| grid_index(self.width, i, row)).collect();
         cloth.set_pinned(&top)?;
         let top_rest = top.iter().map(|&i| cloth.positions()[i as usize]).collect();
         let sphere = match self.kind {
@@ -214,19 +340,10 @@ pub fn stable_dt(spacing: f64, integrator: Integrator) -> f64 {
     }
 }
 
-/// Offset of the top edge from its rest position at time `t` (s) for a variant.
+/// Offset of the top edge from its rest position at time `t` (s) for a variant, with the
+/// scene's own drive ([`Drive::of`]).
 pub fn top_offset(kind: SceneKind, variant: Variant, t: f64) -> Vec3 {
-    use std::f64::consts::TAU;
-    let swing = if variant == Variant::Underwater {
-        UNDERWATER_SWING_AMPLITUDE
-    } else {
-        SWING_AMPLITUDE
-    };
-    match kind {
-        SceneKind::Swing => Vec3::new(0.0, 0.0, swing * (TAU * SWING_FREQUENCY * t).sin()),
-        SceneKind::Sway => Vec3::new(SWAY_AMPLITUDE * (TAU * SWAY_FREQUENCY * t).sin(), 0.0, 0.0),
-        SceneKind::Sphere => Vec3::zeros(),
-    }
+    Drive::of(kind, variant).offset(kind, t)
 }
 
 /// The sphere of the `sphere` scene at time `t` (s).
@@ -255,7 +372,7 @@ impl Scene {
     pub fn step(&mut self) -> Result<(), Error> {
         let dt = self.spec.dt;
         let t_end = self.cloth.time() + dt;
-        let off = top_offset(self.spec.kind, self.spec.variant, t_end);
+        let off = self.spec.drive.offset(self.spec.kind, t_end);
         self.targets.clear();
         self.targets.extend(self.top_rest.iter().map(|p| p + off));
         self.cloth.set_pin_targets(&self.top, &self.targets)?;
@@ -274,7 +391,7 @@ impl Scene {
         Ok(())
     }
 
-    /// Pinned top-row vertex indices.
+    /// Pinned vertex indices (the top row; the foot of the kelp).
     pub fn top_row(&self) -> &[u32] {
         &self.top
     }

@@ -23,7 +23,7 @@ use fraccloth::export::{read_cache, read_obj};
 use fraccloth::export::{write_obj, CacheFormat, CacheWriter};
 use fraccloth::history::Scheme;
 use fraccloth::look::{measure, Look};
-use fraccloth::scenes::{stable_dt, Scene, SceneKind, SceneSpec, Variant, DEFAULT_DT};
+use fraccloth::scenes::{stable_dt, Drive, Scene, SceneKind, SceneSpec, Variant, DEFAULT_DT};
 use fraccloth::{HalfDerivative, Integrator, RegularDrag, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use render::{contact_sheet, render_frame, save_png, side_view, space_time, Camera, GifWriter, Scene3d};
@@ -72,16 +72,31 @@ struct LookArgs {
 
 #[derive(clap::Args, Debug)]
 struct Args {
-    /// Scene: swing, sway or sphere.
+    /// Scene: swing, sway, sphere, current (the towel still in a current along its plane) or
+    /// kelp (a buoyant 10 x 100 cm strip pinned at its foot).
     #[arg(long, default_value = "swing")]
     scene: String,
     /// Model: underwater (the water's physics per unit area; the default), fractional (the
     /// paper's), regular (normal drag), regular-viscous, regular-viscous-normal.
     #[arg(long, default_value = "underwater")]
     variant: String,
-    /// Grid size as COLUMNSxROWS (the paper uses 61x41 and 31x21).
-    #[arg(long, default_value = "61x41")]
-    size: String,
+    /// Grid size as COLUMNSxROWS (the paper uses 61x41 and 31x21; default 61x41, 11x101 for
+    /// kelp: 1 cm spacing).
+    #[arg(long)]
+    size: Option<String>,
+    /// Drive frequency of the pinned edge, Hz (default: the scene's own, 0.5 Hz for swing).
+    #[arg(long)]
+    frequency: Option<f64>,
+    /// Drive amplitude of the pinned edge, m (default: the scene's own, 4 cm for the
+    /// underwater swing; 0 holds the edge still).
+    #[arg(long)]
+    amplitude: Option<f64>,
+    /// Water current as X,Y,Z in m/s (default: the scene's own; none but for `current`).
+    #[arg(long, value_parser = parse_vec3)]
+    current: Option<Vec3>,
+    /// Seconds over which the drive fades in (default 0: a sudden start, as the paper's).
+    #[arg(long)]
+    ramp: Option<f64>,
     /// Simulated seconds.
     #[arg(long, default_value_t = 12.0)]
     seconds: f64,
@@ -125,6 +140,38 @@ struct Args {
     quiet: bool,
 }
 
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let [x, y, z] = parts[..] else {
+        return Err(format!("{s:?} is not X,Y,Z"));
+    };
+    let p = |v: &str| v.trim().parse::<f64>().map_err(|e| format!("{s:?}: {e}"));
+    let v = Vec3::new(p(x)?, p(y)?, p(z)?);
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(v)
+    } else {
+        Err(format!("{s:?} is not finite"))
+    }
+}
+
+/// The scene named by `--scene`.
+fn scene_kind(args: &Args) -> Result<SceneKind, String> {
+    SceneKind::from_name(&args.scene).ok_or_else(|| {
+        format!(
+            "unknown scene {:?} (swing, sway, sphere, current, kelp)",
+            args.scene
+        )
+    })
+}
+
+/// Columns and rows: `--size`, or the scene's own.
+fn size_of(args: &Args) -> Result<(u32, u32), String> {
+    match &args.size {
+        Some(s) => parse_size(s),
+        None => Ok(scene_kind(args)?.default_size()),
+    }
+}
+
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
@@ -146,8 +193,8 @@ fn integrator_and_dt(args: &Args, variant: Variant) -> Result<(Integrator, f64),
         .ok_or_else(|| {
             format!("unknown integrator {key:?} (explicit, symplectic, implicit, symplectic2, implicit2)")
         })?;
-    let (width, _) = parse_size(&args.size)?;
-    let spacing = fraccloth::scenes::CLOTH_WIDTH / f64::from(width.max(2) - 1);
+    let (width, _) = size_of(args)?;
+    let spacing = scene_kind(args)?.extent().0 / f64::from(width.max(2) - 1);
     let dt = args.dt.unwrap_or_else(|| stable_dt(spacing, integrator));
     if !(dt.is_finite() && dt > 0.0) {
         return Err(format!("--dt must be positive, got {dt}"));
@@ -171,19 +218,31 @@ fn scheme_from(args: &Args) -> Result<Scheme, String> {
 }
 
 fn spec_from(args: &Args, variant: Variant, scheme: Scheme) -> Result<SceneSpec, String> {
-    let kind = SceneKind::from_name(&args.scene)
-        .ok_or_else(|| format!("unknown scene {:?} (swing, sway, sphere)", args.scene))?;
-    let (width, height) = parse_size(&args.size)?;
+    let kind = scene_kind(args)?;
+    let (width, height) = size_of(args)?;
     if !(args.seconds.is_finite() && args.seconds > 0.0 && args.fps.is_finite() && args.fps > 0.0) {
         return Err("--seconds and --fps must be positive".into());
     }
     let (integrator, dt) = integrator_and_dt(args, variant)?;
+    let own = Drive::of(kind, variant);
+    let drive = Drive {
+        amplitude: args.amplitude.unwrap_or(own.amplitude),
+        frequency: args.frequency.unwrap_or(own.frequency),
+        ramp: args.ramp.unwrap_or(own.ramp),
+        current: args.current.unwrap_or(own.current),
+    };
+    if !(drive.amplitude.is_finite() && drive.frequency.is_finite() && drive.frequency > 0.0)
+        || !(drive.ramp.is_finite() && drive.ramp >= 0.0)
+    {
+        return Err("--amplitude must be finite, --frequency positive, --ramp >= 0".into());
+    }
     Ok(SceneSpec {
         width,
         height,
         dt,
         scheme,
         integrator,
+        drive,
         ..SceneSpec::paper(kind, variant)
     })
 }
@@ -592,7 +651,9 @@ fn compare(args: &Args) -> Result<(), String> {
     save_png(&sheet, &sheet_path).map_err(io(&sheet_path))?;
     let table = format!(
         "Look of `{}` ({}, {} s; each model with its own integrator and a stable step unless given: explicit Euler for the paper's models, symplectic Euler for the underwater preset), measured by `fraccloth look` on the centre column over whole drive periods of the second half:\n\n{LOOK_HEADER}{table}",
-        args.scene, args.size, args.seconds
+        args.scene,
+        size_of(args).map(|(w, h)| format!("{w}x{h}"))?,
+        args.seconds
     );
     let table_path = args.out.join(format!("look-{}.md", args.scene));
     std::fs::write(&table_path, &table).map_err(io(&table_path))?;
