@@ -630,13 +630,14 @@ impl Cloth {
     pub fn energy(&self) -> f64 {
         let m = &self.config.model;
         let t = &self.topology;
-        let mut normals = vec![Vec3::zeros(); self.x.len()];
+        let n = self.x.len();
+        let (mut normals, mut projected) = (vec![Vec3::zeros(); n], vec![1.0; n]);
         if m.water.added_mass != 0.0 {
-            forces::vertex_normals(&self.x, &t.triangles, &mut normals);
+            forces::patch_normals(&self.x, t, &mut normals, &mut projected);
         }
         let mut e = 0.0;
         for (i, (x, v)) in self.x.iter().zip(&self.v).enumerate() {
-            let inertia = forces::Inertia::of(m, t.masses[i], t.areas[i], normals[i]);
+            let inertia = forces::Inertia::of(m, t.masses[i], t.areas[i], normals[i], projected[i]);
             e += inertia.kinetic_energy(v) - forces::body_force(m, t.masses[i]).dot(x);
         }
         for s in &t.springs {

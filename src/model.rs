@@ -212,12 +212,19 @@ impl Model {
 }
 
 impl Model {
-    /// A wet towel in still water (`FC_PRESET_UNDERWATER`): the paper's springs, lightly
-    /// velocity-damped, and the water's physics per unit area instead of per-particle linear
-    /// drags: 10 kg/m^2 of entrained water (ten times a wet towel's own mass, in every
-    /// direction) and form drag with C_d = 1. Measured with `fraccloth look` on the swing
-    /// (4 cm at 0.5 Hz) at 31 x 21, 61 x 41 and 121 x 81: about 4 half-waves travelling down at
-    /// about 0.15 m/s, a third of the top's amplitude at mid-height (`docs/underwater.md`).
+    /// A wet towel in water (`FC_PRESET_UNDERWATER`): the paper's springs, lightly
+    /// velocity-damped, and the water's physics per unit area, each term by direction
+    /// (`docs/underwater.md` derives the numbers and measures the look):
+    /// - normal added mass [`UNDERWATER_ADDED_MASS`] (the water a face carries when it moves
+    ///   face first; none along the cloth), with the turning forces that keep its energy;
+    /// - form drag on the normal velocity, C_d = [`UNDERWATER_FORM_DRAG`];
+    /// - skin drag on the tangential velocity, [`UNDERWATER_SKIN_DRAG`] (laminar skin friction
+    ///   on both faces, linearised at 0.3 m/s on a 0.4 m cloth): a current along the cloth
+    ///   drags it, and motion in its plane dies out.
+    ///
+    /// Swung 4 cm at 0.25 to 2 Hz the towel hangs at least 0.9 of its length and shows bumps
+    /// travelling down (about 4 half-waves at 0.5 Hz, 0.13 m/s), the same within a few percent
+    /// from 2 cm to 0.5 cm spacing.
     pub fn underwater() -> Self {
         Self {
             spring_damping: UNDERWATER_SPRING_DAMPING,
@@ -226,14 +233,29 @@ impl Model {
             history_drag: 0.0,
             normal_drag: 0.0,
             water: Water {
-                entrained_mass: 10.0,
-                form_drag: 1.0,
+                added_mass: UNDERWATER_ADDED_MASS,
+                form_drag: UNDERWATER_FORM_DRAG,
+                skin_drag: UNDERWATER_SKIN_DRAG,
                 ..Water::default()
             },
             ..Self::fractional()
         }
     }
 }
+
+/// Normal added mass of the underwater preset, kg/m^2. Potential flow gives
+/// `rho_w lambda / pi` for a sheet rippled at wavelength lambda (about 60 kg/m^2 for the
+/// 0.19 m bumps the preset shows at 0.5 Hz) and up to `rho_w pi W / 4` for a whole sheet of
+/// width W moving rigidly: the preset carries a quarter of the ripples' value, the largest that
+/// keeps a towel swung 4 cm at 2 Hz hanging (more gives more and deeper bumps and shortens the
+/// hang; `docs/underwater.md`).
+pub const UNDERWATER_ADDED_MASS: f64 = 15.0;
+/// Form-drag coefficient of the underwater preset (a flat plate face on: 1-2).
+pub const UNDERWATER_FORM_DRAG: f64 = 1.0;
+/// Skin drag of the underwater preset, N s/m^3: laminar skin friction on both faces,
+/// `2 * 0.664 rho_w sqrt(nu / L) U^1.5` (`C_f = 1.328 / sqrt(Re)` per face, water
+/// `nu = 1e-6 m^2/s`), is 0.345 N/m^2 at U = 0.3 m/s over L = 0.4 m; over U, 1.15 N s/m^3.
+pub const UNDERWATER_SKIN_DRAG: f64 = 1.15;
 
 /// Velocity spring damping of the underwater preset, N s/m.
 pub const UNDERWATER_SPRING_DAMPING: f64 = 1.5e-2;

@@ -279,7 +279,10 @@ impl SceneSpec {
         let spacing = self.spacing();
         // 1 kg/m^2 (the towel's 0.24 kg over 0.6 x 0.4 m) at any size.
         let areal_density = CLOTH_MASS / (CLOTH_WIDTH * CLOTH_WIDTH * 2.0 / 3.0);
-        let (cols, rows) = (f64::from(self.width.max(2) - 1), f64::from(self.height.max(2) - 1));
+        let (cols, rows) = (
+            f64::from(self.width.max(2) - 1),
+            f64::from(self.height.max(2) - 1),
+        );
         let topology = GridSpec {
             width: self.width,
             height: self.height,
@@ -306,7 +309,11 @@ impl SceneSpec {
         };
         let mut cloth = Cloth::new(topology, config)?;
         // The pinned edge: the top row, or the foot of the kelp.
-        let row = if self.kind == SceneKind::Kelp { self.height - 1 } else { 0 };
+        let row = if self.kind == SceneKind::Kelp {
+            self.height - 1
+        } else {
+            0
+        };
         let top: Vec<u32> = (0..self.width).map(|i| grid_index(self.width, i, row)).collect();
         cloth.set_pinned(&top)?;
         let top_rest = top.iter().map(|&i| cloth.positions()[i as usize]).collect();

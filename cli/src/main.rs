@@ -22,7 +22,7 @@ mod render;
 use fraccloth::export::{read_cache, read_obj};
 use fraccloth::export::{write_obj, CacheFormat, CacheWriter};
 use fraccloth::history::Scheme;
-use fraccloth::look::{measure, Look};
+use fraccloth::look::{measure, measure_stream, Look};
 use fraccloth::scenes::{stable_dt, Drive, Scene, SceneKind, SceneSpec, Variant, DEFAULT_DT};
 use fraccloth::{HalfDerivative, Integrator, RegularDrag, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -505,6 +505,26 @@ fn bake(args: &Args) -> Result<(), String> {
         }
         Err(e) => {
             let _ = writeln!(summary, "look         not measured: {e}");
+        }
+    }
+    // A still cloth in a current: how far it leans and how its free edge flutters.
+    if matches!(spec.kind, SceneKind::Current | SceneKind::Kelp) || spec.drive.amplitude == 0.0 {
+        let (w, h) = (spec.width as usize, spec.height as usize);
+        let root = scene.top_row()[w / 2] as usize;
+        let tip = if spec.kind == SceneKind::Kelp {
+            w / 2
+        } else {
+            (h - 1) * w + w / 2
+        };
+        match measure_stream(&topo.rest_positions, &recorded, &times, root, tip) {
+            Ok(stream) => {
+                let json = path("-stream.json");
+                std::fs::write(&json, stream.to_json() + "\n").map_err(io(&json))?;
+                let _ = write!(summary, "stream ({}):\n{}", json.display(), stream.summary());
+            }
+            Err(e) => {
+                let _ = writeln!(summary, "stream       not measured: {e}");
+            }
         }
     }
     print!("{summary}");

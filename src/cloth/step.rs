@@ -73,6 +73,9 @@ pub(super) struct StepScratch {
     /// water's turning forces), one per particle; empty without them.
     pub prior_forces: Vec<Vec3>,
     pub turning: forces::TurningScratch,
+    /// Each patch's projected-area ratio ([`forces::patch_normals`]), with normal added mass
+    /// only (else empty).
+    pub projected: Vec<f64>,
     pub force_pass: ForceScratch,
     pub implicit: ImplicitScratch,
 }
@@ -351,21 +354,23 @@ impl Cloth {
     /// [`forces::turning_forces`]), added to the forces before the pass; nothing without
     /// normal added mass.
     fn water_turning(&mut self) {
+        let (s, t) = (&mut self.scratch, &self.topology);
         if self.config.model.water.added_mass == 0.0 {
+            s.projected.clear();
             return;
         }
-        let (s, t) = (&mut self.scratch, &self.topology);
         if s.prior_forces.is_empty() {
             s.prior_forces.resize(self.x.len(), Vec3::zeros());
         }
+        s.projected.resize(self.x.len(), 0.0);
+        let m = &self.config.model;
         forces::turning_forces(
-            &self.config.model,
+            m,
+            t,
             &self.x,
             &s.v_rel,
-            &t.areas,
-            &t.triangles,
-            &t.vertex_triangles,
             &mut s.turning,
+            &mut s.projected,
             &mut s.prior_forces,
         );
     }
@@ -385,6 +390,7 @@ impl Cloth {
             strain_w0,
         };
         let (masses, areas) = (&self.topology.masses, &self.topology.areas);
+        let projected = &s.projected;
         let model = &self.config.model;
         let max_speed2 = self.config.max_speed * self.config.max_speed;
         let all_sound = AtomicBool::new(true);
@@ -407,6 +413,7 @@ impl Cloth {
                         &masses[r.clone()],
                         &areas[r.clone()],
                         n,
+                        projected.get(r.clone()).unwrap_or(&[]),
                         tile.force,
                         &mut effective,
                     );
@@ -453,7 +460,13 @@ impl Cloth {
             SpringInputs::Filled,
             &mut s.force_array,
         );
-        forces::linearise(&input, w0, s.force_pass.normals(), &mut s.implicit.lin);
+        forces::linearise(
+            &input,
+            w0,
+            s.force_pass.normals(),
+            &s.projected,
+            &mut s.implicit.lin,
+        );
         let inp = ImplicitInput {
             h,
             x: &self.x,

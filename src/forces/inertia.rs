@@ -24,6 +24,7 @@
 use nalgebra::Matrix3;
 
 use crate::model::Model;
+use crate::topology::Topology;
 use crate::Vec3;
 
 /// The inertia of one particle: `M = (mass + entrained) I + normal_mass n n^T`.
@@ -46,13 +47,14 @@ pub fn carries_water(m: &Model) -> bool {
 
 impl Inertia {
     /// The inertia of a particle of mass `mass` (kg) and area `area` (m^2) with unit normal
-    /// `normal`, in the water of model `m`.
+    /// `normal`, whose patch faces that normal with `projected` times its rest area
+    /// ([`patch_normals`]; 1 at rest), in the water of model `m`.
     #[inline]
-    pub fn of(m: &Model, mass: f64, area: f64, normal: Vec3) -> Inertia {
+    pub fn of(m: &Model, mass: f64, area: f64, normal: Vec3, projected: f64) -> Inertia {
         Inertia {
             mass,
             entrained: m.water.entrained_mass * area,
-            normal_mass: m.water.added_mass * area,
+            normal_mass: m.water.added_mass * area * (projected * projected),
             normal,
         }
     }
@@ -119,57 +121,86 @@ impl Inertia {
 }
 
 /// Writes the effective forces of a tile into `out` (component arrays):
-/// [`Inertia::effective_force`] of each particle.
+/// [`Inertia::effective_force`] of each particle. `projected`: each patch's projected-area
+/// ratio ([`patch_normals`]), empty when the model has no normal added mass.
 pub fn effective_forces(
     m: &Model,
     masses: &[f64],
     areas: &[f64],
     normals: &[Vec3],
+    projected: &[f64],
     force: [&[f64]; 3],
     out: &mut [[f64; crate::parallel::TILE]; 3],
 ) {
     let len = force[0].len();
     for k in 0..len {
         let f = Vec3::new(force[0][k], force[1][k], force[2][k]);
-        let g = Inertia::of(m, masses[k], areas[k], normals[k]).effective_force(f);
+        let p = projected.get(k).copied().unwrap_or(1.0);
+        let g = Inertia::of(m, masses[k], areas[k], normals[k], p).effective_force(f);
         (out[0][k], out[1][k], out[2][k]) = (g.x, g.y, g.z);
     }
 }
 
-/// Scratch of [`turning_forces`]: per face its normal times twice its area and that
-/// normal's rate, then per face the sum of its vertices' weights; per vertex the weight.
+/// Scratch of [`turning_forces`]: per face its normal times twice its area (then the sum of
+/// its vertices' weights) and that normal's rate; per vertex its weight.
 #[derive(Clone, Debug, Default)]
 pub struct TurningScratch {
     faces: Vec<Vec3>,
     rates: Vec<Vec3>,
-    weights: Vec<Vec3>,
+    patches: Vec<Vec3>,
 }
 
-/// Adds the forces of the carried water as the normals turn, `dT/dx - (dM/dt) v`, to `out`
-/// (one per particle), for the normal added mass of `m` at positions `x` and velocities
-/// relative to the water `v`. Nothing without normal added mass.
+/// The unit normal of every vertex and how much of its patch's rest area faces along it.
 ///
-/// With `N_i` the sum of vertex i's face normals (each twice its face's area, as
-/// [`super::vertex_normals`]), `n_i = N_i / |N_i|` and `P_i = I - n_i n_i^T`:
-/// - `(dM_i/dt) v_i = m_a,i (ndot_i (n_i . v_i) + n_i (ndot_i . v_i))`, with
-///   `ndot_i = P_i Ndot_i / |N_i|` and `Ndot_i` the sum of its faces' normals' rates;
-/// - `dT/dx_j = sum_i (dN_i/dx_j)^T w_i`, `w_i = m_a,i (n_i . v_i) P_i v_i / |N_i|`: per face
+/// A vertex's patch is its triangles; `N_i` is the sum of their normals each twice its area
+/// (as [`super::vertex_normals`] sums them). The ratio `p_i = |N_i| / |N_i(rest)|` (1 at rest,
+/// growing as the patch stretches and falling to 0 as it folds onto itself) scales the normal
+/// added mass: `m_a A_i p_i^2`. The water a patch carries is that of its projected area, and
+/// the kinetic energy `1/2 m_a A_i (v . a_i)^2`, `a_i = N_i / |N_i(rest)|`, is a polynomial in
+/// the positions: no normal to divide by where a fold makes it vanish.
+pub fn patch_normals(x: &[Vec3], t: &Topology, normals: &mut [Vec3], projected: &mut [f64]) {
+    let (triangles, vertex_triangles) = (&t.triangles, &t.vertex_triangles);
+    let faces: Vec<Vec3> = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| i as usize);
+            (x[b] - x[a]).cross(&(x[c] - x[a]))
+        })
+        .collect();
+    for i in 0..x.len() {
+        let big_n: Vec3 = vertex_triangles.row(i).iter().map(|&t| faces[t as usize]).sum();
+        let len = big_n.norm();
+        normals[i] = if len > 0.0 { big_n / len } else { big_n };
+        projected[i] = len * t.patch_scale[i];
+    }
+}
+
+/// Adds the forces of the carried water as the cloth turns and stretches,
+/// `dT/dx - (dM/dt) v`, to `out` (one per particle), for the normal added mass of `m` at
+/// positions `x` and velocities relative to the water `v`, and writes every vertex's
+/// projected-area ratio into `projected` ([`patch_normals`]). Nothing without normal added
+/// mass.
+///
+/// With `a_i = N_i / |N_i(rest)|` (see [`patch_normals`]) and `k_i = m_a A_i`, the water's kinetic
+/// energy is `T = 1/2 sum k_i (v_i . a_i)^2` and its mass matrix `k_i a_i a_i^T`:
+/// - `(dM_i/dt) v_i = k_i (adot_i (a_i . v_i) + a_i (adot_i . v_i))`, `adot_i` from the
+///   rates of its faces' normals (`(v_b - v_a) x e2 + e1 x (v_c - v_a)`);
+/// - `dT/dx_j = sum_i (dN_i/dx_j)^T w_i`, `w_i = k_i (a_i . v_i) v_i / |N_i(rest)|`: per face
 ///   `c = e1 x e2` (`e1 = x_b - x_a`, `e2 = x_c - x_a`) and `W` the sum of its vertices' w,
 ///   the gradient of `W . c` is `e2 x W` at b, `W x e1` at c and minus their sum at a.
 ///
-/// Both are quadratic in the velocity (no stiffness): they enter every integrator as known
-/// forces of the step's start.
-#[allow(clippy::too_many_arguments)] // the state, the mesh and the output of one pass
+/// Both are quadratic in the velocity and bounded (no division by the normal's length):
+/// they enter every integrator as known forces of the step's start.
 pub fn turning_forces(
     m: &Model,
+    t: &Topology,
     x: &[Vec3],
     v: &[Vec3],
-    areas: &[f64],
-    triangles: &[[u32; 3]],
-    vertex_triangles: &crate::topology::Adjacency,
     scratch: &mut TurningScratch,
+    projected: &mut [f64],
     out: &mut [Vec3],
 ) {
+    let (areas, triangles, vertex_triangles) = (&t.areas, &t.triangles, &t.vertex_triangles);
     let ma = m.water.added_mass;
     if ma == 0.0 {
         return;
@@ -177,7 +208,7 @@ pub fn turning_forces(
     let TurningScratch {
         faces,
         rates,
-        weights,
+        patches,
     } = scratch;
     faces.clear();
     rates.clear();
@@ -187,28 +218,25 @@ pub fn turning_forces(
         faces.push(e1.cross(&e2));
         rates.push((v[b] - v[a]).cross(&e2) + e1.cross(&(v[c] - v[a])));
     }
-    weights.clear();
+    patches.clear();
     for (i, o) in out.iter_mut().enumerate() {
         let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
         for &t in vertex_triangles.row(i) {
             big_n += faces[t as usize];
             big_ndot += rates[t as usize];
         }
-        let len = big_n.norm();
-        if len == 0.0 {
-            weights.push(Vec3::zeros());
-            continue;
-        }
-        let n = big_n / len;
-        let mass = ma * areas[i];
-        let vn = n.dot(&v[i]);
-        let ndot = (big_ndot - n.dot(&big_ndot) * n) / len;
-        *o -= mass * (vn * ndot + ndot.dot(&v[i]) * n);
-        weights.push((mass * vn / len) * (v[i] - vn * n));
+        let scale = t.patch_scale[i];
+        let (a, adot) = (scale * big_n, scale * big_ndot);
+        projected[i] = a.norm();
+        let k = ma * areas[i];
+        let av = a.dot(&v[i]);
+        *o -= k * (av * adot + adot.dot(&v[i]) * a);
+        // w_i, kept in `patches` (its area vector is no longer needed).
+        patches.push((k * av * scale) * v[i]);
     }
     // W of every face, then each vertex gathers its faces' gradients (no scatter).
     for (f, t) in faces.iter_mut().zip(triangles) {
-        *f = t.iter().map(|&i| weights[i as usize]).sum();
+        *f = t.iter().map(|&i| patches[i as usize]).sum();
     }
     for (i, o) in out.iter_mut().enumerate() {
         for &t in vertex_triangles.row(i) {
@@ -230,7 +258,7 @@ pub fn turning_forces(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::topology::{GridSpec, Topology};
+    use crate::topology::GridSpec;
 
     /// A crumpled, moving patch: positions, velocities, and a model with normal added mass.
     fn patch() -> (Topology, Vec<Vec3>, Vec<Vec3>, Model) {
@@ -254,17 +282,21 @@ mod tests {
         (t, x, v, m)
     }
 
-    fn normals(t: &Topology, x: &[Vec3]) -> Vec<Vec3> {
-        let mut n = vec![Vec3::zeros(); x.len()];
-        super::super::vertex_normals(x, &t.triangles, &mut n);
-        n
+    /// Each vertex's inertia at positions `x`.
+    fn inertias(t: &Topology, m: &Model, x: &[Vec3]) -> Vec<Inertia> {
+        let (mut n, mut p) = (vec![Vec3::zeros(); x.len()], vec![0.0; x.len()]);
+        patch_normals(x, t, &mut n, &mut p);
+        (0..x.len())
+            .map(|i| Inertia::of(m, 0.0, t.areas[i], n[i], p[i]))
+            .collect()
     }
 
-    /// The water's kinetic energy `1/2 sum m_a (v . n)^2`.
+    /// The water's kinetic energy.
     fn water_energy(t: &Topology, m: &Model, x: &[Vec3], v: &[Vec3]) -> f64 {
-        let n = normals(t, x);
-        (0..x.len())
-            .map(|i| 0.5 * m.water.added_mass * t.areas[i] * v[i].dot(&n[i]).powi(2))
+        inertias(t, m, x)
+            .iter()
+            .zip(v)
+            .map(|(i, v)| i.kinetic_energy(v))
             .sum()
     }
 
@@ -273,20 +305,21 @@ mod tests {
         let (t, x, v, m) = patch();
         let mut got = vec![Vec3::zeros(); x.len()];
         let mut s = TurningScratch::default();
-        turning_forces(
-            &m,
-            &x,
-            &v,
-            &t.areas,
-            &t.triangles,
-            &t.vertex_triangles,
-            &mut s,
-            &mut got,
+        let mut projected = vec![0.0; x.len()];
+        turning_forces(&m, &t, &x, &v, &mut s, &mut projected, &mut got);
+        // The ratios are the patches' own, 1 at rest.
+        let (mut n, mut p) = (vec![Vec3::zeros(); x.len()], vec![0.0; x.len()]);
+        patch_normals(&x, &t, &mut n, &mut p);
+        assert!(
+            projected.iter().zip(&p).all(|(a, b)| (a - b).abs() < 1e-14),
+            "{projected:?} {p:?}"
         );
+        let mut rest = vec![0.0; x.len()];
+        patch_normals(&t.rest_positions, &t, &mut n, &mut rest);
+        assert!(rest.iter().all(|r| (r - 1.0).abs() < 1e-12), "{rest:?}");
         // dT/dx by central differences of T at fixed v; (dM/dt) v by central differences
         // of M(x + s v) v in s.
         let eps = 1e-6;
-        let ma: Vec<f64> = t.areas.iter().map(|a| m.water.added_mass * a).collect();
         for j in 0..x.len() {
             let mut grad = Vec3::zeros();
             for a in 0..3 {
@@ -299,8 +332,7 @@ mod tests {
             }
             let m_v = |s: f64| {
                 let y: Vec<Vec3> = x.iter().zip(&v).map(|(x, v)| x + s * eps * v).collect();
-                let n = normals(&t, &y)[j];
-                ma[j] * n.dot(&v[j]) * n
+                inertias(&t, &m, &y)[j].apply(&v[j])
             };
             let mdot_v = (m_v(1.0) - m_v(-1.0)) / (2.0 * eps);
             let want = grad - mdot_v;
@@ -314,16 +346,7 @@ mod tests {
         // Nothing without normal added mass.
         let mut none = vec![Vec3::zeros(); x.len()];
         let plain = Model::fractional();
-        turning_forces(
-            &plain,
-            &x,
-            &v,
-            &t.areas,
-            &t.triangles,
-            &t.vertex_triangles,
-            &mut s,
-            &mut none,
-        );
+        turning_forces(&plain, &t, &x, &v, &mut s, &mut projected, &mut none);
         assert!(none.iter().all(|f| *f == Vec3::zeros()));
     }
 
@@ -331,7 +354,7 @@ mod tests {
         let mut model = Model::fractional();
         model.water.added_mass = 40.0;
         model.water.entrained_mass = 3.0;
-        Inertia::of(&model, 1e-3, 1e-4, Vec3::new(0.3, -0.4, 0.866).normalize())
+        Inertia::of(&model, 1e-3, 1e-4, Vec3::new(0.3, -0.4, 0.866).normalize(), 1.0)
     }
 
     #[test]

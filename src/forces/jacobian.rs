@@ -65,8 +65,15 @@ fn outer(a: &Vec3) -> Matrix3<f64> {
 }
 
 /// Fills `out` for the state in `input`; `w0` is the current-velocity weight of D^{1/2};
-/// `normals` are the vertex normals (needed only with normal drag).
-pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Linearisation) {
+/// `normals` are the vertex normals (needed only with terms that read them or the water's
+/// inertia), `projected` the patches' projected-area ratios (with normal added mass only).
+pub fn linearise(
+    input: &ForceInput<'_>,
+    w0: f64,
+    normals: &[Vec3],
+    projected: &[f64],
+    out: &mut Linearisation,
+) {
     let m = input.model;
     let ns = input.topology.springs.len();
     let n = input.x.len();
@@ -120,8 +127,10 @@ pub fn linearise(input: &ForceInput<'_>, w0: f64, normals: &[Vec3], out: &mut Li
     out.inertia.clear();
     if super::carries_water(m) {
         let t = input.topology;
-        out.inertia
-            .extend((0..n).map(|i| super::Inertia::of(m, t.masses[i], t.areas[i], normals[i])));
+        out.inertia.extend((0..n).map(|i| {
+            let p = projected.get(i).copied().unwrap_or(1.0);
+            super::Inertia::of(m, t.masses[i], t.areas[i], normals[i], p)
+        }));
     }
 }
 
@@ -237,7 +246,7 @@ mod tests {
                 strain_w0: self.w0,
             };
             let mut out = Linearisation::default();
-            linearise(&input, self.w0, &[], &mut out);
+            linearise(&input, self.w0, &[], &[], &mut out);
             out
         }
     }

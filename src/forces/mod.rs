@@ -33,7 +33,7 @@ mod tiles;
 pub use assemble::add_spring_values;
 pub use body::{body_acceleration, body_force};
 pub use contact::{apply_friction, friction_active, Capsule, Collider, Plane, Sphere};
-pub use inertia::{carries_water, effective_forces, turning_forces, Inertia, TurningScratch};
+pub use inertia::{carries_water, effective_forces, patch_normals, turning_forces, Inertia, TurningScratch};
 pub use jacobian::{linearise, Linearisation, SpringBlock};
 pub use memories::{memories, Memories};
 pub use normals::{vertex_normals, vertex_normals_with};

@@ -41,6 +41,11 @@ pub struct Topology {
     pub spring_kinds: Vec<u8>,
     /// Triangles (counter-clockwise seen from the +normal side), vertex indices.
     pub triangles: Vec<[u32; 3]>,
+    /// One over the length of each vertex's patch normal at rest: `1 / |N_i|`, `N_i` the sum
+    /// of its triangles' normals each twice its area (0 where that sum vanishes). A patch's
+    /// area vector relative to its rest area is `N_i(x) * patch_scale[i]`
+    /// ([`crate::forces::patch_normals`]).
+    pub patch_scale: Vec<f64>,
     /// Grid size (columns, rows) when the cloth was built from a grid.
     pub grid: Option<(u32, u32)>,
     /// Springs touching each vertex (see [`Adjacency::springs`]).
@@ -86,8 +91,22 @@ impl Topology {
                 areas[i] += third;
             }
         }
+        let mut patch = vec![Vec3::zeros(); n];
+        for tri in &triangles {
+            let [a, b, c] = tri.map(|i| i as usize);
+            let face =
+                (rest_positions[b] - rest_positions[a]).cross(&(rest_positions[c] - rest_positions[a]));
+            for i in [a, b, c] {
+                patch[i] += face;
+            }
+        }
+        let patch_scale = patch
+            .iter()
+            .map(|p| if p.norm() > 0.0 { 1.0 / p.norm() } else { 0.0 })
+            .collect();
         let mut t = Self {
             areas,
+            patch_scale,
             spring_rest: springs.iter().map(|s| s.rest).collect(),
             spring_kinds: springs.iter().map(|s| s.kind as u8).collect(),
             vertex_springs: Adjacency::springs(n, &springs),

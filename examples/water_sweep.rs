@@ -1,0 +1,136 @@
+//! The underwater preset across the scenes an artist would try (issue: water that holds in
+//! every scene): the swing at several drive frequencies, sizes and integrators, measured with
+//! the look meter, one line per bake.
+//!
+//! `cargo run --release --example water_sweep -- [KEY=VALUE ...]`
+//!
+//! Keys (defaults in brackets): `freq=0.25,0.5,1,2` (Hz), `amp=0.04` (m), `size=61x41`,
+//! `current=X,Y,Z` (m/s; with `amp=0`, how far the tip leans and flutters), `integrator=symplectic|implicit|explicit|symplectic2|implicit2` [symplectic], `dt` [2 ms
+//! explicit, 1/30 s implicit], `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
+//! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag),
+//! `skin=` (N s/m^3), `damping=` (spring damping, N s/m).
+
+use fraccloth::look::measure;
+use fraccloth::scenes::{Drive, SceneKind, SceneSpec, Variant};
+use fraccloth::{Integrator, Model, Vec3};
+
+fn main() {
+    let args: Vec<(String, String)> = std::env::args()
+        .skip(1)
+        .filter_map(|a| a.split_once('=').map(|(k, v)| (k.to_string(), v.to_string())))
+        .collect();
+    let get = |k: &str| args.iter().find(|(key, _)| key == k).map(|(_, v)| v.clone());
+    let num = |k: &str, d: f64| get(k).map_or(d, |v| v.parse().expect("a number"));
+    let freqs: Vec<f64> = get("freq")
+        .unwrap_or("0.25,0.5,1,2".into())
+        .split(',')
+        .map(|f| f.parse().expect("a frequency"))
+        .collect();
+    let (w, h) = get("size").map_or((61, 41), |s| {
+        let (a, b) = s.split_once('x').expect("COLSxROWS");
+        (a.parse().expect("cols"), b.parse().expect("rows"))
+    });
+    let integrator = Integrator::ALL
+        .into_iter()
+        .find(|i| i.key() == get("integrator").as_deref().unwrap_or("symplectic"))
+        .expect("an integrator");
+    let mut model = Model::underwater();
+    let w_ = &mut model.water;
+    w_.added_mass = num("added", w_.added_mass);
+    w_.entrained_mass = num("entrained", w_.entrained_mass);
+    w_.form_drag = num("cd", w_.form_drag);
+    w_.skin_drag = num("skin", w_.skin_drag);
+    model.spring_damping = num("damping", model.spring_damping);
+    let seconds = num("seconds", 12.0);
+    let fps = 30.0;
+    println!(
+        "# {w}x{h} {} added {} entrained {} C_d {} skin {} damping {}",
+        integrator.key(),
+        model.water.added_mass,
+        model.water.entrained_mass,
+        model.water.form_drag,
+        model.water.skin_drag,
+        model.spring_damping
+    );
+    println!("freq Hz | half-waves | travel m/s | mid | bottom | zigzag | hang m | max speed m/s | status");
+    for f in freqs {
+        let spec = SceneSpec {
+            width: w,
+            height: h,
+            integrator,
+            dt: num(
+                "dt",
+                if integrator.is_implicit() {
+                    1.0 / 30.0
+                } else {
+                    2e-3
+                },
+            ),
+            drive: Drive {
+                amplitude: num("amp", 0.04),
+                frequency: f,
+                ramp: num("ramp", 0.0),
+                current: get("current").map_or(Vec3::zeros(), |c| {
+                    let v: Vec<f64> = c.split(',').map(|x| x.parse().expect("X,Y,Z")).collect();
+                    Vec3::new(v[0], v[1], v[2])
+                }),
+            },
+            ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
+        };
+        let mut scene = spec.build().expect("a scene");
+        scene
+            .cloth
+            .reconfigure(fraccloth::ClothConfig {
+                model: Model {
+                    current: spec.drive.current,
+                    ..model.clone()
+                },
+                ..scene.cloth.config().clone()
+            })
+            .expect("a valid model");
+        let topo = scene.cloth.topology().clone();
+        let (mut frames, mut times) = (vec![scene.cloth.positions().to_vec()], vec![0.0]);
+        let mut status = "ok".to_string();
+        let mut vmax: f64 = 0.0;
+        for k in 1..=(seconds * fps) as usize {
+            if let Err(e) = scene.run_until(k as f64 / fps) {
+                status = e.to_string();
+                break;
+            }
+            frames.push(scene.cloth.positions().to_vec());
+            times.push(k as f64 / fps);
+            vmax = scene
+                .cloth
+                .velocities()
+                .iter()
+                .map(|v| v.norm())
+                .fold(vmax, f64::max);
+        }
+        if spec.drive.amplitude == 0.0 {
+            let root = scene.top_row()[w as usize / 2] as usize;
+            let tip = (h as usize - 1) * w as usize + w as usize / 2;
+            let s = fraccloth::look::measure_stream(&topo.rest_positions, &frames, &times, root, tip);
+            let d = scene.cloth.positions()[tip] - topo.rest_positions[tip];
+            println!(
+                "still | {s:?} | tip moved ({:.4}, {:.4}, {:.4}) m | {status}",
+                d.x, d.y, d.z
+            );
+            continue;
+        }
+        match measure(&topo.rest_positions, &topo.triangles, &frames, &times, Vec3::y()) {
+            Ok(look) => {
+                let d = &look.descriptors;
+                println!(
+                    "{f} | {:.2} | {} | {:.3} | {:.3} | {} | {:.3} | {vmax:.3} | {status}",
+                    d.half_waves,
+                    d.travel_speed.map_or("-".into(), |c| format!("{c:.3}")),
+                    d.mid_ratio,
+                    d.bottom_ratio,
+                    d.zigzag.map_or("-".into(), |z| format!("{z:.2}")),
+                    d.hang_depth
+                );
+            }
+            Err(e) => println!("{f} | not measured: {e} | {status}"),
+        }
+    }
+}
