@@ -231,9 +231,8 @@ fn spec_from(args: &Args, variant: Variant, scheme: Scheme) -> Result<SceneSpec,
         ramp: args.ramp.unwrap_or(own.ramp),
         current: args.current.unwrap_or(own.current),
     };
-    if !(drive.amplitude.is_finite() && drive.frequency.is_finite() && drive.frequency > 0.0)
-        || !(drive.ramp.is_finite() && drive.ramp >= 0.0)
-    {
+    let finite = drive.amplitude.is_finite() && drive.frequency.is_finite() && drive.ramp.is_finite();
+    if !(finite && drive.frequency > 0.0 && drive.ramp >= 0.0) {
         return Err("--amplitude must be finite, --frequency positive, --ramp >= 0".into());
     }
     Ok(SceneSpec {
