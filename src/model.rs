@@ -216,15 +216,16 @@ impl Model {
     /// velocity-damped, and the water's physics per unit area, each term by direction
     /// (`docs/underwater.md` derives the numbers and measures the look):
     /// - normal added mass [`UNDERWATER_ADDED_MASS`] (the water a face carries when it moves
-    ///   face first; none along the cloth), with the turning forces that keep its energy;
+    ///   face first; none along the cloth), with the turning forces that keep its energy
+    ///   (`forces/inertia.rs`);
     /// - form drag on the normal velocity, C_d = [`UNDERWATER_FORM_DRAG`];
     /// - skin drag on the tangential velocity, [`UNDERWATER_SKIN_DRAG`] (laminar skin friction
     ///   on both faces, linearised at 0.3 m/s on a 0.4 m cloth): a current along the cloth
     ///   drags it, and motion in its plane dies out.
     ///
     /// Swung 4 cm at 0.25 to 2 Hz the towel hangs at least 0.9 of its length and shows bumps
-    /// travelling down (about 4 half-waves at 0.5 Hz, 0.13 m/s), the same within a few percent
-    /// from 2 cm to 0.5 cm spacing.
+    /// travelling down (about 4 half-waves at 0.5 Hz, 0.15 m/s), the same within 7 % from 2 cm
+    /// to 0.5 cm spacing.
     pub fn underwater() -> Self {
         Self {
             spring_damping: UNDERWATER_SPRING_DAMPING,
@@ -244,12 +245,13 @@ impl Model {
 }
 
 /// Normal added mass of the underwater preset, kg/m^2. Potential flow gives
-/// `rho_w lambda / pi` for a sheet rippled at wavelength lambda (about 60 kg/m^2 for the
-/// 0.19 m bumps the preset shows at 0.5 Hz) and up to `rho_w pi W / 4` for a whole sheet of
-/// width W moving rigidly: the preset carries a quarter of the ripples' value, the largest that
-/// keeps a towel swung 4 cm at 2 Hz hanging (more gives more and deeper bumps and shortens the
-/// hang; `docs/underwater.md`).
-pub const UNDERWATER_ADDED_MASS: f64 = 15.0;
+/// `rho_w lambda / pi` for a sheet rippled at wavelength lambda (about 80 kg/m^2 for the
+/// 0.25 m bumps the preset shows at 0.5 Hz) and up to `rho_w pi W / 4` for a whole sheet of
+/// width W moving rigidly. The preset carries far less: the most that keeps a towel swung 4 cm
+/// at 2 Hz hanging at 0.9 of its length (15 kg/m^2 hangs 0.885; more gives more and deeper
+/// bumps and a shorter hang), which is also what gives the look it was tuned for at 0.5 Hz
+/// (`docs/underwater.md`).
+pub const UNDERWATER_ADDED_MASS: f64 = 10.0;
 /// Form-drag coefficient of the underwater preset (a flat plate face on: 1-2).
 pub const UNDERWATER_FORM_DRAG: f64 = 1.0;
 /// Skin drag of the underwater preset, N s/m^3: laminar skin friction on both faces,

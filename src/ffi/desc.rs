@@ -77,7 +77,7 @@ pub enum FcPreset {
     /// Regular cloth of Fig. 7, third column: damped springs, normal drag.
     FC_PRESET_REGULAR_NORMAL = 3,
     /// A wet towel in water: the paper's springs lightly velocity-damped, and per unit area the
-    /// water's normal added mass (15 kg/m^2), form drag (C_d = 1) and skin drag (1.15 N s/m^3),
+    /// water's normal added mass (10 kg/m^2), form drag (C_d = 1) and skin drag (1.15 N s/m^3),
     /// symplectic Euler (step 0.5 ms at 1 cm spacing). The look, measured: docs/underwater.md.
     FC_PRESET_UNDERWATER = 4,
 }
