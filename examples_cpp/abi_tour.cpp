@@ -38,7 +38,7 @@ int main(int argc, char** argv) try {
     cloth.pin_group(std::vector<uint32_t>{0, 12}, 1.0f);
     std::vector<float> rest = cloth.positions();
     std::vector<float> targets(rest.begin(), rest.begin() + 39);
-    for (std::size_t i = 0; i < 13; ++i) targets[3 * i + 2] = 0.02f;
+    for (std::size_t i = 0; i < 13; ++i) targets[3 * i + 2] = 0.002f;
     cloth.set_pin_targets(top, targets);
     cloth.set_current(fraccloth::Vec3f{0.0f, 0.0f, 0.01f});
     cloth.set_current(std::array<double, 3>{0.0, 0.0, 0.02});

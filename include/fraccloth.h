@@ -158,9 +158,9 @@ typedef enum {
    */
   FC_PRESET_REGULAR_NORMAL = 3,
   /**
-   * A wet towel in still water: the paper's springs lightly velocity-damped, entrained water
-   * (10 kg/m^2) and form drag (C_d = 1) per unit area, symplectic Euler (step 0.5 ms at 1 cm
-   * spacing). The look, measured: docs/underwater.md.
+   * A wet towel in water: the paper's springs lightly velocity-damped, and per unit area the
+   * water's normal added mass (10 kg/m^2), form drag (C_d = 1) and skin drag (1.15 N s/m^3),
+   * symplectic Euler (step 0.5 ms at 1 cm spacing). The look, measured: docs/underwater.md.
    */
   FC_PRESET_UNDERWATER = 4,
 } FcPreset;

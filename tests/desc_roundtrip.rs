@@ -50,9 +50,10 @@ fn the_description_reads_back_and_a_round_trip_changes_nothing() {
     assert!((got.spacing - 0.02).abs() < 1e-7);
     assert!((got.total_mass - 0.24).abs() < 1e-6, "{}", got.total_mass); // spacing is a float
     assert!((got.areal_density - 1.0).abs() < 1e-6);
-    // The added mass as C_a rho_w W, W = 0.4 m: 200 kg/m^2, the coefficient folded in.
+    // The added mass as C_a rho_w W, W = 0.4 m: 200 kg/m^2 on top of the preset's, the
+    // coefficient folded in.
     assert!(
-        (got.added_mass - 200.0).abs() < 1e-4 && got.added_mass_coefficient == 0.0,
+        (got.added_mass - (d.added_mass + 200.0)).abs() < 1e-4 && got.added_mass_coefficient == 0.0,
         "{}",
         got.added_mass
     );
