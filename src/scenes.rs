@@ -12,7 +12,9 @@
 //! - `current`: the towel pinned at its top edge, still, in a current ([`CURRENT_SPEED`]
 //!   along its plane by default);
 //! - `kelp`: a buoyant strip [`KELP_WIDTH`] x [`KELP_LENGTH`] pinned at its foot, in still
-//!   water (density [`KELP_DENSITY`]: it stands up).
+//!   water (density [`KELP_DENSITY`]: it stands up);
+//! - `curtain`: a 1 x 1.5 m curtain ([`CURTAIN_EXTENT`]), the same cloth as the towel, swung
+//!   at its top edge like it.
 //!
 //! Every scene's drive ([`Drive`]: amplitude, frequency, a fade-in and the current) can be
 //! changed ([`SceneSpec::drive`]); the pinned edge moves along the scene's axis (z, out of
@@ -56,6 +58,9 @@ pub const SPHERE_SPEED: f64 = 0.2;
 /// Sphere start, z in m (its centre is at x = 0, y = -0.2 m: the middle of the cloth).
 pub const SPHERE_START_Z: f64 = -0.25;
 
+/// Width and height of the `curtain`, m.
+pub const CURTAIN_EXTENT: (f64, f64) = (1.0, 1.5);
+
 /// Speed of the `current` scene's water by default, m/s (along the towel's plane, +x).
 pub const CURRENT_SPEED: f64 = 0.3;
 /// Width of the `kelp` strip, m.
@@ -75,15 +80,18 @@ pub enum SceneKind {
     Current,
     /// A buoyant strip pinned at its foot.
     Kelp,
+    /// A 1 x 1.5 m curtain swung at its top edge like the towel.
+    Curtain,
 }
 
 impl SceneKind {
-    pub const ALL: [SceneKind; 5] = [
+    pub const ALL: [SceneKind; 6] = [
         SceneKind::Swing,
         SceneKind::Sway,
         SceneKind::Sphere,
         SceneKind::Current,
         SceneKind::Kelp,
+        SceneKind::Curtain,
     ];
     pub fn name(&self) -> &'static str {
         match self {
@@ -92,19 +100,23 @@ impl SceneKind {
             SceneKind::Sphere => "sphere",
             SceneKind::Current => "current",
             SceneKind::Kelp => "kelp",
+            SceneKind::Curtain => "curtain",
         }
     }
     /// The cloth's width and height, m.
     pub fn extent(&self) -> (f64, f64) {
         match self {
             SceneKind::Kelp => (KELP_WIDTH, KELP_LENGTH),
+            SceneKind::Curtain => CURTAIN_EXTENT,
             _ => (CLOTH_WIDTH, CLOTH_WIDTH * 2.0 / 3.0),
         }
     }
-    /// Columns and rows at 1 cm spacing (the paper's 61 x 41 for the towel).
+    /// Columns and rows: 1 cm spacing (the paper's 61 x 41 for the towel), 2 cm for the
+    /// curtain.
     pub fn default_size(&self) -> (u32, u32) {
         match self {
             SceneKind::Kelp => (11, 101),
+            SceneKind::Curtain => (51, 76),
             _ => (61, 41),
         }
     }
@@ -193,7 +205,7 @@ impl Drive {
             current: Vec3::zeros(),
         };
         match kind {
-            SceneKind::Swing => Drive {
+            SceneKind::Swing | SceneKind::Curtain => Drive {
                 amplitude: if variant == Variant::Underwater {
                     UNDERWATER_SWING_AMPLITUDE
                 } else {
@@ -288,7 +300,7 @@ impl SceneSpec {
             height: self.height,
             spacing,
             total_mass: match self.kind {
-                SceneKind::Kelp => areal_density * cols * rows * spacing * spacing,
+                SceneKind::Kelp | SceneKind::Curtain => areal_density * cols * rows * spacing * spacing,
                 _ => CLOTH_MASS,
             },
         }

@@ -72,8 +72,8 @@ struct LookArgs {
 
 #[derive(clap::Args, Debug)]
 struct Args {
-    /// Scene: swing, sway, sphere, current (the towel still in a current along its plane) or
-    /// kelp (a buoyant 10 x 100 cm strip pinned at its foot).
+    /// Scene: swing, sway, sphere, current (the towel still in a current along its plane),
+    /// kelp (a buoyant 10 x 100 cm strip pinned at its foot) or curtain (1 x 1.5 m, swung).
     #[arg(long, default_value = "swing")]
     scene: String,
     /// Model: underwater (the water's physics per unit area; the default), fractional (the
@@ -81,7 +81,7 @@ struct Args {
     #[arg(long, default_value = "underwater")]
     variant: String,
     /// Grid size as COLUMNSxROWS (the paper uses 61x41 and 31x21; default 61x41, 11x101 for
-    /// kelp: 1 cm spacing).
+    /// kelp: 1 cm spacing; 51x76 for the curtain: 2 cm).
     #[arg(long)]
     size: Option<String>,
     /// Drive frequency of the pinned edge, Hz (default: the scene's own, 0.5 Hz for swing).
@@ -158,7 +158,7 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
 fn scene_kind(args: &Args) -> Result<SceneKind, String> {
     SceneKind::from_name(&args.scene).ok_or_else(|| {
         format!(
-            "unknown scene {:?} (swing, sway, sphere, current, kelp)",
+            "unknown scene {:?} (swing, sway, sphere, current, kelp, curtain)",
             args.scene
         )
     })

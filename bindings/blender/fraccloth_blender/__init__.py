@@ -67,14 +67,10 @@ DAMPING_ITEMS = [
 ]
 
 # Presets in an artist's words: (label, tooltip, values). "Underwater towel" is the library's
-# FC_PRESET_UNDERWATER (docs/underwater.md); the others differ visibly from it.
+# FC_PRESET_UNDERWATER, read from the library when chosen (docs/underwater.md); the others
+# differ visibly from it.
 PRESETS = {
-    "UNDERWATER": ("Underwater towel", "A wet towel in still water: slow bumps that travel down it (the library's underwater preset)", {
-        "stretch_stiffness": 10.0, "shear_stiffness": 2.0, "bend_stiffness": 0.5,
-        "damping_mode": "VELOCITY", "spring_damping": 0.015, "history_drag": 0.0, "viscous_drag": 0.0,
-        "normal_drag": 0.0, "mass_per_area": 1.0, "cloth_density": 1100.0, "water_density": 1000.0,
-        "entrained_mass": 10.0, "added_mass": 0.0, "form_drag": 1.0, "skin_drag": 0.0,
-        "history": "OFF", "integrator": "SYMPLECTIC"}),
+    "UNDERWATER": ("Underwater towel", "A wet towel in water: slow bumps that travel down it (the library's underwater preset)", None),
     "SILK": ("Light silk", "A thin, light scarf: billows and drifts, settles slowly", {
         "stretch_stiffness": 4.0, "shear_stiffness": 0.8, "bend_stiffness": 0.02,
         "damping_mode": "VELOCITY", "spring_damping": 0.005, "history_drag": 0.0, "viscous_drag": 0.0,
@@ -97,11 +93,46 @@ PRESETS = {
 PRESET_ITEMS = [("CUSTOM", "Custom", "Your own values")] + [(k, v[0], v[1]) for k, v in PRESETS.items()]
 
 
+def _library_preset():
+    """The panel's values of the library's FC_PRESET_UNDERWATER (the panel's drags are per
+    1 cm^2 of cloth, the library's per m^2)."""
+    import fraccloth
+
+    d = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
+    modes = {
+        fraccloth.SPRING_DAMPING_FRACTIONAL: "FRACTIONAL",
+        fraccloth.SPRING_DAMPING_FRACTIONAL_STRAIN: "STRAIN",
+        fraccloth.SPRING_DAMPING_VELOCITY: "VELOCITY",
+        fraccloth.SPRING_DAMPING_NONE: "NONE",
+    }
+    integrators = {
+        fraccloth.INTEGRATOR_SYMPLECTIC_EULER: "SYMPLECTIC",
+        fraccloth.INTEGRATOR_EXPLICIT_EULER: "EXPLICIT",
+        fraccloth.INTEGRATOR_IMPLICIT_EULER: "IMPLICIT",
+        fraccloth.INTEGRATOR_EXTRAPOLATED_SYMPLECTIC: "SYMPLECTIC2",
+        fraccloth.INTEGRATOR_EXTRAPOLATED_IMPLICIT: "IMPLICIT2",
+    }
+    fractional = d.history_drag or d.history_drag_per_area or d.spring_damping_mode in (
+        fraccloth.SPRING_DAMPING_FRACTIONAL, fraccloth.SPRING_DAMPING_FRACTIONAL_STRAIN)
+    return {
+        "stretch_stiffness": d.stretch_stiffness, "shear_stiffness": d.shear_stiffness,
+        "bend_stiffness": d.bend_stiffness, "damping_mode": modes[d.spring_damping_mode],
+        "spring_damping": d.spring_damping,
+        # The library's per-particle drags are 0 in this preset; per area, to the panel's 1 cm^2.
+        "history_drag": d.history_drag_per_area * 1e-4, "viscous_drag": d.viscous_drag_per_area * 1e-4,
+        "normal_drag": d.normal_drag_per_area * 1e-4,
+        "mass_per_area": d.areal_density, "cloth_density": d.cloth_density, "water_density": d.water_density,
+        "entrained_mass": d.entrained_mass, "added_mass": d.added_mass, "form_drag": d.form_drag,
+        "skin_drag": d.skin_drag, "history": "SOE" if fractional else "OFF",
+        "integrator": integrators[d.integrator],
+    }
+
+
 def _apply_preset(self, context):
     values = PRESETS.get(self.preset)
     if values is None:
         return
-    for name, value in values[2].items():
+    for name, value in (values[2] or _library_preset()).items():
         setattr(self, name, value)
 
 
