@@ -198,7 +198,7 @@ fn strain_comparison() {
     for (name, springs, bake, model) in rows {
         for size in [(31, 21), (61, 41)] {
             let bake = Bake { size, ..bake };
-            let d = look_with(bake, model.clone(), Scheme::DEFAULT, None);
+            let d = look_with(bake, model, Scheme::DEFAULT, None);
             match d {
                 Some(d) => println!(
                     "| {name} | {springs} | {} x {} | {:.2} | {} | {:.2} | {} | {:.3} |",
@@ -263,7 +263,7 @@ fn main() {
                         normal_drag: kn,
                         ..Water::default()
                     },
-                    ..b.clone()
+                    ..*b
                 };
                 (
                     m,
@@ -288,7 +288,7 @@ fn main() {
                         form_drag: cd,
                         ..Water::default()
                     },
-                    ..b.clone()
+                    ..*b
                 };
                 (
                     m,
@@ -311,7 +311,7 @@ fn main() {
                         history_drag: kh,
                         ..Water::default()
                     },
-                    ..b.clone()
+                    ..*b
                 };
                 (m, format!("entrained {me:.2} kg/m^2, C_d {cd:.2}, fractional k_d {kd:.3}, history {kh:.2} N s^1/2/m^3"))
             },
@@ -327,7 +327,7 @@ fn main() {
         let mut best: Option<(f64, Option<Descriptors>, String, Model)> = None;
         for _ in 0..budget {
             let (model, label) = draw(&mut rng, &base);
-            let d = look(model.clone(), *scheme, None);
+            let d = look(model, *scheme, None);
             let j = cost(&d);
             if best.as_ref().is_none_or(|b| j < b.0) {
                 best = Some((j, d, label, model));
@@ -367,7 +367,7 @@ fn fractional(r: &mut Rng, b: &Model) -> (Model, String) {
             viscous_drag: kv,
             ..Water::default()
         },
-        ..b.clone()
+        ..*b
     };
     (
         m,

@@ -8,7 +8,8 @@
 //! `current=X,Y,Z` (m/s; with `amp=0`, how far the tip leans and flutters), `integrator=symplectic|implicit|explicit|symplectic2|implicit2` [symplectic], `dt` [2 ms
 //! explicit, 1/30 s implicit], `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
 //! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag),
-//! `skin=` (N s/m^3), `damping=` (spring damping, N s/m).
+//! `skin=` (N s/m^3), `damping=` (spring damping), `mode=velocity|fractional|strain|none` (what the
+//! springs damp), `history=` (history drag per area, N s^1/2/m^3; the SOE history is kept).
 
 use fraccloth::look::measure;
 use fraccloth::scenes::{Drive, SceneKind, SceneSpec, Variant};
@@ -41,6 +42,16 @@ fn main() {
     w_.form_drag = num("cd", w_.form_drag);
     w_.skin_drag = num("skin", w_.skin_drag);
     model.spring_damping = num("damping", model.spring_damping);
+    model.water.history_drag = num("history", model.water.history_drag);
+    if let Some(mode) = get("mode") {
+        model.spring_damping_mode = match mode.as_str() {
+            "velocity" => fraccloth::model::SpringDamping::Velocity,
+            "fractional" => fraccloth::model::SpringDamping::Fractional,
+            "strain" => fraccloth::model::SpringDamping::FractionalStrain,
+            "none" => fraccloth::model::SpringDamping::None,
+            other => panic!("unknown mode {other}"),
+        };
+    }
     let seconds = num("seconds", 12.0);
     let fps = 30.0;
     println!(
@@ -75,19 +86,17 @@ fn main() {
                     Vec3::new(v[0], v[1], v[2])
                 }),
             },
+            scheme: fraccloth::history::Scheme::DEFAULT,
             ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
         };
+        let spec = SceneSpec {
+            model: Some(Model {
+                current: spec.drive.current,
+                ..model
+            }),
+            ..spec
+        };
         let mut scene = spec.build().expect("a scene");
-        scene
-            .cloth
-            .reconfigure(fraccloth::ClothConfig {
-                model: Model {
-                    current: spec.drive.current,
-                    ..model.clone()
-                },
-                ..scene.cloth.config().clone()
-            })
-            .expect("a valid model");
         let topo = scene.cloth.topology().clone();
         let (mut frames, mut times) = (vec![scene.cloth.positions().to_vec()], vec![0.0]);
         let mut status = "ok".to_string();

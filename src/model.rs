@@ -24,7 +24,7 @@ pub enum SpringDamping {
 }
 
 /// Every force coefficient. A coefficient of zero switches its term off and costs nothing.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Model {
     /// Density of a wet cloth particle rho_c, kg/m^3 (> 0). Particle volume is `V_c = m / rho_c`.
     pub cloth_density: f64,

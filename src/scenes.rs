@@ -262,6 +262,9 @@ pub struct SceneSpec {
     pub stiffness_scale: f64,
     /// How the pinned edge moves and the water flows.
     pub drive: Drive,
+    /// The cloth's model instead of the variant's (its current is the drive's); None: the
+    /// variant's.
+    pub model: Option<Model>,
 }
 
 impl SceneSpec {
@@ -279,6 +282,7 @@ impl SceneSpec {
             dt: DEFAULT_DT,
             stiffness_scale: 1.0,
             drive: Drive::of(kind, variant),
+            model: None,
         }
     }
 
@@ -308,6 +312,9 @@ impl SceneSpec {
         let mut model = self.variant.model(spacing);
         if self.kind == SceneKind::Kelp {
             model.cloth_density = KELP_DENSITY;
+        }
+        if let Some(own) = self.model {
+            model = own;
         }
         model.current = self.drive.current;
         model.stretch_stiffness *= self.stiffness_scale;

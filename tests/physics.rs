@@ -36,7 +36,7 @@ fn sinking_particle_reaches_the_terminal_velocity_of_buoyancy_and_viscous_drag()
         viscous_drag: 1.0e-3,
         ..Model::fractional()
     };
-    let mut cloth = free_particles(model.clone());
+    let mut cloth = free_particles(model);
     let m = cloth.topology().masses[0];
     let terminal = body_force(&model, m) / model.viscous_drag;
     // Independent of the code under test: (1 - rho_w / rho_c) m g / k_vd.

@@ -207,7 +207,7 @@ fn swung_differences(integrator: fraccloth::Integrator, smooth: bool) -> (f64, f
             ..SceneSpec::paper(SceneKind::Swing, Variant::Fractional)
         };
         let s = spec.build().unwrap();
-        let mut model = s.cloth.model().clone();
+        let mut model = *s.cloth.model();
         model.history_drag = 0.0;
         model.viscous_drag = 0.0;
         let config = ClothConfig {

@@ -481,13 +481,21 @@ fn bake(args: &Args) -> Result<(), String> {
         );
     }
     let times: Vec<f64> = (0..recorded.len()).map(|k| k as f64 / args.fps).collect();
-    match measure(
-        &topo.rest_positions,
-        &topo.triangles,
-        &recorded,
-        &times,
-        Vec3::y(),
-    ) {
+    let driven = spec.drive.amplitude != 0.0;
+    let look = if driven {
+        measure(
+            &topo.rest_positions,
+            &topo.triangles,
+            &recorded,
+            &times,
+            Vec3::y(),
+        )
+    } else {
+        Err(fraccloth::Error::invalid(
+            "the pinned edge is held still (no drive): see the stream below",
+        ))
+    };
+    match look {
         Ok(look) => {
             let json = path("-look.json");
             std::fs::write(&json, look.to_json() + "\n").map_err(io(&json))?;
@@ -507,7 +515,7 @@ fn bake(args: &Args) -> Result<(), String> {
         }
     }
     // A still cloth in a current: how far it leans and how its free edge flutters.
-    if matches!(spec.kind, SceneKind::Current | SceneKind::Kelp) || spec.drive.amplitude == 0.0 {
+    if !driven {
         let (w, h) = (spec.width as usize, spec.height as usize);
         let root = scene.top_row()[w / 2] as usize;
         let tip = if spec.kind == SceneKind::Kelp {

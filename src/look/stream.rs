@@ -6,6 +6,9 @@ use super::harmonic::dominant_frequency;
 use crate::error::Error;
 use crate::Vec3;
 
+/// Flutter below this (m, rms) is stillness: no frequency is reported.
+pub const STILL: f64 = 1e-4;
+
 /// A streaming cloth's numbers over the second half of a cache.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Stream {
@@ -14,7 +17,7 @@ pub struct Stream {
     /// Root-mean-square distance of the tip from its mean position, m.
     pub flutter_amplitude: f64,
     /// Dominant frequency of the tip's motion along its main direction, Hz (None when it is
-    /// still).
+    /// still: flutter below [`STILL`]).
     pub flutter_frequency: Option<f64>,
 }
 
@@ -86,7 +89,8 @@ pub fn measure_stream(
     let axis: Vec3 = eig.eigenvectors.column(eig.eigenvalues.imax()).into();
     let along: Vec<f64> = offsets.iter().map(|d| d.dot(&axis)).collect();
     let t: Vec<f64> = second.iter().map(|&k| times[k]).collect();
-    let flutter_frequency = if flutter_amplitude > 1e-6 {
+    // Below a tenth of a millimetre the tip is still: no frequency to speak of.
+    let flutter_frequency = if flutter_amplitude > STILL {
         dominant_frequency(&t, &along).map(|w| w / std::f64::consts::TAU)
     } else {
         None

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The underwater preset's catalogue of scenes (docs/underwater.md): bakes each scene with the
+# baker into OUT (default out/catalogue), one folder per scene, and prints its look (driven
+# scenes) or its lean and flutter (still scenes in a current). About a minute.
+# Usage: bash scripts/underwater_catalogue.sh [OUT]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+OUT="${1:-out/catalogue}"
+cargo build --release --quiet -p fraccloth-cli
+BIN=target/release/fraccloth
+bake() {  # name, then the baker's options
+  local name="$1"; shift
+  "$BIN" --quiet --out "$OUT/$name" "$@" > "$OUT/$name.txt" 2>&1 || { echo "$name: refused"; tail -3 "$OUT/$name.txt"; return 0; }
+  echo "== $name ($*)"
+  grep -E "^(half-waves|travel|mid / bottom|zigzag|hang depth|streaming angle|flutter) " "$OUT/$name.txt" | sed 's/^/   /'
+}
+mkdir -p "$OUT"
+for f in 0.25 0.5 1 2; do bake "swing-${f}hz" --frequency "$f"; done
+bake swing-31x21 --size 31x21 --dt 0.001
+bake swing-121x81 --size 121x81 --dt 0.00025
+bake curtain-51x76 --scene curtain --dt 0.001
+bake curtain-101x151 --scene curtain --size 101x151 --dt 0.0005
+bake current-along --scene current --current 0.3,0,0
+bake current-face-0.1 --scene current --current 0,0,0.1
+bake current-face-0.3 --scene current --current 0,0,0.3
+bake kelp-still --scene kelp --seconds 20
+bake kelp-along-0.3 --scene kelp --current 0.3,0,0 --seconds 20
+bake kelp-face-0.1 --scene kelp --current 0,0,0.1 --seconds 20
