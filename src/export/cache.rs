@@ -8,6 +8,10 @@
 //! host that keeps going never ends with a success on a corrupt file. Arguments that are
 //! refused before anything is written (a wrong vertex count, a frame past an MDD's announced
 //! count) do not poison.
+//!
+//! **A cache dropped without [`CacheWriter::finish`]** (a host that stops on an error and lets
+//! it go) is finished on drop: its header counts exactly the frames written whole, or, if that
+//! cannot be done, the file is removed. Only `finish` reports errors.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
@@ -223,6 +227,28 @@ impl CacheWriter {
                 discard(&path);
             }),
             Inner::Obj { .. } | Inner::Failed(..) => Ok(()),
+        }
+    }
+}
+
+impl Drop for CacheWriter {
+    /// Finishes a cache that was not finished (module docs); errors remove the file.
+    fn drop(&mut self) {
+        match std::mem::replace(
+            &mut self.inner,
+            Inner::Failed(io::ErrorKind::Other, String::new()),
+        ) {
+            Inner::Pc2 { writer, path } => {
+                if writer.finish().and_then(|f| f.sync_all()).is_err() {
+                    discard(&path);
+                }
+            }
+            Inner::Mdd { writer, path } => {
+                if writer.finish().is_err() {
+                    discard(&path);
+                }
+            }
+            Inner::Obj { .. } | Inner::Failed(..) => {}
         }
     }
 }
