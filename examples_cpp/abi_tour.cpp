@@ -86,6 +86,9 @@ int main(int argc, char** argv) try {
     cloth.step(1.0 / 60.0);
     const fraccloth::SolverStats stats = cloth.solver_stats();
     require(stats.iterations > 0 && stats.residual <= 1e-7, "solver stats");
+    // The preset's automatic step chose the substeps of that call.
+    const fraccloth::StepStats steps = cloth.step_stats();
+    require(steps.substeps >= 1 && steps.estimate > 0.0, "step stats");
     cloth.remove_collider(capsule);
 
     cloth.write_obj(dir + "/tour.obj");

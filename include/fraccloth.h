@@ -160,7 +160,8 @@ typedef enum {
   /**
    * A wet towel in water: the paper's springs lightly velocity-damped, and per unit area the
    * water's normal added mass (10 kg/m^2), form drag (C_d = 1) and skin drag (1.15 N s/m^3),
-   * symplectic Euler (step 0.5 ms at 1 cm spacing). The look, measured: docs/underwater.md.
+   * symplectic Euler with the automatic step (`max_substep = FC_MAX_SUBSTEP_AUTO`: call
+   * `fc_cloth_step` once per frame). The look, measured: docs/underwater.md.
    */
   FC_PRESET_UNDERWATER = 4,
 } FcPreset;
@@ -308,7 +309,10 @@ typedef struct {
   uint32_t integrator;
   /**
    * Longest substep (s) `fc_cloth_step` takes: a call with a larger dt is split into
-   * `ceil(dt / max_substep)` equal substeps. 0 = never split. Default 0.
+   * `ceil(dt / max_substep)` equal substeps. 0 = never split; `FC_MAX_SUBSTEP_AUTO` (any
+   * negative value) = as few substeps as the cloth needs, chosen by the library each call
+   * (`fc_cloth_get_step_stats` says how many it took). Default 0; `FC_PRESET_UNDERWATER`
+   * uses `FC_MAX_SUBSTEP_AUTO`.
    */
   double max_substep;
   /**
@@ -648,6 +652,20 @@ FcStatus fc_cloth_get_solver_stats(const FcCloth *cloth,
                                    double *residual);
 
 /**
+ * Reads what the last `fc_cloth_step` or `fc_cloth_step_substeps` did: the substeps it took
+ * (with the automatic step, those of the attempt that succeeded), how many times the automatic
+ * step retried with twice the substeps after a refused substep, and its substep estimate in
+ * seconds (0 with a fixed step). All 0 before the first step. Any output may be NULL.
+ *
+ * # Safety
+ * `cloth` NULL or live; outputs NULL or writable.
+ */
+FcStatus fc_cloth_get_step_stats(const FcCloth *cloth,
+                                 uint32_t *substeps,
+                                 uint32_t *retries,
+                                 double *estimate);
+
+/**
  * Whether an implicit step whose solver stops at `solver_max_iterations` above
  * `solver_tolerance` is accepted (`accept` non-zero: the step returns `FC_OK`; read
  * `fc_cloth_get_solver_stats`) or refused (0, the default: `FC_ERROR_NOT_CONVERGED`, the
@@ -916,8 +934,19 @@ FcStatus fc_cloth_save_snapshot(const FcCloth *cloth,
  * foreign snapshot gives `FC_ERROR_INVALID_ARGUMENT` (the message says why) and leaves the
  * cloth exactly as it was. Beyond the checksum, the contents are checked for meaning: every
  * number finite and within the float range, speeds within this cloth's `max_speed`, history
- * times ordered and not after the cloth's time, step sizes positive; a snapshot that loads
- * can always be stepped, and the message names the field that was refused.
+ * times ordered and within the span the cloth has lived, step sizes positive; then a trial step
+ * on a copy (at the mean step the state was reached with, pins held) must succeed, so a
+ * snapshot that loads can always be stepped. The message names what was refused (the
+ * half-derivative history when the trial succeeds without it).
+ *
+ * **What a snapshot carries.** The state: positions, velocities, pins and their targets,
+ * colliders and their friction, the current, the solver settings, the half-derivative
+ * histories, the time and the step count. Not the model: the receiving cloth keeps its own
+ * coefficients, integrator, `max_speed` and `max_substep`, so a snapshot saved with one model
+ * continues with the receiving cloth's (and is refused only if that cloth cannot take a step
+ * from it). The receiving cloth must have the same topology (vertex, spring and triangle counts
+ * and rest shape: a grid and the same vertices built as a quad mesh have different springs and
+ * are refused) and the same history scheme and settings.
  *
  * # Safety
  * `cloth` NULL or live; `data` NULL or `size` readable bytes.
@@ -1009,6 +1038,16 @@ uint32_t fc_version(void);
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus
+
+/**
+ * `FcClothDesc.max_substep` for the automatic step: `fc_cloth_step(cloth, dt)` splits `dt` into
+ * as few equal substeps as the cloth as it is allows (estimated from its springs, masses, drags,
+ * contacts and pins for its integrator, with a measured safety factor), and retries a frame whose
+ * substep is refused with twice the substeps (up to 16 times the estimate) before it returns
+ * `FC_ERROR_UNSTABLE`. Any negative `max_substep` means the same. Read what a call did with
+ * `fc_cloth_get_step_stats`.
+ */
+#define FC_MAX_SUBSTEP_AUTO (-1.0)
 
 /**
  * The default description, `struct_size = sizeof(FcClothDesc)`: a 61 x 41 grid of 1 cm spacing

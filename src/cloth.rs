@@ -6,6 +6,7 @@
 //! than [`ClothConfig::max_speed`] (an underwater cloth never moves at 100 m/s; a
 //! state that does has exploded).
 
+mod auto_step;
 mod extrapolate;
 mod prepass;
 mod snapshot;
@@ -13,6 +14,7 @@ mod step;
 
 use step::{Rollback, StepScratch};
 
+pub use auto_step::{StepStats, AUTO, MAX_RETRIES, SAFETY};
 pub use snapshot::SNAPSHOT_VERSION;
 
 use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
@@ -33,7 +35,8 @@ pub struct ClothConfig {
     pub integrator: Integrator,
     /// Speed (m/s) above which a step is declared unstable. Default 100.
     pub max_speed: f64,
-    /// Longest substep (s) `Cloth::step` takes; 0 = one step per call. Default 0.
+    /// Longest substep (s) `Cloth::step` takes; 0 = one step per call; negative ([`AUTO`]) =
+    /// the automatic step (`cloth/auto_step.rs`). Default 0.
     pub max_substep: f64,
     /// Implicit solver settings.
     pub solver: SolverSettings,
@@ -85,9 +88,9 @@ fn checked_config(mut config: ClothConfig, width: f64) -> Result<ClothConfig, Er
     }
     config.scheme.validate()?;
     check_solver(&config.solver)?;
-    if !(config.max_substep.is_finite() && config.max_substep >= 0.0) {
+    if !config.max_substep.is_finite() {
         return Err(Error::invalid(format!(
-            "max_substep must be finite and >= 0, got {}",
+            "max_substep must be finite (> 0 a longest substep, 0 one step per call, negative the automatic step), got {}",
             config.max_substep
         )));
     }
@@ -147,6 +150,8 @@ pub struct Cloth {
     /// The whole step of an extrapolated integrator, beside its two half steps.
     probe: Rollback,
     solver_stats: SolverStats,
+    /// What the last call to `step` did.
+    step_stats: StepStats,
     /// Where the step runs (`plumbing/parallel.rs`).
     threads: Threads,
 }
@@ -199,6 +204,7 @@ impl Cloth {
             rollback: Rollback::default(),
             probe: Rollback::default(),
             solver_stats: SolverStats::default(),
+            step_stats: StepStats::default(),
             threads: Threads::default(),
             topology,
             config,
@@ -527,10 +533,15 @@ impl Cloth {
     }
 
     /// Advances by `dt` seconds with the configured integrator, split into
-    /// `ceil(dt / max_substep)` equal substeps when `max_substep` is set. Atomic.
+    /// `ceil(dt / max_substep)` equal substeps when `max_substep` is positive, into as few as
+    /// the cloth needs when it is negative ([`AUTO`]: retried with twice the substeps when one
+    /// is refused). Atomic.
     pub fn step(&mut self, dt: f64) -> Result<(), Error> {
         check_dt(dt)?;
         let max = self.config.max_substep;
+        if max < 0.0 {
+            return self.step_auto(dt);
+        }
         let n = if max > 0.0 {
             (dt / max).ceil().max(1.0)
         } else {
@@ -573,6 +584,10 @@ impl Cloth {
                 "substeps must be in 1..={MAX_SUBSTEPS}, got {substeps}"
             )));
         }
+        self.step_stats = StepStats {
+            substeps,
+            ..StepStats::default()
+        };
         let extrapolated = self.config.integrator.is_extrapolated();
         if substeps == 1 && !extrapolated {
             return self.advance(dt, None);
@@ -605,6 +620,12 @@ impl Cloth {
         }
         self.rollback = snap;
         Ok(())
+    }
+
+    /// What the last call to [`Cloth::step`] or [`Cloth::step_substeps`] did: its substeps,
+    /// the automatic step's retries and estimate.
+    pub fn step_stats(&self) -> StepStats {
+        self.step_stats
     }
 
     /// Statistics of the last implicit solve (zeros for explicit integrators).

@@ -265,6 +265,9 @@ pub struct SceneSpec {
     /// The cloth's model instead of the variant's (its current is the drive's); None: the
     /// variant's.
     pub model: Option<Model>,
+    /// The cloth's `max_substep`: 0 steps `dt` at once (the paper's scenes), negative
+    /// ([`crate::cloth::AUTO`]) lets the cloth split each `dt` as it needs.
+    pub max_substep: f64,
 }
 
 impl SceneSpec {
@@ -283,6 +286,7 @@ impl SceneSpec {
             stiffness_scale: 1.0,
             drive: Drive::of(kind, variant),
             model: None,
+            max_substep: 0.0,
         }
     }
 
@@ -324,6 +328,7 @@ impl SceneSpec {
             model,
             scheme: self.scheme,
             integrator: self.integrator,
+            max_substep: self.max_substep,
             ..ClothConfig::default()
         };
         let mut cloth = Cloth::new(topology, config)?;

@@ -149,6 +149,10 @@ fn realtime_frame_loop_runs() {
     assert!(z > 0.02 && z < 0.2, "the swung cloth left its plane: {out}");
     let len = (v[3] * v[3] + v[4] * v[4] + v[5] * v[5]).sqrt();
     assert!((len - 1.0).abs() < 1e-3, "unit normal: {out}");
+    // The automatic step split each frame (one fc_cloth_step per frame).
+    let sub = field(&out, "substeps");
+    let (mean, most): (f64, u32) = (sub[1].parse().unwrap(), sub[3].parse().unwrap());
+    assert!(mean >= 1.0 && f64::from(most) >= mean, "{out}");
 }
 
 /// Four cloths stepped on four host threads, each on its calling thread only, end bit for bit

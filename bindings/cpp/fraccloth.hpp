@@ -98,6 +98,13 @@ struct SolverStats {
     double residual = 0.0;    ///< final relative residual
 };
 
+/// What the last step call did (`fc_cloth_get_step_stats`).
+struct StepStats {
+    uint32_t substeps = 0;  ///< substeps taken (the successful attempt's)
+    uint32_t retries = 0;   ///< automatic step: attempts retried with twice the substeps
+    double estimate = 0.0;  ///< automatic step: the substep estimate, s (0 with a fixed step)
+};
+
 /// One simulated cloth. Move-only; the handle is freed by the destructor.
 class Cloth {
 public:
@@ -156,6 +163,13 @@ public:
     SolverStats solver_stats() const {
         SolverStats s;
         check(fc_cloth_get_solver_stats(handle_, &s.iterations, &s.residual));
+        return s;
+    }
+    /// What the last `step` or `step_substeps` did (substeps, the automatic step's retries and
+    /// estimate).
+    StepStats step_stats() const {
+        StepStats s;
+        check(fc_cloth_get_step_stats(handle_, &s.substeps, &s.retries, &s.estimate));
         return s;
     }
     /// Accept (true) or refuse (false, the default) implicit steps whose solver did not converge.

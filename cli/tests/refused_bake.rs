@@ -23,7 +23,11 @@ fn a_refused_bake_leaves_honest_caches() {
         let frames = back.frames.len() as u64;
         assert!(frames < 361, "{name}: {frames} frames");
         let header = if name.ends_with("pc2") { 32 } else { 8 + 4 * frames };
-        assert_eq!(bytes, header + frames * 2501 * 12, "{name}: the header counts {frames} frames");
+        assert_eq!(
+            bytes,
+            header + frames * 2501 * 12,
+            "{name}: the header counts {frames} frames"
+        );
     }
     std::fs::remove_dir_all(&out).unwrap();
 }

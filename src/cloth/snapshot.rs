@@ -337,22 +337,62 @@ impl Cloth {
                 "snapshot: pin list does not match the pin weights",
             ));
         }
-        // Commit.
-        self.time = time;
-        self.steps = steps;
-        self.config.model.current = current;
-        self.config.solver = solver;
-        self.pinned = weights.iter().map(|&w| w == 1.0).collect();
-        self.x = x;
-        self.v = v;
-        self.pin_weight = weights;
-        self.pin_list = pin_list;
-        self.pin_target = targets;
-        self.collider_slots = collider_slots;
-        self.rebuild_colliders();
-        self.history = history;
-        self.strain_history = strain_history;
+        // The loaded cloth, then a trial step on a copy of it: a snapshot that loads can step.
+        let mut next = self.clone();
+        next.time = time;
+        next.steps = steps;
+        next.config.model.current = current;
+        next.config.solver = solver;
+        next.pinned = weights.iter().map(|&w| w == 1.0).collect();
+        next.x = x;
+        next.v = v;
+        next.pin_weight = weights;
+        next.pin_list = pin_list;
+        next.pin_target = targets;
+        next.collider_slots = collider_slots;
+        next.rebuild_colliders();
+        next.history = history;
+        next.strain_history = strain_history;
+        next.trial_step()?;
+        *self = next;
         Ok(())
+    }
+
+    /// Refuses a loaded state that cannot take one step: one step on a copy, at the mean step
+    /// size the state was reached with (`time / steps`; 0.1 ms before any step), pins held
+    /// where they are, an implicit solve accepted whatever its residual (only an unsound
+    /// result refuses). When it fails, the same trial without the half-derivative histories
+    /// says whether they are what the cloth cannot step from.
+    fn trial_step(&self) -> Result<(), Error> {
+        let h = if self.steps > 0 && self.time > 0.0 {
+            self.time / self.steps as f64
+        } else {
+            1e-4
+        };
+        let trial = |c: &Cloth| -> Result<(), Error> {
+            let mut t = c.clone();
+            t.pin_target.clone_from(&t.x);
+            t.config.accept_unconverged = true;
+            t.advance(h, None)
+        };
+        let Err(e) = trial(self) else {
+            return Ok(());
+        };
+        let mut without = self.clone();
+        let memories = crate::forces::memories(&self.config.model);
+        let scheme = |on: bool| if on { self.config.scheme } else { Scheme::Off };
+        without.history = History::new(scheme(memories.particles), self.vertex_count())?;
+        let entries = crate::forces::strain::entries(self.topology.springs.len());
+        without.strain_history = History::new(scheme(memories.springs), entries)?;
+        let what = if trial(&without).is_ok() {
+            "its half-derivative history holds values the cloth cannot step from"
+        } else {
+            "its positions, velocities, pins or colliders are a state the cloth cannot step from"
+        };
+        Err(Error::invalid(format!(
+            "snapshot: {what} (a trial step of {h:.3e} s on a copy: {}); the cloth is unchanged",
+            e.message
+        )))
     }
 
     /// Size in bytes of [`Cloth::save_snapshot`]'s result now, counted without building it.

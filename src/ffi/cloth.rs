@@ -471,6 +471,39 @@ pub unsafe extern "C" fn fc_cloth_get_solver_stats(
     })
 }
 
+/// Reads what the last `fc_cloth_step` or `fc_cloth_step_substeps` did: the substeps it took
+/// (with the automatic step, those of the attempt that succeeded), how many times the automatic
+/// step retried with twice the substeps after a refused substep, and its substep estimate in
+/// seconds (0 with a fixed step). All 0 before the first step. Any output may be NULL.
+///
+/// # Safety
+/// `cloth` NULL or live; outputs NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_step_stats(
+    cloth: *const FcCloth,
+    substeps: *mut u32,
+    retries: *mut u32,
+    estimate: *mut f64,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let stats = unsafe { handle(cloth) }?.step_stats();
+        // SAFETY: each output is NULL or writable, as the caller promises.
+        unsafe {
+            if let Some(s) = substeps.as_mut() {
+                *s = stats.substeps;
+            }
+            if let Some(r) = retries.as_mut() {
+                *r = stats.retries;
+            }
+            if let Some(e) = estimate.as_mut() {
+                *e = stats.estimate;
+            }
+        }
+        Ok(())
+    })
+}
+
 /// Whether an implicit step whose solver stops at `solver_max_iterations` above
 /// `solver_tolerance` is accepted (`accept` non-zero: the step returns `FC_OK`; read
 /// `fc_cloth_get_solver_stats`) or refused (0, the default: `FC_ERROR_NOT_CONVERGED`, the

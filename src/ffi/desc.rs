@@ -78,7 +78,8 @@ pub enum FcPreset {
     FC_PRESET_REGULAR_NORMAL = 3,
     /// A wet towel in water: the paper's springs lightly velocity-damped, and per unit area the
     /// water's normal added mass (10 kg/m^2), form drag (C_d = 1) and skin drag (1.15 N s/m^3),
-    /// symplectic Euler (step 0.5 ms at 1 cm spacing). The look, measured: docs/underwater.md.
+    /// symplectic Euler with the automatic step (`max_substep = FC_MAX_SUBSTEP_AUTO`: call
+    /// `fc_cloth_step` once per frame). The look, measured: docs/underwater.md.
     FC_PRESET_UNDERWATER = 4,
 }
 
@@ -147,7 +148,10 @@ pub struct FcClothDesc {
     /// An `FcIntegrator` value. Default `FC_INTEGRATOR_EXPLICIT_EULER`.
     pub integrator: u32,
     /// Longest substep (s) `fc_cloth_step` takes: a call with a larger dt is split into
-    /// `ceil(dt / max_substep)` equal substeps. 0 = never split. Default 0.
+    /// `ceil(dt / max_substep)` equal substeps. 0 = never split; `FC_MAX_SUBSTEP_AUTO` (any
+    /// negative value) = as few substeps as the cloth needs, chosen by the library each call
+    /// (`fc_cloth_get_step_stats` says how many it took). Default 0; `FC_PRESET_UNDERWATER`
+    /// uses `FC_MAX_SUBSTEP_AUTO`.
     pub max_substep: f64,
     /// Relative residual at which the implicit solver's CG stops (> 0). Default 1e-6.
     pub solver_tolerance: f64,
@@ -458,6 +462,8 @@ fn preset_desc(preset: u32) -> Result<FcClothDesc, FfiError> {
         } else {
             Integrator::ExplicitEuler
         },
+        // The underwater preset chooses its own step: one `fc_cloth_step` per frame works.
+        max_substep: if preset == 4 { crate::cloth::AUTO } else { 0.0 },
         ..ClothConfig::default()
     };
     Ok(FcClothDesc::from_model(&model, &config))

@@ -61,8 +61,19 @@ pub unsafe extern "C" fn fc_cloth_save_snapshot(
 /// foreign snapshot gives `FC_ERROR_INVALID_ARGUMENT` (the message says why) and leaves the
 /// cloth exactly as it was. Beyond the checksum, the contents are checked for meaning: every
 /// number finite and within the float range, speeds within this cloth's `max_speed`, history
-/// times ordered and not after the cloth's time, step sizes positive; a snapshot that loads
-/// can always be stepped, and the message names the field that was refused.
+/// times ordered and within the span the cloth has lived, step sizes positive; then a trial step
+/// on a copy (at the mean step the state was reached with, pins held) must succeed, so a
+/// snapshot that loads can always be stepped. The message names what was refused (the
+/// half-derivative history when the trial succeeds without it).
+///
+/// **What a snapshot carries.** The state: positions, velocities, pins and their targets,
+/// colliders and their friction, the current, the solver settings, the half-derivative
+/// histories, the time and the step count. Not the model: the receiving cloth keeps its own
+/// coefficients, integrator, `max_speed` and `max_substep`, so a snapshot saved with one model
+/// continues with the receiving cloth's (and is refused only if that cloth cannot take a step
+/// from it). The receiving cloth must have the same topology (vertex, spring and triangle counts
+/// and rest shape: a grid and the same vertices built as a quad mesh have different springs and
+/// are refused) and the same history scheme and settings.
 ///
 /// # Safety
 /// `cloth` NULL or live; `data` NULL or `size` readable bytes.

@@ -115,9 +115,11 @@ impl Full {
         if let Some(k) = self.times.windows(2).position(|w| w[1] <= w[0]) {
             return bad(format!("times {k} and {} are not increasing", k + 1));
         }
-        if !(self.now.is_finite() && self.now <= now_cloth + slack) {
+        // Now lies within the span the cloth has lived, and not before its last sample.
+        let first = self.times.last().copied().unwrap_or(0.0).max(0.0);
+        if !(self.now.is_finite() && self.now >= first - slack && self.now <= now_cloth + slack) {
             return bad(format!(
-                "time now {} is not finite or is after the cloth's {now_cloth}",
+                "time now {} is not within [{first}, {now_cloth}] (its last sample and the cloth's time)",
                 self.now
             ));
         }

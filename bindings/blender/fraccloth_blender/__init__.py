@@ -158,7 +158,7 @@ class FracclothSettings(bpy.types.PropertyGroup):
     current: bpy.props.FloatVectorProperty(name="Current", description="Water current, m/s (world)", default=(0.0, 0.0, 0.0), size=3)
     history: bpy.props.EnumProperty(name="History", items=HISTORY_ITEMS, default="SOE")
     integrator: bpy.props.EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="SYMPLECTIC")
-    auto_step: bpy.props.BoolProperty(name="Automatic time step", description="Choose a stable step from the mesh spacing, stiffness and integrator (implicit ones step once per frame)", default=True)
+    auto_step: bpy.props.BoolProperty(name="Automatic time step", description="The library splits each frame into as few steps as the cloth needs (from its springs, weight, water, colliders and pins) and retries a frame that fails with more", default=True)
     time_step: bpy.props.FloatProperty(name="Time step", description="Longest step when not automatic, s", default=5e-4, min=1e-6, max=0.1, precision=5)
     friction: bpy.props.FloatProperty(name="Collider friction", description="How much the colliders grip the cloth (0 = slippery, 1 = grippy)", default=0.0, min=0.0, soft_max=1.0)
     collision_margin: bpy.props.FloatProperty(name="Collision margin", description="Distance from a collider at which the cloth is pushed away, m", default=0.01, min=0.0, soft_max=0.05)
@@ -299,21 +299,6 @@ def describe(s):
     return desc
 
 
-def automatic_step(s, spacing, frame_dt):
-    """A stable step for the settings on a mesh of edge length `spacing` (m). Implicit
-    integrators: one frame. Explicit ones: 0.5 ms at 1 cm spacing with the built-in cloth
-    (stretch 10 N/m, 1 kg/m^2; the stability map's symplectic bound there is about 1.6 ms),
-    scaled as the bound scales, spacing * sqrt(inertia / stiffness), and never above a frame."""
-    if s.integrator in ("IMPLICIT", "IMPLICIT2"):
-        return frame_dt
-    inertia = (s.mass_per_area + s.entrained_mass) / 1.0
-    stiffness = max(s.stretch_stiffness, s.shear_stiffness, s.bend_stiffness, 1e-9) / 10.0
-    dt = 5e-4 * (spacing / 0.01) * math.sqrt(inertia / stiffness)
-    if s.integrator == "EXPLICIT":
-        dt *= 0.5
-    return min(dt, frame_dt)
-
-
 def build_cloth(context, obj, others):
     """The fraccloth cloth for `obj` with its settings, in world coordinates at the current
     frame; returns (cloth, step plan, pinned indices, collider ids)."""
@@ -327,6 +312,10 @@ def build_cloth(context, obj, others):
     if len(pos) != len(obj.data.vertices):
         raise ValueError(f"{obj.name}: its modifiers change the vertex count; apply or remove them")
     desc = describe(s)
+    if s.auto_step:
+        # The library chooses each frame's substeps from the cloth as it is (and retries a
+        # refused frame with more): FC_MAX_SUBSTEP_AUTO.
+        desc.max_substep = fraccloth.MAX_SUBSTEP_AUTO
     cloth = fraccloth.Cloth.mesh(desc, pos.astype(np.float32), faces)
     w = pin_weights(obj, s.pin_group)
     if w.any():
@@ -343,10 +332,8 @@ def build_cloth(context, obj, others):
         ids.append(cid)
     fps = context.scene.render.fps / context.scene.render.fps_base
     frame_dt = 1.0 / fps
-    edges = np.linalg.norm(pos[faces[:, 0]] - pos[faces[:, 1]], axis=1)
-    spacing = float(np.mean(edges)) if len(edges) else 0.01
-    step = automatic_step(s, spacing, frame_dt) if s.auto_step else s.time_step
-    substeps = max(1, math.ceil(frame_dt / step - 1e-9))
+    # None: the library's automatic step splits each frame; else a fixed count of substeps.
+    substeps = None if s.auto_step else max(1, math.ceil(frame_dt / s.time_step - 1e-9))
     return cloth, (frame_dt, substeps), np.flatnonzero(w > 0.0).astype(np.uint32), ids
 
 
@@ -390,7 +377,10 @@ def _simulate(context, obj, others):
                 else:
                     cloth.set_sphere(cid, new[1], new[2], velocity)
             previous = now
-            cloth.step_substeps(frame_dt, substeps)
+            if substeps is None:
+                cloth.step(frame_dt)
+            else:
+                cloth.step_substeps(frame_dt, substeps)
         yield f, cloth, to_local(obj, cloth.positions_f64()).astype(np.float32)
 
 

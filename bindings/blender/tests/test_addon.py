@@ -187,11 +187,11 @@ def test_the_underwater_preset_is_the_librarys(addon, tmp_path):
     assert s.mass_per_area < 0.5 and s.bend_stiffness < 0.1
     s.preset = "CUSTOM"
     assert s.mass_per_area < 0.5
-    # The automatic step: a frame for implicit integrators, a few hundred microseconds at 1 cm.
+    # The automatic step is the library's: the bake asks for FC_MAX_SUBSTEP_AUTO.
     s.preset = "UNDERWATER"
-    assert addon.automatic_step(s, 0.01, 1 / 24) == pytest.approx(5e-4)
-    s.integrator = "IMPLICIT2"
-    assert addon.automatic_step(s, 0.01, 1 / 24) == pytest.approx(1 / 24)
+    assert s.auto_step
+    built, (frame_dt, substeps), _, _ = addon.build_cloth(bpy.context, cloth, [])
+    assert substeps is None and built.desc.max_substep == fraccloth.MAX_SUBSTEP_AUTO
 
 
 def test_two_cloths_bake_to_their_own_caches(addon, tmp_path):

@@ -26,6 +26,8 @@ __all__ = [
     "version",
     "FcClothDesc",
     "SolverStats",
+    "StepStats",
+    "MAX_SUBSTEP_AUTO",
     "PRESET_FRACTIONAL_PAPER",
     "PRESET_REGULAR_VISCOUS_NORMAL",
     "PRESET_REGULAR_VISCOUS",
@@ -98,6 +100,10 @@ HISTORY_OFF: int = _ENUMS["FC_HISTORY_OFF"]
 HISTORY_TRUNCATED: int = _ENUMS["FC_HISTORY_TRUNCATED"]
 HISTORY_FULL: int = _ENUMS["FC_HISTORY_FULL"]
 HISTORY_SOE: int = _ENUMS["FC_HISTORY_SOE"]
+#: ``FcClothDesc.max_substep`` for the automatic step (``FC_MAX_SUBSTEP_AUTO``): ``step(dt)``
+#: splits ``dt`` into as few substeps as the cloth needs and retries a refused one with twice as
+#: many. The underwater preset uses it.
+MAX_SUBSTEP_AUTO: float = -1.0
 INTEGRATOR_EXPLICIT_EULER: int = _ENUMS["FC_INTEGRATOR_EXPLICIT_EULER"]
 INTEGRATOR_SYMPLECTIC_EULER: int = _ENUMS["FC_INTEGRATOR_SYMPLECTIC_EULER"]
 INTEGRATOR_IMPLICIT_EULER: int = _ENUMS["FC_INTEGRATOR_IMPLICIT_EULER"]
@@ -155,6 +161,7 @@ _SIGNATURES = {
     "fc_cloth_get_threads": (_c.c_uint32, [_P]),
     "fc_cloth_set_solver": (_c.c_int, [_P, _c.c_double, _c.c_uint32]),
     "fc_cloth_get_solver_stats": (_c.c_int, [_P, _U32P, _D3]),
+    "fc_cloth_get_step_stats": (_c.c_int, [_P, _U32P, _U32P, _D3]),
     "fc_cloth_set_solver_accept_unconverged": (_c.c_int, [_P, _c.c_int32]),
     "fc_cloth_snapshot_size": (_c.c_size_t, [_P]),
     "fc_cloth_save_snapshot": (_c.c_int, [_P, _P, _c.c_size_t, _c.POINTER(_c.c_size_t)]),
@@ -292,6 +299,16 @@ def preset_desc(preset: int) -> FcClothDesc:
 
 Vec3 = Union[Sequence[float], np.ndarray]
 """Three numbers (x, y, z): a sequence or a numpy array."""
+
+
+class StepStats(NamedTuple):
+    """What the last ``step`` did: the ``substeps`` it took, the automatic step's ``retries``
+    (attempts retried with twice the substeps) and its substep ``estimate`` in seconds (0 with a
+    fixed step)."""
+
+    substeps: int
+    retries: int
+    estimate: float
 
 
 class SolverStats(NamedTuple):
@@ -509,6 +526,13 @@ class Cloth:
         it, res = ctypes.c_uint32(), ctypes.c_double()
         _check(library.fc_cloth_get_solver_stats(self._h, ctypes.byref(it), ctypes.byref(res)))
         return SolverStats(it.value, res.value)
+
+    def step_stats(self) -> StepStats:
+        """What the last ``step`` or ``step_substeps`` did (substeps, and the automatic step's
+        retries and estimate)."""
+        n, r, e = ctypes.c_uint32(), ctypes.c_uint32(), ctypes.c_double()
+        _check(library.fc_cloth_get_step_stats(self._h, ctypes.byref(n), ctypes.byref(r), ctypes.byref(e)))
+        return StepStats(n.value, r.value, e.value)
 
     def set_solver_accept_unconverged(self, accept: bool) -> None:
         """Accept (True) or refuse (False, the default) implicit steps that stop at the

@@ -1,0 +1,264 @@
+//! The automatic step: the largest substep the cloth as it is can take, and how a frame is
+//! split when `max_substep` is [`AUTO`].
+//!
+//! **The estimate.** Each particle is read as a damped oscillator along its softest direction
+//! (its own mass and the water it carries in every direction; the normal added mass only ever
+//! slows motion): `omega^2` from the springs and contacts that touch it (Gershgorin's bound on the
+//! stiffness matrix's row, `2 sum k / m`), `gamma` from everything that damps it (its springs'
+//! damping, `2 sum c / m`, the drags' rates at the velocities it has now, contact damping), and
+//! `rho`, the rate of the carried water's turning forces (`m_a A |v| / (m l)`, quadratic in the
+//! velocity, explicit in every integrator). Then, per integrator:
+//! - symplectic Euler: `h < (sqrt(gamma^2 + 4 omega^2) - gamma) / omega^2` (its exact bound on a
+//!   damped oscillator: `2 / omega` undamped, `2 / gamma` overdamped);
+//! - explicit Euler: the same, and `h < gamma_s / omega_s^2` for damping in proportion to the
+//!   springs (`c / k` per family; for fractional springs, whose current-rate weight is
+//!   `w0 = h^{1/2} / Gamma(3/2)`, `h < (k_d / (Gamma(3/2) k))^2`): explicit Euler gains energy on
+//!   any undamped oscillator, and only the springs' own damping holds it;
+//! - the extrapolated (second-order) steps as the step they extrapolate;
+//! - implicit Euler: no bound from springs, drags or contacts; the turning forces' `2 / rho`.
+//!
+//! And pins: no pin travels more than one spring rest length in a substep.
+//!
+//! **The safety factor** [`SAFETY`] times the smallest bound over particles is the substep; it is
+//! measured on the stability map of every preset, mesh kind and size (`docs/stability.md`,
+//! `cargo run --release --example auto_step_map`).
+//!
+//! **A frame never fails for want of substeps.** A frame is split into as few equal substeps as
+//! the estimate allows; a frame whose substep is refused is rolled back to its start (the call
+//! is atomic) and retried with twice the substeps, at most [`MAX_RETRIES`] times.
+
+use crate::forces::Inertia;
+use crate::integrate::Integrator;
+use crate::model::{Model, SpringDamping};
+use crate::Vec3;
+
+use super::Cloth;
+
+/// `max_substep` that asks for the automatic step (any negative value does).
+pub const AUTO: f64 = -1.0;
+
+/// Fraction of the estimated bound the automatic step takes (measured: `docs/stability.md`).
+pub const SAFETY: f64 = 0.5;
+
+/// Times a refused frame is retried with twice the substeps (so up to 16 times the estimate's).
+pub const MAX_RETRIES: u32 = 4;
+
+/// Gamma(3/2) = sqrt(pi) / 2: `w0 = h^{1/2} / Gamma(3/2)` for the half-derivative's current rate.
+const GAMMA_3_2: f64 = 0.886_226_925_452_758;
+
+/// What the last call to `step` did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepStats {
+    /// Substeps the last call took (the successful attempt's).
+    pub substeps: u32,
+    /// Attempts refused and retried with twice the substeps (automatic step only).
+    pub retries: u32,
+    /// The automatic step's substep estimate for the last call, s (0 with a fixed step).
+    pub estimate: f64,
+}
+
+/// The bound of symplectic Euler on `x'' + gamma x' + omega^2 x = 0`.
+fn symplectic_bound(omega2: f64, gamma: f64) -> f64 {
+    if omega2 <= 0.0 {
+        return if gamma > 0.0 { 2.0 / gamma } else { f64::INFINITY };
+    }
+    ((gamma * gamma + 4.0 * omega2).sqrt() - gamma) / omega2
+}
+
+/// Explicit Euler's bound from damping in proportion to the springs (`c / k` per family).
+fn explicit_bound(m: &Model) -> f64 {
+    use crate::topology::SpringKind::*;
+    let mut bound = f64::INFINITY;
+    for kind in [Stretch, Shear, Bend] {
+        let (k, c) = (m.stiffness(kind), m.spring_damping_of(kind));
+        if k <= 0.0 {
+            continue;
+        }
+        let b = match m.spring_damping_mode {
+            SpringDamping::Velocity => c / k,
+            SpringDamping::Fractional | SpringDamping::FractionalStrain => (c / (GAMMA_3_2 * k)).powi(2),
+            SpringDamping::None => f64::INFINITY,
+        };
+        bound = bound.min(b);
+    }
+    bound
+}
+
+impl Cloth {
+    /// Advances by `dt` with the automatic step (module docs).
+    pub(super) fn step_auto(&mut self, dt: f64) -> Result<(), crate::error::Error> {
+        use crate::error::ErrorKind;
+        let h = self.auto_substep(dt);
+        let limit = f64::from(super::MAX_SUBSTEPS);
+        let mut n = if h > 0.0 {
+            (dt / h).ceil().clamp(1.0, limit)
+        } else {
+            limit
+        };
+        let mut retries = 0;
+        loop {
+            let substeps = n as u32;
+            match self.step_substeps(dt, substeps) {
+                Ok(()) => {
+                    self.step_stats = StepStats {
+                        substeps,
+                        retries,
+                        estimate: h,
+                    };
+                    return Ok(());
+                }
+                Err(e)
+                    if retries < MAX_RETRIES
+                        && n < limit
+                        && matches!(e.kind, ErrorKind::Unstable | ErrorKind::NotConverged) =>
+                {
+                    retries += 1;
+                    n = (2.0 * n).min(limit);
+                }
+                Err(mut e) => {
+                    e.message = format!(
+                        "{} (automatic step: the estimate was {h:.3e} s; refused with {substeps} substeps after {retries} retries with twice as many)",
+                        e.message
+                    );
+                    return Err(e);
+                }
+            }
+        }
+    }
+
+    /// The automatic step's substep for a call of `dt` seconds whose pins end at their
+    /// targets: [`SAFETY`] times the smallest bound (module docs), never above `dt`.
+    pub fn auto_substep(&self, dt: f64) -> f64 {
+        // Fractional damping's current-rate weight grows as h^{1/2}: the bound at the bound.
+        let mut h = self.substep_bound(dt, 0.0);
+        if self.fractional_damping() {
+            for _ in 0..3 {
+                h = self.substep_bound(dt, h);
+            }
+        }
+        (SAFETY * h).min(dt)
+    }
+
+    /// Whether the springs or drags damp on D^{1/2} (their damping depends on the step).
+    fn fractional_damping(&self) -> bool {
+        let m = &self.config.model;
+        matches!(
+            m.spring_damping_mode,
+            SpringDamping::Fractional | SpringDamping::FractionalStrain
+        ) && m.spring_damping > 0.0
+            || m.history_drag > 0.0
+            || m.water.history_drag > 0.0
+    }
+
+    /// The smallest bound over the particles and pins (module docs); `h` the step at which the
+    /// half-derivative's current-rate weight `h^{1/2} / Gamma(3/2)` is taken (0: none).
+    fn substep_bound(&self, dt: f64, h: f64) -> f64 {
+        let w0 = h.sqrt() / GAMMA_3_2;
+        let m = &self.config.model;
+        let t = &self.topology;
+        let integrator = self.config.integrator.base();
+        let implicit = integrator == Integrator::ImplicitEuler;
+        let explicit = integrator == Integrator::ExplicitEuler;
+        // Explicit Euler: half symplectic Euler's bound (measured: docs/stability.md), and the
+        // springs' damping bound.
+        let mut bound = if explicit {
+            explicit_bound(m)
+        } else {
+            f64::INFINITY
+        };
+        let oscillator = if explicit { 0.5 } else { 1.0 };
+        let (ma, rho_w, cd) = (m.water.added_mass, m.water_density, m.water.form_drag);
+        for i in 0..self.x.len() {
+            if self.pinned[i] {
+                continue;
+            }
+            let inertia = Inertia::of(m, t.masses[i], t.areas[i], Vec3::z(), 0.0);
+            let mass = inertia.isotropic();
+            let (mut k, mut c, mut shortest) = (0.0, 0.0, f64::INFINITY);
+            for &e in t.vertex_springs.row(i) {
+                let s = &t.springs[(e / 2) as usize];
+                k += m.stiffness(s.kind);
+                c += match m.spring_damping_mode {
+                    SpringDamping::Velocity => m.spring_damping_of(s.kind),
+                    SpringDamping::Fractional | SpringDamping::FractionalStrain => {
+                        w0 * m.spring_damping_of(s.kind)
+                    }
+                    SpringDamping::None => 0.0,
+                };
+                shortest = shortest.min(s.rest);
+            }
+            let area = t.areas[i];
+            let rel = self.v[i] - m.current;
+            let speed = rel.norm();
+            // Drags' rates at the velocity the particle has now (each in its own direction;
+            // the largest is what limits).
+            let drag = (crate::forces::terms::per_particle(m.viscous_drag, m.water.viscous_drag, area)
+                + crate::forces::terms::per_particle(m.normal_drag, m.water.normal_drag, area)
+                + w0 * crate::forces::terms::per_particle(m.history_drag, m.water.history_drag, area)
+                + m.water.skin_drag * area
+                + rho_w * cd * area * speed)
+                / mass;
+            let mut omega2 = 2.0 * k / mass;
+            let mut gamma = 2.0 * c / mass + drag;
+            if !self.colliders.is_empty() {
+                omega2 += m.collision_stiffness / mass;
+                gamma += m.collision_damping / mass;
+            }
+            if !implicit {
+                bound = bound.min(oscillator * symplectic_bound(omega2, gamma));
+            }
+            // The carried water's turning forces, explicit in every integrator.
+            if ma > 0.0 && shortest.is_finite() && shortest > 0.0 {
+                let rho = ma * area * speed / (mass * shortest);
+                if rho > 0.0 {
+                    bound = bound.min(2.0 / rho);
+                }
+            }
+        }
+        // Pins travel at most one rest length of their springs per substep.
+        for &p in &self.pin_list {
+            let p = p as usize;
+            let travel = (self.pin_target[p] - self.x[p]).norm();
+            let shortest = t
+                .vertex_springs
+                .row(p)
+                .iter()
+                .map(|&e| t.springs[(e / 2) as usize].rest)
+                .fold(f64::INFINITY, f64::min);
+            if travel > 0.0 && shortest.is_finite() {
+                bound = bound.min(dt * shortest / travel / SAFETY);
+            }
+        }
+        bound
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn symplectic_bound_is_the_damped_oscillators() {
+        // Undamped: 2 / omega; overdamped without stiffness: 2 / gamma; and on the boundary
+        // the amplification of symplectic Euler has modulus 1.
+        assert!((symplectic_bound(100.0, 0.0) - 0.2).abs() < 1e-15);
+        assert!((symplectic_bound(0.0, 50.0) - 0.04).abs() < 1e-15);
+        let (w2, g) = (1.0e6, 1800.0);
+        let h = symplectic_bound(w2, g);
+        // v' = v + h(-w2 x - g v), x' = x + h v': on (x, v) the step matrix is
+        // [[1 - h^2 w2, h (1 - h g)], [-h w2, 1 - h g]]; stable iff |det| <= 1 and
+        // |tr| <= 1 + det, and the bound sits where tr = -(1 + det).
+        let tr = (1.0 - h * h * w2) + (1.0 - h * g);
+        let det = (1.0 - h * h * w2) * (1.0 - h * g) + h * w2 * h * (1.0 - h * g);
+        assert!((tr + 1.0 + det).abs() < 1e-9, "tr {tr} det {det}");
+        assert!(h > 8.9e-4 && h < 8.92e-4, "{h}");
+    }
+
+    #[test]
+    fn explicit_eulers_bound_for_the_papers_springs_is_its_measured_one() {
+        // Eq. 5 springs, k_d 0.35, k 10: (k_d / (Gamma(3/2) k))^2 = 1.56 ms; the stability
+        // map measured 1.3-1.7 ms on the swing (docs/stability.md).
+        let b = explicit_bound(&Model::fractional());
+        assert!((b - 1.56e-3).abs() < 0.01e-3, "{b}");
+    }
+}

@@ -1,0 +1,150 @@
+//! A snapshot that loads can always step: forged snapshots with a valid checksum whose history
+//! holds finite but absurd values are refused, naming the history; and the cross-model rule
+//! (`fc_cloth_load_snapshot` in the header): a snapshot carries the state, the receiving cloth
+//! keeps its own model, and the topology must be the same.
+
+use fraccloth::history::Scheme;
+use fraccloth::topology::{MeshMass, MeshSpec};
+use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, Model, Vec3};
+
+fn grid() -> fraccloth::Topology {
+    GridSpec {
+        width: 6,
+        height: 5,
+        spacing: 0.01,
+        total_mass: 0.003,
+    }
+    .build()
+    .unwrap()
+}
+
+fn cloth(scheme: Scheme, model: Model, integrator: Integrator) -> Cloth {
+    let mut c = Cloth::new(
+        grid(),
+        ClothConfig {
+            model,
+            scheme,
+            integrator,
+            ..ClothConfig::default()
+        },
+    )
+    .unwrap();
+    c.set_pinned(&[0, 1, 2, 3, 4, 5]).unwrap();
+    c
+}
+
+/// Rewrites the snapshot's checksum after a change to its body.
+fn reseal(snap: &mut [u8]) {
+    let n = snap.len();
+    let crc = crc32fast::hash(&snap[..n - 4]);
+    snap[n - 4..].copy_from_slice(&crc.to_le_bytes());
+}
+
+fn stepped(scheme: Scheme) -> (Cloth, Vec<u8>) {
+    let mut a = cloth(scheme, Model::fractional(), Integrator::SymplecticEuler);
+    for _ in 0..40 {
+        a.step(5e-4).unwrap();
+    }
+    let snap = a.save_snapshot().unwrap();
+    (a, snap)
+}
+
+fn refused_and_unchanged(snap: &[u8], scheme: Scheme, want: &str) {
+    let mut b = cloth(scheme, Model::fractional(), Integrator::SymplecticEuler);
+    let before = (b.positions().to_vec(), b.time());
+    let err = b.load_snapshot(snap).expect_err("a forged snapshot was accepted");
+    assert!(err.message.contains(want), "{}", err.message);
+    assert_eq!((b.positions().to_vec(), b.time()), before, "the cloth changed");
+    b.step(5e-4).unwrap();
+}
+
+#[test]
+fn finite_but_absurd_soe_modes_are_refused_naming_the_history() {
+    let (a, snap) = stepped(Scheme::DEFAULT);
+    // The SOE state ends: modes (n K 3 f64), prev and newest (u64 length + 24 n bytes each), a
+    // flag byte and two f64; then the (empty) strain history and the checksum.
+    let n = a.vertex_count();
+    let k = a.history().mode_count();
+    let end = snap.len() - 4 - 8 - 8 - 1 - 2 * (8 + 24 * n);
+    for value in [1e300f64, -3e200, 1e30] {
+        let mut forged = snap.clone();
+        for p in (end - 8 * n * k * 3..end).step_by(8) {
+            forged[p..p + 8].copy_from_slice(&value.to_le_bytes());
+        }
+        reseal(&mut forged);
+        refused_and_unchanged(
+            &forged,
+            Scheme::DEFAULT,
+            "half-derivative history holds values the cloth cannot step from (a trial step",
+        );
+    }
+    // The untouched snapshot loads and steps.
+    let mut b = cloth(Scheme::DEFAULT, Model::fractional(), Integrator::SymplecticEuler);
+    b.load_snapshot(&snap).unwrap();
+    b.step(5e-4).unwrap();
+}
+
+#[test]
+fn a_full_history_whose_now_is_outside_the_cloths_life_is_refused() {
+    let (_, snap) = stepped(Scheme::Full);
+    for now in [-1e9, -1.0, 1e9] {
+        let mut forged = snap.clone();
+        let at = forged.len() - 4 - 8;
+        forged[at..at + 8].copy_from_slice(&f64::to_le_bytes(now));
+        reseal(&mut forged);
+        refused_and_unchanged(&forged, Scheme::Full, "full history");
+    }
+}
+
+#[test]
+fn a_snapshot_carries_the_state_and_the_receiving_cloth_keeps_its_model() {
+    let (a, snap) = stepped(Scheme::DEFAULT);
+    // Another model (springs 1000 times stiffer) and another integrator (implicit).
+    let stiff = Model {
+        stretch_stiffness: 1e4,
+        ..Model::fractional()
+    };
+    let mut b = cloth(Scheme::DEFAULT, stiff, Integrator::ImplicitEuler);
+    b.load_snapshot(&snap).unwrap();
+    assert_eq!(b.positions(), a.positions());
+    assert_eq!(b.velocities(), a.velocities());
+    assert_eq!(b.time(), a.time());
+    assert_eq!(b.model().stretch_stiffness, 1e4, "the receiving cloth's model");
+    assert_eq!(b.config().integrator, Integrator::ImplicitEuler);
+    b.step(1.0 / 60.0).unwrap();
+}
+
+#[test]
+fn a_grids_snapshot_is_refused_by_the_same_geometry_built_as_a_quad_mesh() {
+    let (_, snap) = stepped(Scheme::DEFAULT);
+    let g = grid();
+    let w = 6u32;
+    let quads: Vec<u32> = (0..4)
+        .flat_map(|j| {
+            (0..5).flat_map(move |i| [j * w + i, j * w + i + 1, (j + 1) * w + i + 1, (j + 1) * w + i])
+        })
+        .collect();
+    let t = MeshSpec {
+        positions: &g.rest_positions,
+        indices: &quads,
+        face_size: 4,
+        mass: MeshMass::Total(0.003),
+    }
+    .build()
+    .unwrap();
+    let mut m = Cloth::new(
+        t,
+        ClothConfig {
+            scheme: Scheme::DEFAULT,
+            integrator: Integrator::SymplecticEuler,
+            ..ClothConfig::default()
+        },
+    )
+    .unwrap();
+    let err = m.load_snapshot(&snap).expect_err("another topology was accepted");
+    assert!(err.message.contains("another cloth"), "{}", err.message);
+    assert_eq!(
+        m.positions()[7],
+        Vec3::new(m.positions()[7].x, m.positions()[7].y, 0.0)
+    );
+}
