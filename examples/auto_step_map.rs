@@ -7,7 +7,6 @@
 
 use fraccloth::history::Scheme;
 use fraccloth::scenes::{Drive, SceneKind, Variant};
-use fraccloth::topology::{MeshMass, MeshSpec};
 use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, Model, RegularDrag, Topology, Vec3};
 
 /// A grid's topology, or the same vertices jittered and triangulated with random diagonals.
@@ -17,53 +16,15 @@ fn topology(w: u32, h: u32, jittered: bool) -> Topology {
         width: w,
         height: h,
         spacing,
-        total_mass: 0.24 * f64::from((w - 1) * (h - 1)) * spacing * spacing / 0.24,
+        total_mass: f64::from((w - 1) * (h - 1)) * spacing * spacing,
     }
     .build()
     .expect("a grid");
-    if !jittered {
-        return grid;
+    if jittered {
+        fraccloth::scenes::jittered_mesh(&grid, w, 1.0, 12345).expect("a mesh")
+    } else {
+        grid
     }
-    let mut seed = 12345u64;
-    let mut r = move || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    let positions: Vec<Vec3> = grid
-        .rest_positions
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let (col, row) = (i as u32 % w, i as u32 / w);
-            let inner = col > 0 && col < w - 1 && row > 0 && row < h - 1;
-            if inner {
-                p + Vec3::new(0.3 * spacing * r(), 0.3 * spacing * r(), 0.0)
-            } else {
-                *p
-            }
-        })
-        .collect();
-    let mut indices = vec![];
-    for j in 0..h - 1 {
-        for i in 0..w - 1 {
-            let (a, b, c, d) = (j * w + i, j * w + i + 1, (j + 1) * w + i + 1, (j + 1) * w + i);
-            if r() < 0.0 {
-                indices.extend([a, d, b, b, d, c]);
-            } else {
-                indices.extend([a, d, c, a, c, b]);
-            }
-        }
-    }
-    MeshSpec {
-        positions: &positions,
-        indices: &indices,
-        face_size: 3,
-        mass: MeshMass::ArealDensity(1.0),
-    }
-    .build()
-    .expect("a mesh")
 }
 
 /// Whether `seconds` of the swing at fixed step `dt` complete.

@@ -268,6 +268,65 @@ pub struct SceneSpec {
     /// The cloth's `max_substep`: 0 steps `dt` at once (the paper's scenes), negative
     /// ([`crate::cloth::AUTO`]) lets the cloth split each `dt` as it needs.
     pub max_substep: f64,
+    /// Build the cloth as an irregular triangle mesh ([`jittered_mesh`]) instead of the grid:
+    /// the same vertices in the same order, moved and triangulated at random.
+    pub jittered: bool,
+}
+
+/// A grid's vertices (same order, edges kept straight) moved by up to 15 % of the spacing in
+/// its plane and triangulated with random diagonals, as a DCC's irregular mesh; masses and
+/// areas lumped from the faces at `areal_density` (kg/m^2). The same `seed` gives the same mesh.
+pub fn jittered_mesh(
+    grid: &crate::Topology,
+    width: u32,
+    areal_density: f64,
+    seed: u64,
+) -> Result<crate::Topology, Error> {
+    let (w, h) = (width, (grid.vertex_count() as u32) / width.max(1));
+    let spacing = grid
+        .rest_positions
+        .get(1)
+        .zip(grid.rest_positions.first())
+        .map_or(0.0, |(a, b)| (a - b).norm());
+    let mut seed = seed;
+    let mut r = move || {
+        seed = seed
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let positions: Vec<Vec3> = grid
+        .rest_positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let (col, row) = (i as u32 % w, i as u32 / w);
+            let inner = col > 0 && col + 1 < w && row > 0 && row + 1 < h;
+            if inner {
+                p + Vec3::new(0.3 * spacing * r(), 0.3 * spacing * r(), 0.0)
+            } else {
+                *p
+            }
+        })
+        .collect();
+    let mut indices = Vec::with_capacity(6 * (w as usize) * (h as usize));
+    for j in 0..h.saturating_sub(1) {
+        for i in 0..w.saturating_sub(1) {
+            let (a, b, c, d) = (j * w + i, j * w + i + 1, (j + 1) * w + i + 1, (j + 1) * w + i);
+            if r() < 0.0 {
+                indices.extend([a, d, b, b, d, c]);
+            } else {
+                indices.extend([a, d, c, a, c, b]);
+            }
+        }
+    }
+    crate::topology::MeshSpec {
+        positions: &positions,
+        indices: &indices,
+        face_size: 3,
+        mass: crate::topology::MeshMass::ArealDensity(areal_density),
+    }
+    .build()
 }
 
 impl SceneSpec {
@@ -287,6 +346,7 @@ impl SceneSpec {
             drive: Drive::of(kind, variant),
             model: None,
             max_substep: 0.0,
+            jittered: false,
         }
     }
 
@@ -313,6 +373,11 @@ impl SceneSpec {
             },
         }
         .build()?;
+        let topology = if self.jittered {
+            jittered_mesh(&topology, self.width, areal_density, 12345)?
+        } else {
+            topology
+        };
         let mut model = self.variant.model(spacing);
         if self.kind == SceneKind::Kelp {
             model.cloth_density = KELP_DENSITY;

@@ -97,6 +97,10 @@ struct Args {
     /// Seconds over which the drive fades in (default 0: a sudden start, as the paper's).
     #[arg(long)]
     ramp: Option<f64>,
+    /// Build the cloth as an irregular triangle mesh (the grid's vertices moved at random by up
+    /// to 15 % of the spacing, random diagonals) instead of the grid.
+    #[arg(long)]
+    jittered: bool,
     /// Simulated seconds.
     #[arg(long, default_value_t = 12.0)]
     seconds: f64,
@@ -244,6 +248,7 @@ fn spec_from(args: &Args, variant: Variant, scheme: Scheme) -> Result<SceneSpec,
         height,
         dt: if auto { 1.0 / args.fps } else { dt },
         max_substep: if auto { fraccloth::cloth::AUTO } else { 0.0 },
+        jittered: args.jittered,
         scheme,
         integrator,
         drive,

@@ -281,6 +281,20 @@ fuzz_target!(|data: &[u8]| {
                             s[end..].copy_from_slice(&crc.to_le_bytes());
                         }
                     }
+                    // A finite but possibly absurd number written over an 8-byte word of the
+                    // snapshot's tail (where the histories are), checksum made right: the
+                    // loader must refuse what cannot step (a trial step), never accept it.
+                    if pick % 5 == 1 && s.len() > 64 {
+                        let tail = s.len() - 4;
+                        let words = (tail / 2) / 8;
+                        let at = tail - 8 * (1 + usize::from(b.u8()) % words.max(1));
+                        let value = (f64::from(b.u8()) - 128.0) * 10f64.powi(i32::from(b.u8()) * 600 / 255 - 300);
+                        if value.is_finite() {
+                            s[at..at + 8].copy_from_slice(&value.to_le_bytes());
+                            let crc = crc32fast::hash(&s[..tail]);
+                            s[tail..].copy_from_slice(&crc.to_le_bytes());
+                        }
+                    }
                     if pick % 3 == 0 {
                         s = (0..usize::from(b.u8())).map(|_| b.u8()).collect();
                     }

@@ -38,7 +38,7 @@ use super::Cloth;
 pub const AUTO: f64 = -1.0;
 
 /// Fraction of the estimated bound the automatic step takes (measured: `docs/stability.md`).
-pub const SAFETY: f64 = 0.5;
+pub const SAFETY: f64 = 0.8;
 
 /// Times a refused frame is retried with twice the substeps (so up to 16 times the estimate's).
 pub const MAX_RETRIES: u32 = 4;

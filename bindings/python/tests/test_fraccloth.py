@@ -269,3 +269,21 @@ def test_every_call_of_the_header_is_bound():
     inline = {"fc_cloth_desc_default", "fc_cloth_desc_preset", "fc_cloth_get_desc"}
     missing = sorted(calls - inline - set(fraccloth._SIGNATURES))
     assert not missing, f"C calls the Python package does not bind: {missing}"
+
+
+def test_the_underwater_preset_steps_once_per_frame_with_the_automatic_step():
+    desc = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
+    assert desc.max_substep == fraccloth.MAX_SUBSTEP_AUTO
+    desc.width, desc.height, desc.spacing = 21, 15, 0.02
+    with fraccloth.Cloth.grid(desc) as cloth:
+        cloth.set_pinned(np.arange(21))
+        for _ in range(10):
+            cloth.step(1 / 30)
+        stats = cloth.step_stats()
+        assert stats.substeps >= 2 and stats.retries == 0 and 0 < stats.estimate < 1 / 30
+        # A fixed step keeps its count: 1/30 s in 1 ms substeps.
+        d = cloth.desc
+        d.max_substep = 1e-3
+        cloth.desc = d
+        cloth.step(1 / 30)
+        assert cloth.step_stats() == fraccloth.StepStats(34, 0, 0.0)
