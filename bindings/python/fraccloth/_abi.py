@@ -29,7 +29,7 @@ DESC_FIELDS = [
     ('history_horizon', ctypes.c_double, 'Longest simulated time (s) over which the SOE memory is accurate. Default 3600.'),
     ('history_min_dt', ctypes.c_double, 'Smallest step (s) the SOE kernel is built for. Default 1e-4.'),
     ('integrator', ctypes.c_uint32, 'An `FcIntegrator` value. Default `FC_INTEGRATOR_EXPLICIT_EULER`.'),
-    ('max_substep', ctypes.c_double, 'Longest substep (s) `fc_cloth_step` takes: a call with a larger dt is split into `ceil(dt / max_substep)` equal substeps. 0 = never split. Default 0.'),
+    ('max_substep', ctypes.c_double, 'Longest substep (s) `fc_cloth_step` takes: a call with a larger dt is split into `ceil(dt / max_substep)` equal substeps. 0 = never split; `FC_MAX_SUBSTEP_AUTO` (any negative value) = as few substeps as the cloth needs, chosen by the library each call (`fc_cloth_get_step_stats` says how many it took). Default 0; `FC_PRESET_UNDERWATER` uses `FC_MAX_SUBSTEP_AUTO`.'),
     ('solver_tolerance', ctypes.c_double, "Relative residual at which the implicit solver's CG stops (> 0). Default 1e-6."),
     ('solver_max_iterations', ctypes.c_uint32, "Iteration cap of the implicit solver's CG (>= 1). Default 500."),
     ('collision_stiffness', ctypes.c_double, 'Collision penalty stiffness, N/m. Default 50.'),
