@@ -18,6 +18,8 @@ mkdir -p "$OUT"
 for f in 0.25 0.5 1 2; do bake "swing-${f}hz" --frequency "$f"; done
 bake swing-31x21 --size 31x21 --dt 0.001
 bake swing-121x81 --size 121x81 --dt 0.00025
+bake jittered --jittered
+bake jittered-2hz --jittered --frequency 2
 bake curtain-51x76 --scene curtain --dt 0.001
 bake curtain-101x151 --scene curtain --size 101x151 --dt 0.0005
 bake current-along --scene current --current 0.3,0,0
