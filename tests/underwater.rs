@@ -200,6 +200,23 @@ fn per_area_drags_give_the_same_motion_at_any_resolution() {
     assert!((a - b).abs() < 0.01 * a.abs(), "{a} vs {b}");
 }
 
+/// A free plate (no gravity, no drag) with 100 times its mass as normal added mass, crumpled,
+/// and its crumpled positions.
+fn crumpled_plate(integrator: Integrator) -> (Cloth, Vec<Vec3>) {
+    let water = Water {
+        added_mass: 100.0 * MU,
+        ..Water::default()
+    };
+    let mut c = plate(10, Vec3::zeros(), water, integrator);
+    let x: Vec<Vec3> = c
+        .positions()
+        .iter()
+        .map(|p| p + Vec3::new(0.0, 0.0, 0.01 * (40.0 * p.x).sin() * (30.0 * p.y).cos()))
+        .collect();
+    c.set_positions(&x).unwrap();
+    (c, x)
+}
+
 #[test]
 fn a_free_cloth_with_strongly_anisotropic_added_mass_does_not_gain_energy() {
     // No gravity, no drag: only springs and 100 times the cloth's mass for normal motion, none
@@ -207,21 +224,11 @@ fn a_free_cloth_with_strongly_anisotropic_added_mass_does_not_gain_energy() {
     // not grow over 10 s beyond the integrator's own error: the carried water's turning forces
     // (`forces/inertia.rs`) make the equations Lagrange's, so the energy is conserved by the
     // equations and only the step changes it.
-    let water = Water {
-        added_mass: 100.0 * MU,
-        ..Water::default()
-    };
     for (integrator, dt) in [
         (Integrator::SymplecticEuler, 1e-4),
         (Integrator::ImplicitEuler, 1e-3),
     ] {
-        let mut c = plate(10, Vec3::zeros(), water, integrator);
-        let x: Vec<Vec3> = c
-            .positions()
-            .iter()
-            .map(|p| p + Vec3::new(0.0, 0.0, 0.01 * (40.0 * p.x).sin() * (30.0 * p.y).cos()))
-            .collect();
-        c.set_positions(&x).unwrap();
+        let (mut c, x) = crumpled_plate(integrator);
         let e0 = c.energy();
         let (mut worst, mut least) = (e0, e0);
         let steps = (10.0 / dt) as usize;
@@ -255,18 +262,8 @@ fn explicit_euler_gains_energy_with_anisotropic_added_mass_only_as_its_step_make
     // Explicit Euler gains energy on any undamped oscillator, in proportion to its step: on
     // the crumpled free cloth of the test above, the growth of log(energy) over 0.25 s must halve
     // with the step (the integrator's error), not stay (which would be the equations').
-    let water = Water {
-        added_mass: 100.0 * MU,
-        ..Water::default()
-    };
     let growth = |dt: f64| {
-        let mut c = plate(10, Vec3::zeros(), water, Integrator::ExplicitEuler);
-        let x: Vec<Vec3> = c
-            .positions()
-            .iter()
-            .map(|p| p + Vec3::new(0.0, 0.0, 0.01 * (40.0 * p.x).sin() * (30.0 * p.y).cos()))
-            .collect();
-        c.set_positions(&x).unwrap();
+        let (mut c, _) = crumpled_plate(Integrator::ExplicitEuler);
         let e0 = c.energy();
         let mut worst = e0;
         for _ in 0..(0.25 / dt) as usize {
