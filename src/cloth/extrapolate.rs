@@ -98,7 +98,7 @@ impl Cloth {
                 })
                 .unwrap_or(0);
             return Err(Error::unstable(format!(
-                "{} with dt = {h} s is unstable at step {steps}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s) or leave the float range; state left unchanged, retry with a smaller dt",
+                "{} with dt = {h} s is unstable at step {steps}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s) or leave the float range; state left unchanged, retry with a smaller dt (max_substep = FC_MAX_SUBSTEP_AUTO lets the library choose the substeps; or set max_substep, or call fc_cloth_step_substeps)",
                 self.config.integrator.name(),
                 self.v[i].norm(),
                 self.config.max_speed

@@ -573,7 +573,7 @@ impl Cloth {
         match parallel::first_failing(parallel::worth_it(x.len()), x.len(), clean, bad) {
             None => Ok(()),
             Some(i) => Err(Error::unstable(format!(
-                "{} with dt = {dt} s is unstable at step {}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s); state left unchanged, retry with a smaller dt",
+                "{} with dt = {dt} s is unstable at step {}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s); state left unchanged, retry with a smaller dt (max_substep = FC_MAX_SUBSTEP_AUTO lets the library choose the substeps; or set max_substep, or call fc_cloth_step_substeps)",
                 self.config.integrator.name(),
                 self.steps,
                 v[i].norm(),
@@ -587,7 +587,7 @@ impl Cloth {
         match self.scratch.x_new.iter().position(|x| x.amax() >= MAX_COORDINATE) {
             None => Ok(()),
             Some(i) => Err(Error::unstable(format!(
-                "{} with dt = {dt} s would move vertex {i} beyond the float range ({:.3e} m); state left unchanged, retry with a smaller dt",
+                "{} with dt = {dt} s would move vertex {i} beyond the float range ({:.3e} m); state left unchanged, retry with a smaller dt (max_substep = FC_MAX_SUBSTEP_AUTO lets the library choose the substeps; or set max_substep, or call fc_cloth_step_substeps)",
                 self.config.integrator.name(),
                 self.scratch.x_new[i].amax()
             ))),
