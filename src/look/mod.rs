@@ -15,4 +15,4 @@ pub use descriptors::{
 };
 pub use harmonic::{complex_amplitude, dominant_frequency};
 pub use meter::{measure, Look};
-pub use stream::{measure_stream, Stream};
+pub use stream::{measure_stream, Stream, STILL};
