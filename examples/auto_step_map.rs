@@ -1,7 +1,7 @@
 //! The automatic step's safety factor, measured: for every preset, integrator, mesh kind and
 //! size, the largest fixed step that completes the swing (bisection) against the estimate of
-//! `Cloth::auto_substep` (without its safety factor). The smallest ratio over all cases bounds
-//! the safety factor `fraccloth::cloth::SAFETY` (docs/stability.md).
+//! `Cloth::auto_substep` (without its safety factor). The smallest ratio over each integrator's
+//! cases bounds its safety factor (`fraccloth::cloth::safety`; docs/stability.md).
 //!
 //! `cargo run --release --example auto_step_map [SECONDS, default 4]`
 
@@ -138,7 +138,7 @@ fn main() {
             };
             let mut probe = Cloth::new(t.clone(), config).expect("a cloth");
             probe.set_pinned(&(0..w).collect::<Vec<u32>>()).expect("pins");
-            let estimate = probe.auto_substep(1.0) / fraccloth::cloth::SAFETY;
+            let estimate = probe.auto_substep(1.0) / fraccloth::cloth::safety(*integrator);
             // Bracket from the estimate (halving down or doubling up), then bisect in log space:
             // lo completes, hi does not.
             let ok = |dt: f64| completes(&t, w, model, *scheme, *integrator, dt, seconds);
@@ -172,7 +172,8 @@ fn main() {
         }
     }
     println!(
-        "\nsmallest ratio {worst:.2}: the automatic step takes {} of the estimate",
-        fraccloth::cloth::SAFETY
+        "\nsmallest ratio {worst:.2}; the automatic step takes {} of the estimate ({} with symplectic Euler)",
+        fraccloth::cloth::SAFETY,
+        fraccloth::cloth::SAFETY_SYMPLECTIC
     );
 }

@@ -14,7 +14,7 @@ mod step;
 
 use step::{Rollback, StepScratch};
 
-pub use auto_step::{StepStats, AUTO, MAX_RETRIES, SAFETY};
+pub use auto_step::{safety, StepStats, AUTO, MAX_RETRIES, SAFETY, SAFETY_SYMPLECTIC};
 pub use snapshot::SNAPSHOT_VERSION;
 
 use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
