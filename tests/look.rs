@@ -260,3 +260,51 @@ fn json_has_the_documented_keys() {
     }
     assert!(json.contains("\"half_amplitude_depth\": null"));
 }
+
+/// A staggered mesh (every other row shifted half a spacing, like bricks) has no vertex on
+/// every row of its centre line: the meter resamples the column through the rest triangles and
+/// reads the same travelling wave as on the grid.
+#[test]
+fn a_mesh_with_no_vertex_column_is_resampled() {
+    let (w, rows) = (21u32, 41u32);
+    let h = L / f64::from(rows - 1);
+    let mut rest = vec![];
+    for j in 0..rows {
+        let shift = if j % 2 == 1 { 0.5 * h } else { 0.0 };
+        for i in 0..w {
+            rest.push(Vec3::new(
+                (f64::from(i) - 10.0) * h + shift,
+                -f64::from(j) * h,
+                0.0,
+            ));
+        }
+    }
+    let mut triangles = vec![];
+    for j in 0..rows - 1 {
+        for i in 0..w - 1 {
+            let (a, b, c, d) = (j * w + i, j * w + i + 1, (j + 1) * w + i + 1, (j + 1) * w + i);
+            triangles.push([a, d, b]);
+            triangles.push([b, d, c]);
+        }
+    }
+    let c = 0.133;
+    let z = travelling(c, None);
+    let times: Vec<f64> = (0..=(SECONDS * FPS) as usize).map(|k| k as f64 / FPS).collect();
+    let frames: Vec<Vec<Vec3>> = times
+        .iter()
+        .map(|&t| rest.iter().map(|p| Vec3::new(p.x, p.y, z(-p.y, t))).collect())
+        .collect();
+    let look = measure(&rest, &triangles, &frames, &times, Vec3::y()).unwrap();
+    // Points one median edge length apart (the meter's spacing, 1.12 h here) all the way down,
+    // not the 21 rows that have a vertex on the line; most are a mix of a triangle's vertices.
+    assert!(
+        look.column_weights.len() > 30,
+        "{} rows",
+        look.column_weights.len()
+    );
+    assert!(look.column_weights.iter().skip(1).any(|r| r.len() == 3));
+    let d = &look.descriptors;
+    half_waves(d.half_waves, W * L / (PI * c));
+    close(d.travel_speed.expect("a wave travels"), c, 0.05, "travel");
+    close(d.mid_ratio, 1.0, 0.05, "mid");
+}

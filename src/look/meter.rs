@@ -7,7 +7,10 @@
 //!    flat and hangs in the cache is read correctly); "across" is perpendicular to it.
 //! 2. **Centre column.** The vertex of the top edge nearest the middle of the cloth's width,
 //!    and every vertex within a quarter of the mesh spacing of its across coordinate, ordered
-//!    by rest depth below the top.
+//!    by rest depth below the top. When those vertices cover fewer than three quarters of the
+//!    rows one spacing apart that the column's depth holds (a mesh whose vertices do not line
+//!    up), the column is resampled instead: one point a spacing apart down that line, each
+//!    carried by the rest triangle it lies in (barycentric weights of its three vertices).
 //! 3. **Drive.** The out-of-plane axis is the principal horizontal direction of the top
 //!    vertex's motion over the second half of the cache; the drive frequency is its dominant
 //!    harmonic there ([`super::harmonic::dominant_frequency`]).
@@ -30,8 +33,12 @@ pub struct Look {
     pub out_of_plane: Vec3,
     /// Unit up axis used, in the cache's coordinates.
     pub up: Vec3,
-    /// Vertex indices of the centre column, top first.
+    /// Vertex indices of the centre column, top first (for a resampled column, the vertex of
+    /// largest weight of each point).
     pub column: Vec<usize>,
+    /// Each row of the column as vertices and weights (one vertex of weight 1 unless the column
+    /// was resampled).
+    pub column_weights: Vec<Vec<(usize, f64)>>,
     /// Measured window: start and end time, s, and the whole drive periods it holds.
     pub window: (f64, f64, u32),
     /// The descriptors.
@@ -169,7 +176,46 @@ pub fn measure(
             column.len()
         )));
     }
-    let depths: Vec<f64> = column.iter().map(|&i| height[top_vertex] - height[i]).collect();
+    let mut depths: Vec<f64> = column.iter().map(|&i| height[top_vertex] - height[i]).collect();
+    let mut rows: Vec<Vec<(usize, f64)>> = column.iter().map(|&i| vec![(i, 1.0)]).collect();
+    // Sparse: resample the line through the top vertex, one point a spacing apart.
+    let bottom_h = height.iter().copied().fold(f64::INFINITY, f64::min);
+    let expected = ((height[top_vertex] - bottom_h) / h).floor() as usize + 1;
+    if 4 * column.len() < 3 * expected {
+        let line = width[top_vertex];
+        let locate = |hh: f64| -> Option<Vec<(usize, f64)>> {
+            triangles.iter().find_map(|t| {
+                let [a, b, c] = t.map(|i| i as usize);
+                let p = |i: usize| Vector2::new(width[i], height[i]);
+                let (pa, pb, pc) = (p(a), p(b), p(c));
+                let m = Matrix2::from_columns(&[pb - pa, pc - pa]);
+                let uv = m.try_inverse()? * (Vector2::new(line, hh) - pa);
+                let (u, v) = (uv.x, uv.y);
+                let eps = 1e-9;
+                (u >= -eps && v >= -eps && u + v <= 1.0 + eps).then(|| vec![(a, 1.0 - u - v), (b, u), (c, v)])
+            })
+        };
+        let mut resampled = (vec![], vec![]);
+        for k in 0..expected {
+            let d = k as f64 * h;
+            if let Some(w) = locate(height[top_vertex] - d) {
+                resampled.0.push(d);
+                resampled.1.push(w);
+            }
+        }
+        if resampled.0.len() >= 4 {
+            (depths, rows) = resampled;
+            column = rows
+                .iter()
+                .map(|w| {
+                    w.iter()
+                        .max_by(|a, b| a.1.total_cmp(&b.1))
+                        .map_or(top_vertex, |x| x.0)
+                })
+                .collect();
+        }
+    }
+    let at = |f: &[Vec3], row: &[(usize, f64)]| -> Vec3 { row.iter().map(|&(i, w)| w * f[i]).sum() };
 
     // 3. Drive: principal horizontal direction of the top's motion, then its frequency.
     let horiz = |p: Vec3| p - up * p.dot(&up);
@@ -224,15 +270,15 @@ pub fn measure(
         times: ks.iter().map(|&k| times[k]).collect(),
         offsets: ks
             .iter()
-            .map(|&k| column.iter().map(|&i| frames[k][i].dot(&axis)).collect())
+            .map(|&k| rows.iter().map(|r| at(&frames[k], r).dot(&axis)).collect())
             .collect(),
         heights: ks
             .iter()
-            .map(|&k| column.iter().map(|&i| frames[k][i].dot(&up)).collect())
+            .map(|&k| rows.iter().map(|r| at(&frames[k], r).dot(&up)).collect())
             .collect(),
     };
     let motion = motion_of(&window);
-    let amplitudes: Vec<Complex<f64>> = (0..column.len())
+    let amplitudes: Vec<Complex<f64>> = (0..rows.len())
         .map(|j| {
             let z: Vec<f64> = motion.offsets.iter().map(|f| f[j]).collect();
             complex_amplitude(&motion.times, &z, omega)
@@ -247,6 +293,7 @@ pub fn measure(
         out_of_plane: axis,
         up,
         column,
+        column_weights: rows,
         window: (t_start, t_end, periods as u32),
         descriptors,
         history,
