@@ -487,6 +487,11 @@ size_t fc_cloth_triangle_count(const FcCloth *cloth);
  * Creates a grid cloth at rest from `*desc` and writes the handle to `*out_cloth`
  * (only on success). Bad fields give `FC_ERROR_INVALID_ARGUMENT` and a message naming them.
  *
+ * Where the grid sits: in the plane z = 0, centred on x = 0, its top row on y = 0 and its rows
+ * going down (-y); vertex `j * width + i` is at
+ * `(spacing * (i - (width - 1) / 2), -spacing * j, 0)`. Its triangles wind counter-clockwise
+ * seen from +z (normals +z at rest). Gravity defaults to (0, -9.81, 0): y is up.
+ *
  * # Safety
  * `desc` must be NULL or point to an initialised `FcClothDesc`; `out_cloth` NULL or writable.
  */
@@ -1070,7 +1075,9 @@ static inline FcClothDesc fc_cloth_desc_default(void) {
 
 /**
  * Fills `*out_desc` with a preset (an `FcPreset` value) on the default grid, `struct_size` set.
- * `FC_ERROR_INVALID_ARGUMENT` for an unknown preset. Inline: calls `fc_cloth_desc_preset_sized`.
+ * Every field is written, the grid's size and spacing included: set `width`, `height` and
+ * `spacing` after this call, not before. `FC_ERROR_INVALID_ARGUMENT` for an unknown preset.
+ * Inline: calls `fc_cloth_desc_preset_sized`.
  */
 static inline FcStatus fc_cloth_desc_preset(uint32_t preset, FcClothDesc *out_desc) {
   return fc_cloth_desc_preset_sized(preset, out_desc, sizeof(FcClothDesc));

@@ -80,6 +80,11 @@ pub(crate) fn check_float_count(cloth: &Cloth, float_count: usize) -> Result<(),
 /// Creates a grid cloth at rest from `*desc` and writes the handle to `*out_cloth`
 /// (only on success). Bad fields give `FC_ERROR_INVALID_ARGUMENT` and a message naming them.
 ///
+/// Where the grid sits: in the plane z = 0, centred on x = 0, its top row on y = 0 and its rows
+/// going down (-y); vertex `j * width + i` is at
+/// `(spacing * (i - (width - 1) / 2), -spacing * j, 0)`. Its triangles wind counter-clockwise
+/// seen from +z (normals +z at rest). Gravity defaults to (0, -9.81, 0): y is up.
+///
 /// # Safety
 /// `desc` must be NULL or point to an initialised `FcClothDesc`; `out_cloth` NULL or writable.
 #[no_mangle]
