@@ -392,6 +392,17 @@ typedef struct {
    * Default 0.
    */
   double added_mass_coefficient;
+  /**
+   * Self-collision: the distance the cloth keeps from itself, m (0 = off, the default).
+   * Keep it below the spacing of the mesh: pairs nearer than this at rest are not tested.
+   * No vertex moves more than half of it in one substep (the automatic step takes more
+   * substeps; a fixed step that would is refused as unstable). See docs/collisions.md.
+   */
+  double self_collision_thickness;
+  /**
+   * Coulomb friction coefficient of the cloth against itself (>= 0). Default 0.
+   */
+  double self_collision_friction;
 } FcClothDesc;
 
 #ifdef __cplusplus
@@ -906,6 +917,69 @@ FcStatus fc_cloth_create_mesh(const FcClothDesc *desc,
                               size_t index_count,
                               uint32_t face_size,
                               FcCloth **out_cloth);
+
+/**
+ * Adds a triangle-mesh collider and writes its id to `*out_id` (only on success). The id is
+ * shared with the other colliders: `fc_cloth_set_collider_friction` and
+ * `fc_cloth_remove_collider` take it.
+ *
+ * `xyz`: `vertex_count` positions (3 floats each, m). `indices`: `index_count` vertex
+ * indices, three per triangle (any winding on an open mesh; on a closed one, counter-clockwise
+ * seen from outside, as Blender, Maya and glTF write them). `velocities`: NULL (the surface
+ * moves as its positions do between calls) or `vertex_count` velocities (3 floats each, m/s).
+ *
+ * The cloth keeps `collision_margin` from the mesh, with `collision_stiffness` and
+ * `collision_damping` as for the other colliders. A closed mesh (every edge shared by two
+ * triangles) has an inside: a cloth vertex that ends up in it is pushed out. An open mesh is a
+ * two-sided shell. Mesh vertices push cloth triangles too, so a collider thinner than the
+ * cloth's spacing does not slip between cloth vertices. See docs/collisions.md.
+ *
+ * Errors: `FC_ERROR_NULL_ARGUMENT`; `FC_ERROR_OUT_OF_RANGE` for an index not below
+ * `vertex_count`; `FC_ERROR_INVALID_ARGUMENT` for no triangle, an index count not a multiple
+ * of 3, or a non-finite value; `FC_ERROR_OUT_OF_MEMORY`.
+ *
+ * # Safety
+ * `cloth` NULL or live; `xyz` NULL or `3 * vertex_count` readable floats; `indices` NULL or
+ * `index_count` readable values; `velocities` NULL or `3 * vertex_count` readable floats;
+ * `out_id` NULL or writable.
+ */
+FcStatus fc_cloth_add_mesh_collider(FcCloth *cloth,
+                                    const float *xyz,
+                                    size_t vertex_count,
+                                    const uint32_t *indices,
+                                    size_t index_count,
+                                    const float *velocities,
+                                    uint32_t *out_id);
+
+/**
+ * Moves or deforms mesh collider `id`: `vertex_count` new positions (3 floats each, m) of
+ * the same vertices in the same order, and their velocities (NULL: from the motion). The mesh
+ * travels there in a straight line over the next `fc_cloth_step` call, as the pins do; call
+ * it once a frame with the evaluated mesh (armature, shape keys, modifiers).
+ *
+ * Errors: `FC_ERROR_OUT_OF_RANGE` for no mesh collider `id`; `FC_ERROR_INVALID_ARGUMENT` for
+ * a vertex count other than the mesh's or a non-finite value. Nothing changes on an error.
+ *
+ * # Safety
+ * `cloth` NULL or live; `xyz` NULL or `3 * vertex_count` readable floats; `velocities` NULL or
+ * `3 * vertex_count` readable floats.
+ */
+FcStatus fc_cloth_set_mesh_collider(FcCloth *cloth,
+                                    uint32_t id,
+                                    const float *xyz,
+                                    size_t vertex_count,
+                                    const float *velocities);
+
+/**
+ * Reads mesh collider `id`'s vertex and triangle counts (either output may be NULL).
+ *
+ * # Safety
+ * `cloth` NULL or live; `vertex_count`, `triangle_count` NULL or writable.
+ */
+FcStatus fc_cloth_get_mesh_collider(const FcCloth *cloth,
+                                    uint32_t id,
+                                    size_t *vertex_count,
+                                    size_t *triangle_count);
 
 /**
  * Bytes `fc_cloth_save_snapshot` needs now (it grows with the history for `FC_HISTORY_FULL`;

@@ -7,6 +7,7 @@
 //! state that does has exploded).
 
 mod auto_step;
+mod collisions;
 mod extrapolate;
 mod prepass;
 mod snapshot;
@@ -17,6 +18,7 @@ use step::{Rollback, StepScratch};
 pub use auto_step::{safety, StepStats, AUTO, MAX_RETRIES, SAFETY, SAFETY_SYMPLECTIC};
 pub use snapshot::SNAPSHOT_VERSION;
 
+use crate::collide::{MeshCollider, SelfCollision};
 use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
 use crate::forces::{self, Collider, Plane, Sphere};
 use crate::history::{History, Scheme};
@@ -139,6 +141,11 @@ pub struct Cloth {
     collider_slots: Vec<Option<(Collider, f64)>>,
     colliders: Vec<Collider>,
     friction: Vec<f64>,
+    /// Triangle-mesh colliders by id (ids shared with `collider_slots`: an id is in at most
+    /// one of the two).
+    mesh_slots: Vec<Option<MeshCollider>>,
+    /// Self-collision's search and remembered sides (`collide/self_collision.rs`).
+    self_collision: SelfCollision,
     history: History,
     /// One scalar per spring for the rotation-invariant fractional springs
     /// (`forces/strain.rs`), three springs to an entry; `Off` without them.
@@ -189,6 +196,8 @@ impl Cloth {
             collider_slots: Vec::new(),
             colliders: Vec::new(),
             friction: Vec::new(),
+            mesh_slots: Vec::new(),
+            self_collision: SelfCollision::new(&topology.triangles),
             history: History::new(scheme, n)?,
             strain_history: History::new(
                 if memories.springs {
@@ -412,6 +421,8 @@ impl Cloth {
         for &i in &self.pin_list {
             self.pin_target[i as usize] = x[i as usize];
         }
+        // Teleported: the sides self-collision remembered no longer hold.
+        self.self_collision.set_pairs(Vec::new(), Vec::new());
         Ok(())
     }
 
@@ -454,16 +465,11 @@ impl Cloth {
     /// Adds any collider (friction 0) and returns its id, the smallest free one.
     pub fn add_collider(&mut self, collider: Collider) -> Result<u32, Error> {
         let collider = checked_collider(collider)?;
-        let id = match self.collider_slots.iter().position(Option::is_none) {
-            Some(free) => {
-                self.collider_slots[free] = Some((collider, 0.0));
-                free
-            }
-            None => {
-                self.collider_slots.push(Some((collider, 0.0)));
-                self.collider_slots.len() - 1
-            }
-        };
+        let id = self.free_collider_id();
+        if id >= self.collider_slots.len() {
+            self.collider_slots.resize(id + 1, None);
+        }
+        self.collider_slots[id] = Some((collider, 0.0));
         self.rebuild_colliders();
         Ok(id as u32)
     }
@@ -478,9 +484,13 @@ impl Cloth {
         Ok(())
     }
 
-    /// Sets the Coulomb friction coefficient (>= 0) of collider `id`.
+    /// Sets the Coulomb friction coefficient (>= 0) of collider `id` (any kind, meshes too).
     pub fn set_collider_friction(&mut self, id: u32, friction: f64) -> Result<(), Error> {
         check_non_negative("friction", friction)?;
+        if let Some(Some(mesh)) = self.mesh_slots.get_mut(id as usize) {
+            mesh.friction = friction;
+            return Ok(());
+        }
         if let Some((_, f)) = self.collider_slot(id)? {
             *f = friction;
         }
@@ -488,8 +498,12 @@ impl Cloth {
         Ok(())
     }
 
-    /// Removes collider `id`; its id may be reused.
+    /// Removes collider `id` (any kind, meshes too); its id may be reused.
     pub fn remove_collider(&mut self, id: u32) -> Result<(), Error> {
+        if let Some(slot @ Some(_)) = self.mesh_slots.get_mut(id as usize) {
+            *slot = None;
+            return Ok(());
+        }
         *self.collider_slot(id)? = None;
         self.rebuild_colliders();
         Ok(())
@@ -508,12 +522,24 @@ impl Cloth {
             .map(|s| &s.0)
     }
 
-    /// Friction coefficient of collider `id`.
+    /// Friction coefficient of collider `id` (any kind).
     pub fn collider_friction(&self, id: u32) -> Option<f64> {
+        if let Some(Some(mesh)) = self.mesh_slots.get(id as usize) {
+            return Some(mesh.friction);
+        }
         self.collider_slots
             .get(id as usize)
             .and_then(Option::as_ref)
             .map(|s| s.1)
+    }
+
+    /// The smallest id free among the analytic and the mesh colliders.
+    fn free_collider_id(&self) -> usize {
+        let taken = |i: usize| {
+            matches!(self.collider_slots.get(i), Some(Some(_)))
+                || matches!(self.mesh_slots.get(i), Some(Some(_)))
+        };
+        (0..).find(|&i| !taken(i)).unwrap_or(0)
     }
 
     fn collider_slot(&mut self, id: u32) -> Result<&mut Option<(Collider, f64)>, Error> {
@@ -577,8 +603,16 @@ impl Cloth {
         self.threads.count()
     }
 
+    /// One call: the mesh colliders travel to where the host put them over it.
     fn step_substeps_here(&mut self, dt: f64, substeps: u32) -> Result<(), Error> {
         check_dt(dt)?;
+        self.begin_collider_motion(dt);
+        self.step_substeps_inner(dt, substeps)?;
+        self.colliders_arrive();
+        Ok(())
+    }
+
+    fn step_substeps_inner(&mut self, dt: f64, substeps: u32) -> Result<(), Error> {
         if substeps == 0 || substeps > MAX_SUBSTEPS {
             return Err(Error::invalid(format!(
                 "substeps must be in 1..={MAX_SUBSTEPS}, got {substeps}"

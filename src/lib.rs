@@ -30,6 +30,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod cloth;
+pub mod collide;
 pub mod error;
 pub mod export;
 pub mod ffi;

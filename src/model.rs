@@ -59,6 +59,12 @@ pub struct Model {
     pub collision_damping: f64,
     /// Distance from a collider surface below which the repulsion acts, m.
     pub collision_margin: f64,
+    /// Self-collision: the distance the cloth keeps from itself, m (0 = off, and costs
+    /// nothing). Pairs nearer than this at rest are not tested, so keep it below the spacing
+    /// of the mesh (`collide/self_collision.rs`).
+    pub self_collision_thickness: f64,
+    /// Coulomb friction coefficient of the cloth against itself (>= 0).
+    pub self_collision_friction: f64,
     /// The water's terms given per unit area of cloth (zero switches each off).
     pub water: Water,
 }
@@ -152,6 +158,8 @@ impl Model {
         check_non_negative("collision_stiffness", self.collision_stiffness)?;
         check_non_negative("collision_damping", self.collision_damping)?;
         check_non_negative("collision_margin", self.collision_margin)?;
+        check_non_negative("self_collision_thickness", self.self_collision_thickness)?;
+        check_non_negative("self_collision_friction", self.self_collision_friction)?;
         let w = &self.water;
         check_non_negative("added_mass", w.added_mass)?;
         check_non_negative("added_mass_coefficient", w.added_mass_coefficient)?;
@@ -186,6 +194,8 @@ impl Model {
             collision_stiffness: 50.0,
             collision_damping: 0.05,
             collision_margin: 0.01,
+            self_collision_thickness: 0.0,
+            self_collision_friction: 0.0,
             water: Water::default(),
         }
     }

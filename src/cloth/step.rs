@@ -72,6 +72,8 @@ pub(super) struct StepScratch {
     /// Forces of the whole-cloth passes before the force pass (strain springs, the carried
     /// water's turning forces), one per particle; empty without them.
     pub prior_forces: Vec<Vec3>,
+    /// The collision pass's contact elements (mesh colliders, self-collision).
+    pub contacts: Vec<crate::collide::Contact>,
     pub turning: forces::TurningScratch,
     /// Each patch's projected-area ratio ([`forces::patch_normals`]), with normal added mass
     /// only (else empty).
@@ -147,13 +149,15 @@ impl Cloth {
         let w0 = self.step_velocities(h);
         let strain_w0 = self.strain_damping();
         self.water_turning();
+        self.collisions(fraction);
         let integrated_sound = match Route::of(self.config.integrator) {
             Route::ExplicitTiles(step) => self.forces_and_explicit_step(h, strain_w0, step),
             Route::Implicit => self.forces_and_implicit_step(h, w0, strain_w0)?,
         };
-        let friction = self.friction(h);
+        let friction = self.friction(h) | self.contact_friction(h);
         self.pins(h);
         self.check(h, integrated_sound && !friction)?;
+        self.check_collision_step(h)?;
         self.commit(h);
         Ok(())
     }
@@ -476,6 +480,9 @@ impl Cloth {
             topology: &self.topology,
             pinned: &self.pinned,
             settings: self.config.solver,
+            contacts: &s.contacts,
+            contact_stiffness: self.config.model.collision_stiffness,
+            contact_damping: self.config.model.collision_damping,
         };
         self.solver_stats = implicit_euler(&inp, &mut s.implicit, &mut s.v_new);
         let st = self.solver_stats;

@@ -196,6 +196,13 @@ pub struct FcClothDesc {
     /// motion (potential flow); `lambda / (pi W)` that of ripples of wavelength lambda.
     /// Default 0.
     pub added_mass_coefficient: f64,
+    /// Self-collision: the distance the cloth keeps from itself, m (0 = off, the default).
+    /// Keep it below the spacing of the mesh: pairs nearer than this at rest are not tested.
+    /// No vertex moves more than half of it in one substep (the automatic step takes more
+    /// substeps; a fixed step that would is refused as unstable). See docs/collisions.md.
+    pub self_collision_thickness: f64,
+    /// Coulomb friction coefficient of the cloth against itself (>= 0). Default 0.
+    pub self_collision_friction: f64,
 }
 
 fn v3(a: [f64; 3]) -> Vec3 {
@@ -267,6 +274,8 @@ impl FcClothDesc {
             form_drag: model.water.form_drag,
             entrained_mass: model.water.entrained_mass,
             skin_drag: model.water.skin_drag,
+            self_collision_thickness: model.self_collision_thickness,
+            self_collision_friction: model.self_collision_friction,
             viscous_drag_per_area: model.water.viscous_drag,
             history_drag_per_area: model.water.history_drag,
             normal_drag_per_area: model.water.normal_drag,
@@ -364,6 +373,8 @@ impl FcClothDesc {
                 collision_stiffness: self.collision_stiffness,
                 collision_damping: self.collision_damping,
                 collision_margin: self.collision_margin,
+                self_collision_thickness: self.self_collision_thickness,
+                self_collision_friction: self.self_collision_friction,
                 water: crate::model::Water {
                     added_mass: self.added_mass,
                     added_mass_coefficient: self.added_mass_coefficient,

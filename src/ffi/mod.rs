@@ -3,7 +3,7 @@
 //! One file per header area: [`status`] (status codes, last error, the panic
 //! boundary), [`desc`] (the description struct and its defaults), [`desc_size`] (its `struct_size` rule), [`cloth`]
 //! (lifetime, pins, positions, stepping), [`mesh`] (cloths from meshes), [`collider`]
-//! (colliders), [`cache`] (PC2 / MDD / OBJ writers), [`geometry`] (index buffer, normals), [`state`] (positions and velocities in
+//! (colliders), [`mesh_collider`] (triangle-mesh colliders), [`cache`] (PC2 / MDD / OBJ writers), [`geometry`] (index buffer, normals), [`state`] (positions and velocities in
 //! double precision, velocities in float), [`threads`] (where a step runs), [`version`].
 //!
 //! Rules every export follows:
@@ -24,6 +24,7 @@ pub mod desc;
 pub mod desc_size;
 pub mod geometry;
 pub mod mesh;
+pub mod mesh_collider;
 pub mod snapshot;
 pub mod state;
 pub mod threads;
@@ -35,6 +36,7 @@ pub use collider::*;
 pub use desc::*;
 pub use geometry::*;
 pub use mesh::*;
+pub use mesh_collider::*;
 pub use snapshot::*;
 pub use state::*;
 pub use status::*;

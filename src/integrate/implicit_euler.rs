@@ -14,6 +14,7 @@
 use nalgebra::Matrix3;
 
 use super::cg::{self, CgScratch, SolverSettings, SolverStats};
+use crate::collide::{contact, Contact};
 use crate::forces::add_spring_values;
 use crate::forces::{Linearisation, SpringBlock};
 use crate::parallel;
@@ -45,6 +46,10 @@ pub struct ImplicitInput<'a> {
     pub topology: &'a Topology,
     pub pinned: &'a [bool],
     pub settings: SolverSettings,
+    /// Contact elements (`collide/contact.rs`): their blocks join the system.
+    pub contacts: &'a [Contact],
+    pub contact_stiffness: f64,
+    pub contact_damping: f64,
 }
 
 /// Writes `out[k] = blocks[k] (p_i - p_j)` for every spring k.
@@ -87,6 +92,8 @@ fn apply_system(
         }
         add_spring_values(inp.topology, first, values, -1.0, chunk);
     });
+    let (k, c) = (inp.contact_stiffness, inp.contact_damping);
+    contact::add_system_product(inp.contacts, k, c, h, inp.v, p, out);
 }
 
 /// Solves for the new velocities of free particles into `v_new` (pinned entries keep `inp.v`).
@@ -143,6 +150,8 @@ pub fn implicit_euler(
         }
         add_spring_values(t, first, values, -1.0, chunk);
     });
+    let (kc, cc) = (inp.contact_stiffness, inp.contact_damping);
+    contact::add_rhs(inp.contacts, kc, h, inp.v, rhs);
     // Block-Jacobi preconditioner: inverse of each 3x3 diagonal block of the system.
     let blocks = &*spring_blocks;
     parallel::chunks(par, spring_matrices, parallel::CHUNK, |first, chunk| {
@@ -160,6 +169,9 @@ pub fn implicit_euler(
             }
         }
         add_spring_values(t, first, matrices, 1.0, chunk);
+    });
+    contact::add_system_diagonal(inp.contacts, kc, cc, h, inp.v, precond);
+    parallel::chunks(par, precond, parallel::CHUNK, |first, chunk| {
         for (k, m) in chunk.iter_mut().enumerate() {
             *m = m
                 .try_inverse()

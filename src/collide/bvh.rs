@@ -1,0 +1,318 @@
+//! A bounding-volume hierarchy over axis-aligned boxes: built once for a fixed list of items
+//! (a mesh's triangles, a cloth's edges), refitted in linear time when they move, queried for
+//! every item whose box overlaps a box, or for the nearest item to a point.
+//!
+//! Median split on the longest axis of the centroids, at most [`LEAF`] items a leaf; nodes are
+//! stored parent before children, so a refit is one backward sweep.
+
+use crate::Vec3;
+
+/// Items in a leaf, at most.
+const LEAF: usize = 4;
+
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The empty box (grows to anything it is joined with).
+    pub fn empty() -> Aabb {
+        Aabb {
+            min: Vec3::repeat(f64::INFINITY),
+            max: Vec3::repeat(f64::NEG_INFINITY),
+        }
+    }
+
+    /// The box of some points.
+    pub fn of<'a>(points: impl IntoIterator<Item = &'a Vec3>) -> Aabb {
+        let mut b = Aabb::empty();
+        for p in points {
+            b.grow(p);
+        }
+        b
+    }
+
+    pub fn grow(&mut self, p: &Vec3) {
+        self.min = self.min.inf(p);
+        self.max = self.max.sup(p);
+    }
+
+    pub fn join(&self, o: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.inf(&o.min),
+            max: self.max.sup(&o.max),
+        }
+    }
+
+    /// The box grown by `r` on every side.
+    pub fn inflated(&self, r: f64) -> Aabb {
+        Aabb {
+            min: self.min.add_scalar(-r),
+            max: self.max.add_scalar(r),
+        }
+    }
+
+    pub fn overlaps(&self, o: &Aabb) -> bool {
+        self.min.x <= o.max.x
+            && o.min.x <= self.max.x
+            && self.min.y <= o.max.y
+            && o.min.y <= self.max.y
+            && self.min.z <= o.max.z
+            && o.min.z <= self.max.z
+    }
+
+    pub fn contains(&self, p: &Vec3) -> bool {
+        (0..3).all(|c| self.min[c] <= p[c] && p[c] <= self.max[c])
+    }
+
+    /// Squared distance from `p` to the box (0 inside).
+    pub fn distance2(&self, p: &Vec3) -> f64 {
+        let d = (self.min - p).sup(&Vec3::zeros()).sup(&(p - self.max));
+        d.norm_squared()
+    }
+
+    fn centre(&self) -> Vec3 {
+        0.5 * (self.min + self.max)
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    bounds: Aabb,
+    /// A leaf's first item in `order` and count; an inner node's first child (`count` 0, the
+    /// second child is `first + 1`).
+    first: u32,
+    count: u32,
+}
+
+/// The hierarchy; see the module docs.
+#[derive(Clone, Debug, Default)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+    /// Item indices, leaf by leaf.
+    order: Vec<u32>,
+    /// Each item's box.
+    boxes: Vec<Aabb>,
+}
+
+impl Bvh {
+    /// Builds the hierarchy over `boxes` (item k has box k).
+    pub fn build(boxes: &[Aabb]) -> Bvh {
+        let mut bvh = Bvh {
+            nodes: Vec::with_capacity(2 * boxes.len() / LEAF + 1),
+            order: (0..boxes.len() as u32).collect(),
+            boxes: boxes.to_vec(),
+        };
+        if boxes.is_empty() {
+            return bvh;
+        }
+        let centres: Vec<Vec3> = boxes.iter().map(Aabb::centre).collect();
+        bvh.nodes.push(Node {
+            bounds: Aabb::empty(),
+            first: 0,
+            count: boxes.len() as u32,
+        });
+        // (node, first item, item count): split until leaves are small.
+        let mut todo = vec![(0usize, 0usize, boxes.len())];
+        while let Some((node, lo, n)) = todo.pop() {
+            let items = &mut bvh.order[lo..lo + n];
+            bvh.nodes[node].bounds = items
+                .iter()
+                .fold(Aabb::empty(), |b, &i| b.join(&boxes[i as usize]));
+            if n <= LEAF {
+                bvh.nodes[node].first = lo as u32;
+                bvh.nodes[node].count = n as u32;
+                continue;
+            }
+            let spread = Aabb::of(items.iter().map(|&i| &centres[i as usize]));
+            let axis = (spread.max - spread.min).imax();
+            let half = n / 2;
+            items.select_nth_unstable_by(half, |&a, &b| {
+                centres[a as usize][axis].total_cmp(&centres[b as usize][axis])
+            });
+            let child = bvh.nodes.len();
+            for _ in 0..2 {
+                bvh.nodes.push(Node {
+                    bounds: Aabb::empty(),
+                    first: 0,
+                    count: 0,
+                });
+            }
+            bvh.nodes[node].first = child as u32;
+            bvh.nodes[node].count = 0;
+            todo.push((child, lo, half));
+            todo.push((child + 1, lo + half, n - half));
+        }
+        bvh
+    }
+
+    /// Items in the hierarchy.
+    pub fn len(&self) -> usize {
+        self.order.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.order.is_empty()
+    }
+
+    /// New boxes for the same items: the tree is kept, its bounds recomputed.
+    pub fn refit(&mut self, boxes: &[Aabb]) {
+        debug_assert_eq!(boxes.len(), self.order.len());
+        self.boxes.copy_from_slice(boxes);
+        for k in (0..self.nodes.len()).rev() {
+            let Node { first, count, .. } = self.nodes[k];
+            let (first, count) = (first as usize, count as usize);
+            self.nodes[k].bounds = if count > 0 {
+                self.order[first..first + count]
+                    .iter()
+                    .fold(Aabb::empty(), |b, &i| b.join(&boxes[i as usize]))
+            } else {
+                self.nodes[first].bounds.join(&self.nodes[first + 1].bounds)
+            };
+        }
+    }
+
+    /// The box of everything.
+    pub fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::empty(), |n| n.bounds)
+    }
+
+    /// Calls `f` with every item whose box overlaps `q`.
+    pub fn overlapping(&self, q: &Aabb, mut f: impl FnMut(u32)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if !node.bounds.overlaps(q) {
+                continue;
+            }
+            let first = node.first as usize;
+            if node.count > 0 {
+                for &i in &self.order[first..first + node.count as usize] {
+                    if self.boxes[i as usize].overlaps(q) {
+                        f(i);
+                    }
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = first as u32;
+                stack[top + 1] = first as u32 + 1;
+                top += 2;
+            }
+        }
+    }
+
+    /// The item nearest to `p` within squared distance `max2`, by `dist2(item)`, an item's
+    /// exact squared distance (its box must hold it): `(item, squared distance)`.
+    pub fn nearest(&self, p: &Vec3, max2: f64, mut dist2: impl FnMut(u32) -> f64) -> Option<(u32, f64)> {
+        let mut best: Option<(u32, f64)> = None;
+        let mut limit = max2;
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if node.bounds.distance2(p) > limit {
+                continue;
+            }
+            let first = node.first as usize;
+            if node.count > 0 {
+                for &i in &self.order[first..first + node.count as usize] {
+                    let d = dist2(i);
+                    if d <= limit {
+                        limit = d;
+                        best = Some((i, d));
+                    }
+                }
+            } else if top + 2 <= stack.len() {
+                // The nearer child last, so it is searched first.
+                let (a, b) = (first as u32, first as u32 + 1);
+                let near_a =
+                    self.nodes[a as usize].bounds.distance2(p) <= self.nodes[b as usize].bounds.distance2(p);
+                let (far, near) = if near_a { (b, a) } else { (a, b) };
+                stack[top] = far;
+                stack[top + 1] = near;
+                top += 2;
+            }
+        }
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn boxes(n: usize) -> Vec<Aabb> {
+        let mut seed = 3u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..n)
+            .map(|_| {
+                let c = Vec3::new(rnd(), rnd(), rnd()) * 10.0;
+                let e = Vec3::new(rnd(), rnd(), rnd()) * 0.5;
+                Aabb {
+                    min: c - e,
+                    max: c + e,
+                }
+            })
+            .collect()
+    }
+
+    /// Overlap queries find exactly what a brute-force scan finds, before and after a refit.
+    #[test]
+    fn overlap_queries_match_brute_force() {
+        let mut b = boxes(1000);
+        let mut bvh = Bvh::build(&b);
+        for round in 0..2 {
+            for q in boxes(50) {
+                let mut found = Vec::new();
+                bvh.overlapping(&q, |i| found.push(i));
+                found.sort_unstable();
+                let brute: Vec<u32> = (0..b.len() as u32)
+                    .filter(|&i| b[i as usize].overlaps(&q))
+                    .collect();
+                assert_eq!(found, brute, "round {round}");
+            }
+            for x in &mut b {
+                *x = Aabb {
+                    min: x.min * 0.9,
+                    max: x.max * 0.9 + Vec3::repeat(0.1),
+                };
+            }
+            bvh.refit(&b);
+        }
+    }
+
+    /// The nearest item (here: nearest box centre) matches a scan.
+    #[test]
+    fn nearest_matches_brute_force() {
+        let b = boxes(500);
+        let bvh = Bvh::build(&b);
+        let d2 = |p: &Vec3, i: u32| (b[i as usize].centre() - p).norm_squared();
+        for q in boxes(40) {
+            let p = q.centre() + Vec3::new(0.013, 0.021, -0.017);
+            let (i, d) = bvh.nearest(&p, f64::INFINITY, |i| d2(&p, i)).unwrap();
+            let best = (0..b.len() as u32)
+                .map(|i| d2(&p, i))
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(d, best);
+            assert_eq!(d2(&p, i), best);
+            assert!(bvh.nearest(&p, best * 0.99, |i| d2(&p, i)).is_none());
+        }
+        assert!(Bvh::build(&[]).nearest(&Vec3::zeros(), 1.0, |_| 0.0).is_none());
+    }
+}

@@ -1,0 +1,558 @@
+//! Triangle-mesh colliders, static, moving and deforming: the host gives the mesh's vertices
+//! once and new positions (same topology) whenever it moves; the cloth keeps `collision_margin`
+//! from it, as from the analytic colliders.
+//!
+//! **Motion within a step call.** The mesh travels in a straight line from where it was when
+//! the call began (`start`) to where the host put it (`target`), as the pins do; a substep
+//! that ends at fraction f of the call sees the mesh at `start + f (target - start)`. Its
+//! surface velocity is the host's, or `(target - start) / dt`.
+//!
+//! **Contacts, two ways** ([`Contact`] elements):
+//! - *cloth vertex against mesh triangle*: the nearest triangle within reach; on a closed mesh
+//!   (every edge shared by two triangles) the side comes from the angle-weighted pseudo-normal
+//!   of the nearest feature (Baerentzen & Aanaes 2005), so a vertex that ends up inside is
+//!   pushed out along it, however deep (a vertex found inside no triangle's reach is matched
+//!   to the nearest triangle of the whole mesh); an open mesh is a two-sided shell.
+//! - *mesh vertex against cloth triangle*: a mesh vertex within the margin of a cloth triangle
+//!   pushes the triangle's three vertices by their barycentric weights, so a collider thinner
+//!   than the cloth's spacing (a bar, a fin, a finger tip) cannot slip between cloth vertices.
+//!
+//! **Search.** Each call the swept boxes of the mesh's triangles and vertices (start to target)
+//! are refitted into two [`Bvh`]s. Each cloth vertex (and triangle) keeps the candidates found
+//! within `margin + skin` of where it was when it last looked, and looks again once it has
+//! moved more than `skin / 2` (a Verlet list): most substeps test only a few exact distances.
+
+use super::bvh::{Aabb, Bvh};
+use super::contact::Contact;
+use super::geometry::closest_on_triangle;
+use crate::error::Error;
+use crate::Vec3;
+
+const NONE: u32 = u32::MAX;
+
+/// Most vertices (and triangles) a mesh collider may have.
+pub const MAX_MESH_COLLIDER_VERTICES: usize = 1 << 26;
+
+/// A triangle-mesh collider; see the module docs.
+#[derive(Clone, Debug)]
+pub struct MeshCollider {
+    triangles: Vec<[u32; 3]>,
+    /// The triangle across edge k (from corner k to corner k+1) of each triangle, or NONE.
+    neighbours: Vec<[u32; 3]>,
+    closed: bool,
+    start: Vec<Vec3>,
+    target: Vec<Vec3>,
+    /// The host's velocities, or empty (then from the motion over the call).
+    given_velocity: Vec<Vec3>,
+    /// Velocities over the current call.
+    velocity: Vec<Vec3>,
+    face_normal: Vec<Vec3>,
+    vertex_normal: Vec<Vec3>,
+    tri_boxes: Vec<Aabb>,
+    vert_boxes: Vec<Aabb>,
+    tri_bvh: Bvh,
+    vert_bvh: Bvh,
+    /// Whether the boxes and normals are those of `start` and `target` at `reach`.
+    fresh_at: f64,
+    /// Coulomb friction coefficient.
+    pub friction: f64,
+    cache: Candidates,
+}
+
+/// Each cloth vertex's and triangle's candidates (see the module docs).
+#[derive(Clone, Debug, Default)]
+struct Candidates {
+    vertex: Vec<Vec<u32>>,
+    vertex_at: Vec<Vec3>,
+    triangle: Vec<Vec<u32>>,
+    triangle_at: Vec<Vec3>,
+    /// Every list must be looked up again (the mesh moved, or the cloth changed).
+    stale: bool,
+}
+
+fn check_points(what: &str, p: &[Vec3]) -> Result<(), Error> {
+    match p
+        .iter()
+        .position(|v| !(v.iter().all(|c| c.is_finite()) && v.amax() < 1e15))
+    {
+        None => Ok(()),
+        Some(i) => Err(Error::invalid(format!(
+            "mesh collider: {what} {i} is not finite (or beyond 1e15 m): {:?}",
+            p[i]
+        ))),
+    }
+}
+
+impl MeshCollider {
+    /// A collider of `positions` (m) and `triangles` (indices into them), with the vertices'
+    /// velocities (m/s) or `None` (then from the motion between calls).
+    pub fn new(
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        velocities: Option<&[Vec3]>,
+    ) -> Result<MeshCollider, Error> {
+        let n = positions.len();
+        if n == 0 || triangles.is_empty() {
+            return Err(Error::invalid(
+                "mesh collider: needs at least one vertex and one triangle",
+            ));
+        }
+        if n > MAX_MESH_COLLIDER_VERTICES || triangles.len() > MAX_MESH_COLLIDER_VERTICES {
+            return Err(Error::invalid(format!(
+                "mesh collider: at most {MAX_MESH_COLLIDER_VERTICES} vertices and triangles, got {n} and {}",
+                triangles.len()
+            )));
+        }
+        if let Some(t) = triangles.iter().position(|t| t.iter().any(|&i| i as usize >= n)) {
+            return Err(Error::out_of_range(format!(
+                "mesh collider: triangle {t} has index {:?} beyond the {n} vertices",
+                triangles[t]
+            )));
+        }
+        check_points("vertex", positions)?;
+        crate::memory::ensure_available(
+            (n as u64 * 8 + triangles.len() as u64 * 16) * 24,
+            "a mesh collider",
+        )?;
+        let neighbours = neighbours(triangles);
+        let closed = neighbours.iter().all(|t| t.iter().all(|&o| o != NONE));
+        let mut mesh = MeshCollider {
+            triangles: triangles.to_vec(),
+            neighbours,
+            closed,
+            start: positions.to_vec(),
+            target: positions.to_vec(),
+            given_velocity: Vec::new(),
+            velocity: vec![Vec3::zeros(); n],
+            face_normal: Vec::new(),
+            vertex_normal: Vec::new(),
+            tri_boxes: Vec::new(),
+            vert_boxes: Vec::new(),
+            tri_bvh: Bvh::default(),
+            vert_bvh: Bvh::default(),
+            fresh_at: f64::NAN,
+            friction: 0.0,
+            cache: Candidates::default(),
+        };
+        mesh.set_velocities(velocities)?;
+        Ok(mesh)
+    }
+
+    /// New positions (the same vertices, in order) and velocities: where the mesh is at the end
+    /// of the next step call.
+    pub fn set(&mut self, positions: &[Vec3], velocities: Option<&[Vec3]>) -> Result<(), Error> {
+        if positions.len() != self.target.len() {
+            return Err(Error::invalid(format!(
+                "mesh collider: {} positions given for a mesh of {} vertices (the topology is fixed; remove it and add a new one)",
+                positions.len(),
+                self.target.len()
+            )));
+        }
+        check_points("vertex", positions)?;
+        self.set_velocities(velocities)?;
+        self.target.copy_from_slice(positions);
+        self.fresh_at = f64::NAN;
+        Ok(())
+    }
+
+    fn set_velocities(&mut self, velocities: Option<&[Vec3]>) -> Result<(), Error> {
+        match velocities {
+            Some(v) if v.len() != self.target.len() => Err(Error::invalid(format!(
+                "mesh collider: {} velocities for {} vertices",
+                v.len(),
+                self.target.len()
+            ))),
+            Some(v) => {
+                check_points("velocity", v)?;
+                self.given_velocity = v.to_vec();
+                Ok(())
+            }
+            None => {
+                self.given_velocity.clear();
+                Ok(())
+            }
+        }
+    }
+
+    /// Vertex count.
+    pub fn vertex_count(&self) -> usize {
+        self.target.len()
+    }
+
+    /// The triangles.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// Where the host last put the vertices.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.target
+    }
+
+    /// The velocities the host gave, if it gave them.
+    pub fn given_velocities(&self) -> Option<&[Vec3]> {
+        (!self.given_velocity.is_empty()).then_some(&self.given_velocity[..])
+    }
+
+    /// Whether every edge joins exactly two triangles (then inside and outside are told apart).
+    pub fn is_closed(&self) -> bool {
+        self.closed
+    }
+
+    /// A step call of `dt` seconds begins: velocities over it, boxes swept from start to target.
+    pub(crate) fn begin_call(&mut self, dt: f64, reach: f64) {
+        if self.given_velocity.is_empty() {
+            for ((v, s), t) in self.velocity.iter_mut().zip(&self.start).zip(&self.target) {
+                *v = (t - s) / dt;
+            }
+        } else {
+            self.velocity.copy_from_slice(&self.given_velocity);
+        }
+        self.refresh(reach);
+    }
+
+    /// The swept boxes and normals for the mesh's current start and target, if not yet made.
+    pub(crate) fn refresh(&mut self, reach: f64) {
+        if self.fresh_at == reach {
+            return;
+        }
+        self.face_normal = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.target[i as usize]);
+                (b - a)
+                    .cross(&(c - a))
+                    .try_normalize(0.0)
+                    .unwrap_or_else(Vec3::zeros)
+            })
+            .collect();
+        self.vertex_normal = angle_weighted_normals(&self.target, &self.triangles);
+        self.tri_boxes = self
+            .triangles
+            .iter()
+            .map(|t| {
+                Aabb::of(
+                    t.iter()
+                        .flat_map(|&i| [&self.start[i as usize], &self.target[i as usize]]),
+                )
+            })
+            .collect();
+        self.vert_boxes = self
+            .start
+            .iter()
+            .zip(&self.target)
+            .map(|(s, t)| Aabb::of([s, t]).inflated(reach))
+            .collect();
+        if self.tri_bvh.len() == self.tri_boxes.len() {
+            self.tri_bvh.refit(&self.tri_boxes);
+            self.vert_bvh.refit(&self.vert_boxes);
+        } else {
+            self.tri_bvh = Bvh::build(&self.tri_boxes);
+            self.vert_bvh = Bvh::build(&self.vert_boxes);
+        }
+        self.fresh_at = reach;
+        self.cache.stale = true;
+    }
+
+    /// The call succeeded: the mesh is where the host put it.
+    pub(crate) fn arrive(&mut self) {
+        if self.start != self.target {
+            self.start.copy_from_slice(&self.target);
+            self.fresh_at = f64::NAN;
+        }
+    }
+
+    fn at(&self, i: u32, f: f64) -> Vec3 {
+        let i = i as usize;
+        self.start[i] + f * (self.target[i] - self.start[i])
+    }
+
+    fn corners(&self, t: u32, f: f64) -> [Vec3; 3] {
+        self.triangles[t as usize].map(|i| self.at(i, f))
+    }
+
+    /// Outward pseudo-normal of the feature of triangle `t` at barycentric weights `w`.
+    fn pseudo_normal(&self, t: u32, w: [f64; 3]) -> Vec3 {
+        let tri = &self.triangles[t as usize];
+        let zero: Vec<usize> = (0..3).filter(|&k| w[k] <= 0.0).collect();
+        let face = self.face_normal[t as usize];
+        match zero.as_slice() {
+            // On the edge opposite corner z: edge (z+1, z+2), which is edge index (z+1) % 3.
+            [z] => {
+                let o = self.neighbours[t as usize][(z + 1) % 3];
+                if o == NONE {
+                    face
+                } else {
+                    (face + self.face_normal[o as usize])
+                        .try_normalize(0.0)
+                        .unwrap_or(face)
+                }
+            }
+            [a, b] => self.vertex_normal[tri[3 - a - b] as usize],
+            _ => face,
+        }
+    }
+
+    /// Signed distance and outward direction from triangle `t` (at fraction `f`) to `p`, the
+    /// closest point's weights; unsigned on an open mesh.
+    fn probe(&self, t: u32, f: f64, p: &Vec3) -> (f64, Vec3, [f64; 3]) {
+        let [a, b, c] = self.corners(t, f);
+        let w = closest_on_triangle(p, &a, &b, &c);
+        let r = p - (w[0] * a + w[1] * b + w[2] * c);
+        let d = r.norm();
+        let n = self.pseudo_normal(t, w);
+        if self.closed {
+            let inside = r.dot(&n) < 0.0;
+            let dir = if d > 1e-12 && !inside { r / d } else { n };
+            (if inside { -d } else { d }, dir, w)
+        } else {
+            let dir = if d > 1e-12 { r / d } else { n };
+            (d, dir, w)
+        }
+    }
+
+    fn surface_velocity(&self, t: u32, w: [f64; 3]) -> Vec3 {
+        let tri = &self.triangles[t as usize];
+        (0..3).fold(Vec3::zeros(), |s, k| s + w[k] * self.velocity[tri[k] as usize])
+    }
+
+    /// The contacts of the cloth (positions `x`, triangles `cloth_triangles`) with this mesh at
+    /// fraction `f` of the call, appended to `out`: penetration `margin - d`, at most
+    /// `max_depth` (a vertex deep inside is pushed out at a bounded rate).
+    #[allow(clippy::too_many_arguments)] // the cloth's arrays and the contact's three lengths
+    pub(crate) fn contacts(
+        &mut self,
+        x: &[Vec3],
+        cloth_triangles: &[[u32; 3]],
+        f: f64,
+        margin: f64,
+        skin: f64,
+        max_depth: f64,
+        out: &mut Vec<Contact>,
+    ) {
+        self.refresh_candidates(x, cloth_triangles, margin, skin);
+        let friction = self.friction;
+        // Cloth vertex against the nearest mesh triangle.
+        for (i, cands) in self.cache.vertex.iter().enumerate() {
+            let p = &x[i];
+            let mut best: Option<(f64, Vec3, u32, [f64; 3])> = None;
+            for &t in cands {
+                let (d, dir, w) = self.probe(t, f, p);
+                if best.is_none_or(|b| d.abs() < b.0.abs()) {
+                    best = Some((d, dir, t, w));
+                }
+            }
+            if let Some((d, dir, t, w)) = best {
+                if d < margin {
+                    out.push(Contact {
+                        idx: [i as u32, 0, 0, 0],
+                        coef: [1.0, 0.0, 0.0, 0.0],
+                        len: 1,
+                        dir,
+                        depth: (margin - d).min(max_depth),
+                        surface_velocity: self.surface_velocity(t, w),
+                        friction,
+                    });
+                }
+            }
+        }
+        // Mesh vertex against cloth triangle.
+        for (t, cands) in self.cache.triangle.iter().enumerate() {
+            let tri = cloth_triangles[t];
+            let [a, b, c] = tri.map(|i| x[i as usize]);
+            for &m in cands {
+                let q = self.at(m, f);
+                let w = closest_on_triangle(&q, &a, &b, &c);
+                // Only where the mesh vertex faces the triangle's inside: at an edge or a corner
+                // the neighbouring triangle or the vertex contact takes it.
+                if w.iter().any(|&wk| wk <= 0.0) {
+                    continue;
+                }
+                let r = w[0] * a + w[1] * b + w[2] * c - q;
+                let d = r.norm();
+                if d >= margin || d <= 1e-12 {
+                    continue;
+                }
+                out.push(Contact {
+                    idx: [tri[0], tri[1], tri[2], 0],
+                    coef: [w[0], w[1], w[2], 0.0],
+                    len: 3,
+                    dir: r / d,
+                    depth: (margin - d).min(max_depth),
+                    surface_velocity: self.velocity[m as usize],
+                    friction,
+                });
+            }
+        }
+    }
+
+    /// Looks up again the candidates of every cloth vertex and triangle that moved more than
+    /// `skin / 2` since it last looked (all of them after the mesh moved).
+    fn refresh_candidates(&mut self, x: &[Vec3], cloth_triangles: &[[u32; 3]], margin: f64, skin: f64) {
+        let reach = margin + skin;
+        let c = &mut self.cache;
+        let all = c.stale || c.vertex.len() != x.len() || c.triangle.len() != cloth_triangles.len();
+        if all {
+            c.vertex.resize_with(x.len(), Vec::new);
+            c.vertex_at.resize(x.len(), Vec3::zeros());
+            c.triangle.resize_with(cloth_triangles.len(), Vec::new);
+            c.triangle_at.resize(cloth_triangles.len(), Vec3::zeros());
+            c.stale = false;
+        }
+        let moved = |at: &Vec3, p: &Vec3| (p - at).norm_squared() > 0.25 * skin * skin;
+        let bounds = self.tri_bvh.bounds();
+        for i in 0..x.len() {
+            if !(all || moved(&c.vertex_at[i], &x[i])) {
+                continue;
+            }
+            let p = x[i];
+            c.vertex_at[i] = p;
+            let list = &mut c.vertex[i];
+            list.clear();
+            let q = Aabb { min: p, max: p }.inflated(reach);
+            self.tri_bvh.overlapping(&q, |t| list.push(t));
+            if list.is_empty() && self.closed && bounds.contains(&p) {
+                // Possibly deep inside: the nearest triangle of the whole mesh decides.
+                let nearest = self.tri_bvh.nearest(&p, f64::INFINITY, |t| {
+                    let [a, b, cc] = self.triangles[t as usize].map(|k| self.target[k as usize]);
+                    let w = closest_on_triangle(&p, &a, &b, &cc);
+                    (w[0] * a + w[1] * b + w[2] * cc - p).norm_squared()
+                });
+                if let Some((t, _)) = nearest {
+                    list.push(t);
+                }
+            }
+        }
+        for (t, tri) in cloth_triangles.iter().enumerate() {
+            let centre = (x[tri[0] as usize] + x[tri[1] as usize] + x[tri[2] as usize]) / 3.0;
+            if !(all || moved(&c.triangle_at[t], &centre)) {
+                continue;
+            }
+            c.triangle_at[t] = centre;
+            let list = &mut c.triangle[t];
+            list.clear();
+            // The vertices' boxes hold `reach` already; the triangle's grows by the skin it may
+            // move before it looks again.
+            let q = Aabb::of(tri.iter().map(|&i| &x[i as usize])).inflated(skin);
+            self.vert_bvh.overlapping(&q, |m| list.push(m));
+        }
+    }
+}
+
+/// The triangle across each edge (corner k to corner k+1) of each triangle, if exactly one.
+fn neighbours(triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    let mut edges: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * triangles.len());
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            edges.push((a.min(b), a.max(b), t as u32, k as u8));
+        }
+    }
+    edges.sort_unstable();
+    let mut out = vec![[NONE; 3]; triangles.len()];
+    let mut k = 0;
+    while k < edges.len() {
+        let mut e = k + 1;
+        while e < edges.len() && (edges[e].0, edges[e].1) == (edges[k].0, edges[k].1) {
+            e += 1;
+        }
+        if e - k == 2 {
+            let (p, q) = (edges[k], edges[k + 1]);
+            out[p.2 as usize][p.3 as usize] = q.2;
+            out[q.2 as usize][q.3 as usize] = p.2;
+        }
+        k = e;
+    }
+    out
+}
+
+/// Each vertex's normal, the sum of its triangles' unit normals weighted by their angles there.
+fn angle_weighted_normals(x: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut n = vec![Vec3::zeros(); x.len()];
+    for tri in triangles {
+        let p = tri.map(|i| x[i as usize]);
+        let Some(face) = (p[1] - p[0]).cross(&(p[2] - p[0])).try_normalize(0.0) else {
+            continue;
+        };
+        for k in 0..3 {
+            let (u, v) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+            let angle = u.angle(&v);
+            if angle.is_finite() {
+                n[tri[k] as usize] += angle * face;
+            }
+        }
+    }
+    for v in &mut n {
+        *v = v.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
+    }
+    n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collide::shapes::{bar, uv_sphere};
+
+    /// Inside a closed sphere mesh every point gets a negative distance and an outward push,
+    /// however deep; outside, the distance is that of the sphere within the facets' sag.
+    #[test]
+    fn closed_mesh_tells_inside_from_outside() {
+        let (x, t) = uv_sphere(Vec3::zeros(), 0.5, 24, 12);
+        let mut m = MeshCollider::new(&x, &t, None).unwrap();
+        assert!(m.is_closed());
+        m.begin_call(1.0 / 30.0, 0.03);
+        let cloth_tris: Vec<[u32; 3]> = Vec::new();
+        let probes = [
+            Vec3::new(0.0, 0.52, 0.0),
+            Vec3::new(0.3, 0.1, -0.2),
+            Vec3::new(0.0, 0.0, 0.01),
+            Vec3::new(-0.49, 0.0, 0.0),
+        ];
+        let mut out = Vec::new();
+        m.contacts(&probes, &cloth_tris, 1.0, 0.05, 0.02, 10.0, &mut out);
+        assert_eq!(out.len(), 4, "{out:?}");
+        for (c, p) in out.iter().zip(&probes) {
+            let radial = p.try_normalize(0.0).unwrap_or(Vec3::z());
+            assert!(c.dir.dot(&radial) > 0.9, "{p:?}: {:?}", c.dir);
+            let expect = 0.05 - (p.norm() - 0.5);
+            // The facets sag inward by at most r (1 - cos(pi/12)) = 0.017.
+            assert!((c.depth - expect).abs() < 0.02, "{p:?}: {} vs {expect}", c.depth);
+        }
+    }
+
+    /// A mesh vertex within the margin of a cloth triangle pushes the triangle's vertices.
+    #[test]
+    fn a_thin_bar_pushes_the_cloth_triangle_it_is_under() {
+        let (x, t) = bar(Vec3::new(0.3, 0.3, -1.0), Vec3::new(0.3, 0.3, 1.0), 0.002, 2);
+        let mut m = MeshCollider::new(&x, &t, None).unwrap();
+        m.begin_call(0.01, 0.03);
+        // One big cloth triangle 5 mm above the bar's middle.
+        let cloth = vec![
+            Vec3::new(-1.0, 0.305, -1.0),
+            Vec3::new(2.0, 0.305, -1.0),
+            Vec3::new(-1.0, 0.305, 2.0),
+        ];
+        let mut out = Vec::new();
+        m.contacts(&cloth, &[[0, 2, 1]], 1.0, 0.01, 0.01, 1.0, &mut out);
+        assert!(out.iter().any(|c| c.len == 3 && c.dir.y > 0.99), "{out:?}");
+    }
+
+    #[test]
+    fn bad_meshes_are_refused() {
+        let x = vec![Vec3::zeros(), Vec3::x(), Vec3::y()];
+        assert!(MeshCollider::new(&x, &[[0, 1, 3]], None).is_err());
+        assert!(MeshCollider::new(&x, &[], None).is_err());
+        assert!(MeshCollider::new(
+            &[Vec3::new(f64::NAN, 0.0, 0.0), Vec3::x(), Vec3::y()],
+            &[[0, 1, 2]],
+            None
+        )
+        .is_err());
+        let mut m = MeshCollider::new(&x, &[[0, 1, 2]], None).unwrap();
+        assert!(!m.is_closed());
+        assert!(m.set(&x[..2], None).is_err());
+        assert!(m.set(&x, Some(&x[..1])).is_err());
+        assert!(m.set(&x, Some(&x)).is_ok());
+    }
+}

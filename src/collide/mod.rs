@@ -1,0 +1,24 @@
+//! Collisions beyond the analytic colliders: triangle meshes (static, moving, deforming) and
+//! the cloth against itself, as [`Contact`] elements of the step (`docs/collisions.md`).
+//!
+//! | file | what |
+//! |---|---|
+//! | `geometry.rs` | closest points and crossings of points, segments and triangles |
+//! | `intersections.rs` | counting self-intersections and vertices inside a mesh (tests, reports) |
+//! | `bvh.rs` | a bounding-volume hierarchy over boxes, refitted as things move |
+//! | `contact.rs` | the contact element: force, Jacobian blocks, friction |
+//! | `mesh.rs` | triangle-mesh colliders |
+//! | `self_collision.rs` | the cloth against itself |
+//! | `shapes.rs` | closed meshes of simple solids (scenes and tests) |
+
+pub mod bvh;
+pub mod contact;
+pub mod geometry;
+pub mod intersections;
+pub mod mesh;
+pub mod self_collision;
+pub mod shapes;
+
+pub use contact::Contact;
+pub use mesh::MeshCollider;
+pub use self_collision::SelfCollision;

@@ -1,0 +1,361 @@
+//! Self-collision: the cloth keeps `thickness` from itself, as [`Contact`] elements between a
+//! vertex and a triangle, and between two edges, that are not neighbours.
+//!
+//! **Pairs** are found with two [`Bvh`]s (the cloth's triangles and edges, refitted, never
+//! rebuilt) and kept in a list while they are within `thickness + skin` of each other; the
+//! list is looked up again once some vertex has moved `skin / 2` since the last look (a Verlet
+//! list, `skin = thickness`). No pair outside the list can come within the thickness before
+//! the next look. Pairs nearer than the thickness at rest (neighbours of a fine mesh) are left
+//! out, so a flat cloth has no pairs at all.
+//!
+//! **Sides.** Each pair remembers which side of the triangle (of the two edges) it was on when
+//! it entered the list and keeps it for as long as it stays; a vertex pushed through a
+//! triangle in one step is pushed back, not on through. Together with the step limit (no
+//! vertex moves more than half the thickness in a step, `Cloth`'s check) no pair can cross
+//! unnoticed. The sides are the only state self-collision keeps (snapshots carry them).
+//!
+//! Forces: the vertex or edge point is pushed along the remembered side's normal (outside the
+//! triangle's interior, along the line between the closest points) with the model's
+//! `collision_stiffness` and `collision_damping`; friction is the contacts' velocity
+//! correction with `self_collision_friction`.
+
+use super::bvh::{Aabb, Bvh};
+use super::contact::Contact;
+use super::geometry::{closest_on_segments, closest_on_triangle};
+use crate::Vec3;
+
+/// A remembered pair: the two elements and the side, +1 or -1.
+pub type Pair = (u32, u32, i8);
+
+/// Self-collision's search and memory; see the module docs.
+#[derive(Clone, Debug, Default)]
+pub struct SelfCollision {
+    /// Every edge of the triangles once, `[i, j]` with i < j.
+    edges: Vec<[u32; 2]>,
+    tri_boxes: Vec<Aabb>,
+    edge_boxes: Vec<Aabb>,
+    tri_bvh: Bvh,
+    edge_bvh: Bvh,
+    /// Positions at the last look; empty before the first.
+    looked_at: Vec<Vec3>,
+    /// Vertex-triangle and edge-edge pairs, sorted, with their sides.
+    pub(crate) vertex_triangle: Vec<Pair>,
+    pub(crate) edge_edge: Vec<Pair>,
+    /// How many times the list was looked up again (for benchmarks).
+    pub looks: u64,
+}
+
+/// The unique edges of some triangles, `[i, j]` with i < j, sorted.
+pub fn edges_of(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut e: Vec<[u32; 2]> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| [t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])]))
+        .collect();
+    e.sort_unstable();
+    e.dedup();
+    e
+}
+
+/// Distance between vertex `p` and triangle `t` of positions `x`, with the weights and the
+/// vector from the triangle's closest point to `p`.
+fn vertex_triangle(x: &[Vec3], p: u32, t: &[u32; 3]) -> (f64, [f64; 3], Vec3) {
+    let [a, b, c] = t.map(|i| x[i as usize]);
+    let q = x[p as usize];
+    let w = closest_on_triangle(&q, &a, &b, &c);
+    let r = q - (w[0] * a + w[1] * b + w[2] * c);
+    (r.norm(), w, r)
+}
+
+/// Distance between edges `e` and `f` of positions `x`, the parameters, the vector from the
+/// second's closest point to the first's and the (unnormalised) normal `e x f`.
+fn edge_edge(x: &[Vec3], e: &[u32; 2], f: &[u32; 2]) -> (f64, f64, f64, Vec3, Vec3) {
+    let (p0, p1, q0, q1) = (
+        x[e[0] as usize],
+        x[e[1] as usize],
+        x[f[0] as usize],
+        x[f[1] as usize],
+    );
+    let (s, t) = closest_on_segments(&p0, &p1, &q0, &q1);
+    let r = (p0 + s * (p1 - p0)) - (q0 + t * (q1 - q0));
+    (r.norm(), s, t, r, (p1 - p0).cross(&(q1 - q0)))
+}
+
+fn side(v: f64) -> i8 {
+    if v < 0.0 {
+        -1
+    } else {
+        1
+    }
+}
+
+impl SelfCollision {
+    /// Sets up the search for a cloth of these triangles.
+    pub fn new(triangles: &[[u32; 3]]) -> SelfCollision {
+        SelfCollision {
+            edges: edges_of(triangles),
+            ..SelfCollision::default()
+        }
+    }
+
+    /// The contacts of the cloth (positions `x`, velocities unused here, rest positions `rest`)
+    /// with itself at thickness `thickness`, appended to `out`.
+    pub(crate) fn contacts(
+        &mut self,
+        x: &[Vec3],
+        rest: &[Vec3],
+        triangles: &[[u32; 3]],
+        thickness: f64,
+        friction: f64,
+        out: &mut Vec<Contact>,
+    ) {
+        let skin = thickness;
+        let moved = self.looked_at.len() != x.len()
+            || x.iter()
+                .zip(&self.looked_at)
+                .any(|(p, q)| (p - q).norm_squared() > 0.25 * skin * skin);
+        if moved {
+            self.look(x, rest, triangles, thickness + skin, thickness);
+        }
+        let cap = 2.0 * thickness;
+        for &(p, t, s) in &self.vertex_triangle {
+            let tri = &triangles[t as usize];
+            let (d, w, r) = vertex_triangle(x, p, tri);
+            if d >= thickness {
+                continue;
+            }
+            let [a, b, c] = tri.map(|i| x[i as usize]);
+            let interior = w.iter().all(|&wk| wk > 0.0);
+            let Some(normal) = (b - a).cross(&(c - a)).try_normalize(0.0) else {
+                continue;
+            };
+            let side_n = f64::from(s) * normal;
+            let (dist, dir) = if interior && r.dot(&side_n) <= 0.0 {
+                (-d, side_n)
+            } else if interior {
+                (r.dot(&side_n), side_n)
+            } else if d > 1e-12 {
+                (d, r / d)
+            } else {
+                continue;
+            };
+            if dist >= thickness {
+                continue;
+            }
+            out.push(Contact {
+                idx: [p, tri[0], tri[1], tri[2]],
+                coef: [1.0, -w[0], -w[1], -w[2]],
+                len: 4,
+                dir,
+                depth: (thickness - dist).min(cap),
+                surface_velocity: Vec3::zeros(),
+                friction,
+            });
+        }
+        for &(e, f, s) in &self.edge_edge {
+            let (ee, ff) = (&self.edges[e as usize], &self.edges[f as usize]);
+            let (d, a, b, r, n) = edge_edge(x, ee, ff);
+            if d >= thickness || !(a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0) {
+                continue;
+            }
+            let Some(n) = n.try_normalize(1e-12) else {
+                continue;
+            };
+            let side_n = f64::from(s) * n;
+            let along = r.dot(&side_n);
+            let (dist, dir) = if along <= 0.0 { (-d, side_n) } else { (d, r / d) };
+            if dist >= thickness {
+                continue;
+            }
+            out.push(Contact {
+                idx: [ee[0], ee[1], ff[0], ff[1]],
+                coef: [1.0 - a, a, -(1.0 - b), -b],
+                len: 4,
+                dir,
+                depth: (thickness - dist).min(cap),
+                surface_velocity: Vec3::zeros(),
+                friction,
+            });
+        }
+    }
+
+    /// Looks the pairs up again at positions `x`: every pair within `reach`, not neighbours
+    /// (sharing a vertex, or nearer than `thickness` at rest), with its side from the old list
+    /// or, when new, from where it is now.
+    fn look(&mut self, x: &[Vec3], rest: &[Vec3], triangles: &[[u32; 3]], reach: f64, thickness: f64) {
+        self.looks += 1;
+        self.looked_at.clear();
+        self.looked_at.extend_from_slice(x);
+        self.tri_boxes.clear();
+        self.tri_boxes.extend(
+            triangles
+                .iter()
+                .map(|t| Aabb::of(t.iter().map(|&i| &x[i as usize])).inflated(reach)),
+        );
+        self.edge_boxes.clear();
+        self.edge_boxes.extend(
+            self.edges
+                .iter()
+                .map(|e| Aabb::of(e.iter().map(|&i| &x[i as usize])).inflated(0.5 * reach)),
+        );
+        if self.tri_bvh.len() == triangles.len() && self.edge_bvh.len() == self.edges.len() {
+            self.tri_bvh.refit(&self.tri_boxes);
+            self.edge_bvh.refit(&self.edge_boxes);
+        } else {
+            self.tri_bvh = Bvh::build(&self.tri_boxes);
+            self.edge_bvh = Bvh::build(&self.edge_boxes);
+        }
+        let old_vt = std::mem::take(&mut self.vertex_triangle);
+        let old_ee = std::mem::take(&mut self.edge_edge);
+        let remembered = |old: &[Pair], a: u32, b: u32| {
+            old.binary_search_by(|q| (q.0, q.1).cmp(&(a, b)))
+                .ok()
+                .map(|k| old[k].2)
+        };
+        let mut vt = Vec::new();
+        for p in 0..x.len() as u32 {
+            let q = Aabb {
+                min: x[p as usize],
+                max: x[p as usize],
+            };
+            self.tri_bvh.overlapping(&q, |t| {
+                let tri = &triangles[t as usize];
+                if tri.contains(&p) {
+                    return;
+                }
+                let (d, w, r) = vertex_triangle(x, p, tri);
+                if d >= reach || vertex_triangle(rest, p, tri).0 < thickness {
+                    return;
+                }
+                let s = remembered(&old_vt, p, t).unwrap_or_else(|| {
+                    let [a, b, c] = tri.map(|i| x[i as usize]);
+                    let _ = w;
+                    side(r.dot(&(b - a).cross(&(c - a))))
+                });
+                vt.push((p, t, s));
+            });
+        }
+        vt.sort_unstable();
+        let mut ee = Vec::new();
+        for (e, edge) in self.edges.iter().enumerate() {
+            let e = e as u32;
+            self.edge_bvh.overlapping(&self.edge_boxes[e as usize], |f| {
+                if f <= e {
+                    return;
+                }
+                let other = &self.edges[f as usize];
+                if edge.iter().any(|v| other.contains(v)) {
+                    return;
+                }
+                let (d, _, _, r, n) = edge_edge(x, edge, other);
+                if d >= reach || edge_edge(rest, edge, other).0 < thickness {
+                    return;
+                }
+                let s = remembered(&old_ee, e, f).unwrap_or_else(|| side(r.dot(&n)));
+                ee.push((e, f, s));
+            });
+        }
+        ee.sort_unstable();
+        self.vertex_triangle = vt;
+        self.edge_edge = ee;
+    }
+
+    /// Forgets the positions of the last look (the next step looks again; sides are kept).
+    #[cfg(test)]
+    pub(crate) fn look_again(&mut self) {
+        self.looked_at.clear();
+    }
+
+    /// The remembered pairs (vertex-triangle, edge-edge).
+    pub fn pairs(&self) -> (&[Pair], &[Pair]) {
+        (&self.vertex_triangle, &self.edge_edge)
+    }
+
+    /// Replaces the remembered pairs (a snapshot's).
+    pub(crate) fn set_pairs(&mut self, vertex_triangle: Vec<Pair>, edge_edge: Vec<Pair>) {
+        self.vertex_triangle = vertex_triangle;
+        self.edge_edge = edge_edge;
+        self.looked_at.clear();
+    }
+
+    /// Edge count (for checking a snapshot's pairs).
+    pub fn edge_count(&self) -> usize {
+        self.edges.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two parallel squares 3 mm apart: pairs are found across them, none within one square,
+    /// and each vertex is pushed away from the other square.
+    #[test]
+    fn two_sheets_find_each_other_and_only_each_other() {
+        let sq = |y: f64, o: u32| {
+            let x = vec![
+                Vec3::new(0.0, y, 0.0),
+                Vec3::new(0.1, y, 0.0),
+                Vec3::new(0.0, y, 0.1),
+                Vec3::new(0.1, y, 0.1),
+            ];
+            (x, vec![[o, o + 2, o + 1], [o + 1, o + 2, o + 3]])
+        };
+        let (mut x, mut t) = sq(0.0, 0);
+        let (x2, t2) = sq(0.003, 4);
+        x.extend(x2);
+        t.extend(t2);
+        // At rest the sheets are far apart (so the pairs are not neighbours).
+        let rest: Vec<Vec3> = x
+            .iter()
+            .enumerate()
+            .map(|(i, p)| if i >= 4 { p + Vec3::new(0.0, 1.0, 0.0) } else { *p })
+            .collect();
+        let mut sc = SelfCollision::new(&t);
+        let mut out = Vec::new();
+        sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out);
+        assert!(!out.is_empty());
+        for c in &out {
+            let first_top = c.idx[0] >= 4;
+            assert!(c.idx[1..].iter().all(|&i| (i >= 4) != first_top) || c.coef[1] >= 0.0);
+            // The first element is pushed away from the other sheet.
+            let away = if x[c.idx[0] as usize].y > 0.001 { 1.0 } else { -1.0 };
+            assert!(c.dir.y * away > 0.99, "{c:?}");
+            assert!((c.depth - 0.002).abs() < 1e-12);
+        }
+        // Apart, nothing.
+        let far: Vec<Vec3> = rest.clone();
+        sc.look_again();
+        out.clear();
+        sc.contacts(&far, &rest, &t, 0.005, 0.0, &mut out);
+        assert!(out.is_empty());
+    }
+
+    /// A vertex pushed through a triangle keeps the side it came from.
+    #[test]
+    fn a_crossed_vertex_is_pushed_back() {
+        let t = vec![[0, 1, 2], [3, 4, 5]];
+        let mut x = vec![
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(-1.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.004, 0.0),
+            Vec3::new(0.0, 0.5, 0.1),
+            Vec3::new(0.1, 0.5, 0.0),
+        ];
+        let rest: Vec<Vec3> = x
+            .iter()
+            .map(|p| p + Vec3::new(0.0, 0.0, 5.0 * (p.y > 0.001) as u8 as f64))
+            .collect();
+        let mut sc = SelfCollision::new(&t);
+        let mut out = Vec::new();
+        sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out);
+        let up = out.iter().find(|c| c.idx[0] == 3).unwrap();
+        assert!(up.dir.y > 0.99);
+        // Through the triangle by 1 mm (less than the skin: no new look).
+        x[3].y = -0.001;
+        out.clear();
+        sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out);
+        let up = out.iter().find(|c| c.idx[0] == 3).unwrap();
+        assert!(up.dir.y > 0.99 && (up.depth - 0.006).abs() < 1e-12, "{up:?}");
+    }
+}

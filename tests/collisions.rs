@@ -1,0 +1,271 @@
+//! Collisions an artist needs (docs/collisions.md): the cloth folding onto itself with no
+//! triangle pair crossing at any frame (counted exactly), a towel over a turning torus mesh
+//! with no vertex inside it (winding number), a bar thinner than the spacing catching the
+//! cloth, a cloth resting on a mesh in a current keeping its contact, and the brisk swing
+//! with self-collision on.
+
+use fraccloth::collide::intersections::{self_intersections, vertices_inside};
+use fraccloth::collide::shapes::{bar, torus};
+use fraccloth::forces::{Collider, Plane};
+use fraccloth::{Cloth, ClothConfig, Integrator, Model, Scheme, Vec3};
+
+const FPS: f64 = 30.0;
+
+/// An underwater towel of `w x h` vertices `spacing` apart, lying flat at height `y` (or hanging
+/// from `y` when `hanging`), with the library's automatic step and the given self-collision
+/// thickness.
+fn towel(
+    w: u32,
+    h: u32,
+    spacing: f64,
+    y: f64,
+    hanging: bool,
+    thickness: f64,
+    integrator: Integrator,
+) -> Cloth {
+    // A wet towel: 1 kg/m^2, as the C preset.
+    let area = spacing * spacing * f64::from((w - 1) * (h - 1));
+    let grid = fraccloth::topology::GridSpec {
+        width: w,
+        height: h,
+        spacing,
+        total_mass: area,
+    }
+    .build()
+    .unwrap();
+    let model = Model {
+        self_collision_thickness: thickness,
+        self_collision_friction: 0.3,
+        ..Model::underwater()
+    };
+    let config = ClothConfig {
+        model,
+        scheme: Scheme::DEFAULT,
+        integrator,
+        max_substep: fraccloth::cloth::AUTO,
+        ..ClothConfig::default()
+    };
+    let mut cloth = Cloth::new(grid, config).unwrap();
+    let rest = cloth.topology().rest_positions.clone();
+    let (cx, cy) = (
+        0.5 * spacing * f64::from(w - 1),
+        -0.5 * spacing * f64::from(h - 1),
+    );
+    let placed: Vec<Vec3> = rest
+        .iter()
+        .map(|p| {
+            if hanging {
+                Vec3::new(p.x - cx, y + p.y, p.z)
+            } else {
+                // Flat in the x-z plane, centred over the origin.
+                Vec3::new(p.x - cx, y, p.y - cy)
+            }
+        })
+        .collect();
+    cloth.set_positions(&placed).unwrap();
+    cloth
+}
+
+/// The most self-intersections over `frames` frames, stepping with `each` before each frame.
+fn worst_intersections(cloth: &mut Cloth, frames: usize, mut each: impl FnMut(&mut Cloth, usize)) -> usize {
+    let tris = cloth.topology().triangles.clone();
+    let mut worst = 0;
+    for f in 0..frames {
+        each(cloth, f);
+        cloth.step(1.0 / FPS).unwrap();
+        worst = worst.max(self_intersections(cloth.positions(), &tris));
+    }
+    worst
+}
+
+/// A towel dropped edge-first onto the floor piles up in folds: with self-collision no
+/// triangle pair crosses at any frame; without it, they do (the test can fail).
+#[test]
+fn a_towel_dropped_on_the_floor_folds_without_crossing_itself() {
+    let run = |thickness: f64| {
+        let mut cloth = towel(21, 31, 0.02, 0.62, true, thickness, Integrator::SymplecticEuler);
+        // Tilted a little so it folds over rather than straight down.
+        let tilted: Vec<Vec3> = cloth
+            .positions()
+            .iter()
+            .map(|p| Vec3::new(p.x, p.y, p.z + 0.02 * (20.0 * (0.62 - p.y)).sin()))
+            .collect();
+        cloth.set_positions(&tilted).unwrap();
+        cloth
+            .add_collider(Collider::Plane(Plane {
+                point: Vec3::zeros(),
+                normal: Vec3::y(),
+                velocity: Vec3::zeros(),
+            }))
+            .unwrap();
+        let worst = worst_intersections(&mut cloth, 150, |_, _| {});
+        let top = cloth
+            .positions()
+            .iter()
+            .map(|p| p.y)
+            .fold(f64::NEG_INFINITY, f64::max);
+        (
+            worst,
+            top,
+            cloth.self_collision_pairs().0.len() + cloth.self_collision_pairs().1.len(),
+        )
+    };
+    let (with, top, pairs) = run(0.005);
+    let (without, _, _) = run(0.0);
+    println!("self-intersections: {with} with self-collision ({pairs} pairs, pile top {top:.3} m), {without} without");
+    assert!(top < 0.3, "the towel has landed: top at {top} m");
+    assert!(pairs > 0, "it folded onto itself");
+    assert_eq!(with, 0);
+    assert!(without > 0, "without self-collision the pile crosses itself");
+}
+
+/// A towel dropped over a torus mesh turning about its axis: no cloth vertex is inside the
+/// torus at any frame, and the towel rests on it (does not fall through).
+#[test]
+fn a_towel_on_a_turning_torus_stays_outside_it() {
+    let (tx, tt) = torus(Vec3::zeros(), 0.12, 0.05, 48, 16);
+    let mut cloth = towel(25, 25, 0.016, 0.08, false, 0.0, Integrator::SymplecticEuler);
+    let id = cloth.add_mesh_collider(&tx, &tt, None).unwrap();
+    cloth.set_collider_friction(id, 0.5).unwrap();
+    let mut worst = 0;
+    let mut posed = tx.clone();
+    for f in 1..=90 {
+        // Turning about y at 0.5 rad/s, tilted: a non-convex moving mesh.
+        let a = 0.5 * f as f64 / FPS;
+        let rot = nalgebra::Rotation3::from_axis_angle(&Vec3::y_axis(), a)
+            * nalgebra::Rotation3::from_axis_angle(&Vec3::x_axis(), 0.2 * a.sin());
+        posed = tx.iter().map(|p| rot * p).collect();
+        cloth.set_mesh_collider(id, &posed, None).unwrap();
+        cloth.step(1.0 / FPS).unwrap();
+        worst = worst.max(vertices_inside(cloth.positions(), &posed, &tt));
+    }
+    let lowest = cloth
+        .positions()
+        .iter()
+        .map(|p| p.y)
+        .fold(f64::INFINITY, f64::min);
+    let centre = cloth.positions()[12 * 25 + 12];
+    println!("inside: {worst}; lowest vertex {lowest:.3} m; centre {centre:?}");
+    assert_eq!(worst, 0, "no cloth vertex inside the torus");
+    assert!(vertices_inside(cloth.positions(), &posed, &tt) == 0);
+    // Resting on the ring: the ring's top is at 0.05 m.
+    let on_ring = cloth
+        .positions()
+        .iter()
+        .filter(|p| ((p.x * p.x + p.z * p.z).sqrt() - 0.12).abs() < 0.03)
+        .map(|p| p.y)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        on_ring > 0.04,
+        "the towel lies on the ring, not through it: {on_ring}"
+    );
+}
+
+/// A hanging towel, a bar of 4 mm across (the towel's spacing is 2 cm) sweeping through it
+/// sideways: the bar catches the towel and carries it, no vertex slips past.
+#[test]
+fn a_bar_thinner_than_the_spacing_catches_the_towel() {
+    let mut cloth = towel(21, 21, 0.02, 0.0, true, 0.0, Integrator::SymplecticEuler);
+    let top: Vec<u32> = (0..21).collect();
+    cloth.set_pinned(&top).unwrap();
+    // A horizontal bar along x through the towel's lower half, 10 cm in front of it (z).
+    let (bx, bt) = bar(Vec3::new(-0.4, -0.3, 0.0), Vec3::new(0.4, -0.3, 0.0), 0.002, 1);
+    let at = |z: f64| -> Vec<Vec3> { bx.iter().map(|p| p + Vec3::new(0.0, 0.0, z)).collect() };
+    let id = cloth.add_mesh_collider(&at(0.1), &bt, None).unwrap();
+    let mut z = 0.1;
+    for _ in 0..60 {
+        // 0.1 m/s towards and through the towel's plane (z decreasing).
+        z -= 0.1 / FPS;
+        cloth.set_mesh_collider(id, &at(z), None).unwrap();
+        cloth.step(1.0 / FPS).unwrap();
+    }
+    // The bar ended 10 cm behind the towel's rest plane: the towel's lower rows went with it.
+    let bottom = &cloth.positions()[20 * 21..];
+    let behind = bottom.iter().filter(|p| p.z < z + 0.001).count();
+    let mean_z = bottom.iter().map(|p| p.z).sum::<f64>() / bottom.len() as f64;
+    println!("bar at z = {z:.3}; bottom row mean z {mean_z:.3}; {behind} bottom vertices behind the bar");
+    assert_eq!(behind, 0, "no vertex of the bottom row slipped past the bar");
+    assert!(
+        mean_z < z + 0.03,
+        "the towel was carried by the bar: {mean_z} vs bar {z}"
+    );
+}
+
+/// The drop again with implicit Euler at the automatic step: the contacts' Jacobian blocks
+/// are in its system, and the pile does not cross itself either.
+#[test]
+fn the_drop_with_implicit_euler_does_not_cross_itself() {
+    let mut cloth = towel(21, 31, 0.02, 0.62, true, 0.005, Integrator::ImplicitEuler);
+    let wavy: Vec<Vec3> = cloth
+        .positions()
+        .iter()
+        .map(|p| Vec3::new(p.x, p.y, p.z + 0.02 * (20.0 * (0.62 - p.y)).sin()))
+        .collect();
+    cloth.set_positions(&wavy).unwrap();
+    cloth
+        .add_collider(Collider::Plane(Plane {
+            point: Vec3::zeros(),
+            normal: Vec3::y(),
+            velocity: Vec3::zeros(),
+        }))
+        .unwrap();
+    let worst = worst_intersections(&mut cloth, 150, |_, _| {});
+    let top = cloth
+        .positions()
+        .iter()
+        .map(|p| p.y)
+        .fold(f64::NEG_INFINITY, f64::max);
+    println!("implicit: {worst} self-intersections, pile top {top:.3} m");
+    assert!(top < 0.3);
+    assert_eq!(worst, 0);
+}
+
+/// A towel lying on a floor mesh in a current along the floor: with friction it keeps its
+/// place and its contact (no vertex lifts off the floor by more than the margin); without
+/// friction the same current slides it away. The water's inertia does not launch it.
+#[test]
+fn a_towel_on_a_mesh_floor_in_a_current_keeps_its_contact() {
+    let floor =
+        fraccloth::collide::shapes::bar(Vec3::new(-1.0, -0.05, 0.0), Vec3::new(1.0, -0.05, 0.0), 0.05, 8);
+    // The bar's top face is the floor, at y = 0 (half-width 0.05 about y = -0.05), 10 cm deep
+    // in z: widen it to 2 m by scaling z.
+    let fx: Vec<Vec3> = floor.0.iter().map(|p| Vec3::new(p.x, p.y, p.z * 20.0)).collect();
+    let run = |friction: f64| {
+        let mut cloth = towel(21, 21, 0.02, 0.01, false, 0.0, Integrator::SymplecticEuler);
+        let id = cloth.add_mesh_collider(&fx, &floor.1, None).unwrap();
+        cloth.set_collider_friction(id, friction).unwrap();
+        for _ in 0..30 {
+            cloth.step(1.0 / FPS).unwrap();
+        }
+        cloth.set_current(Vec3::new(0.1, 0.0, 0.0)).unwrap();
+        let start: Vec3 = cloth.positions().iter().sum::<Vec3>() / cloth.vertex_count() as f64;
+        let mut highest: f64 = 0.0;
+        for _ in 0..90 {
+            cloth.step(1.0 / FPS).unwrap();
+            highest = highest.max(
+                cloth
+                    .positions()
+                    .iter()
+                    .map(|p| p.y)
+                    .fold(f64::NEG_INFINITY, f64::max),
+            );
+        }
+        let end: Vec3 = cloth.positions().iter().sum::<Vec3>() / cloth.vertex_count() as f64;
+        ((end - start).x, highest)
+    };
+    let (held, high) = run(0.8);
+    let (slid, _) = run(0.0);
+    println!("in a 0.1 m/s current for 3 s: moved {held:.4} m with friction 0.8 (highest vertex {high:.4} m), {slid:.4} m without");
+    assert!(
+        high < 0.0105,
+        "no vertex lifted off the floor by more than the margin: {high}"
+    );
+    assert!(
+        held.abs() < 0.2 * slid.abs(),
+        "friction holds it: {held} vs {slid}"
+    );
+    assert!(
+        slid > 0.05,
+        "the current moves a towel on a frictionless floor: {slid}"
+    );
+}
