@@ -55,6 +55,21 @@ int main(int argc, char** argv) try {
     require(std::fabs(cloth.sphere(sphere).radius - 0.04f) < 1e-6f, "sphere");
     require(cloth.plane(plane).point[1] == -1.1f, "plane");
     require(cloth.capsule(capsule).b[2] == 0.12f, "capsule");
+    // A mesh collider from the host's own buffers (one triangle under the cloth), moved once.
+    std::vector<float> tri = {-1.0f, -0.8f, -1.0f, 1.0f, -0.8f, -1.0f, 0.0f, -0.8f, 1.0f};
+    const std::vector<uint32_t> tri_indices = {0, 2, 1};
+    const uint32_t mesh = cloth.add_mesh_collider(tri, tri_indices);
+    tri[1] = tri[4] = tri[7] = -0.81f;
+    cloth.set_mesh_collider(mesh, tri);
+    cloth.set_collider_friction(mesh, 0.2f);
+    require(cloth.mesh_collider_size(mesh)[1] == 1, "mesh collider size");
+    bool thrown = false;
+    try {
+        cloth.set_mesh_collider(mesh, std::vector<float>(tri.begin(), tri.begin() + 6));
+    } catch (const fraccloth::Error& e) {
+        thrown = e.status() == FC_ERROR_INVALID_ARGUMENT;
+    }
+    require(thrown, "a mesh collider keeps its vertex count");
 
     cloth.step(1e-3);
     cloth.step_substeps(2e-3, 4);

@@ -163,3 +163,34 @@ fn cloths_on_host_threads_match_one_thread() {
     let out = run(&common::compile_c_with("threads.c", &["-pthread"], &dir), &[]);
     assert_eq!(field(&out, "identical"), ["4", "of", "4"], "{out}");
 }
+
+/// The mesh collider example: a box mesh from the host's own buffers, moved every frame; the
+/// towel ends on it, none of its vertices inside, bad input refused with the right statuses.
+#[test]
+fn mesh_collider_example_keeps_the_towel_outside_the_box() {
+    let dir = scratch_dir("mesh_collider");
+    let out = run(&compile_c("mesh_collider.c", &dir), &[]);
+    assert_eq!(
+        field(&out, "collider"),
+        vec!["0", "vertices", "8", "triangles", "12"]
+    );
+    assert_eq!(field(&out, "inside"), vec!["0"]);
+    let h: Vec<f32> = field(&out, "heights")
+        .iter()
+        .map(|s| s.parse().unwrap())
+        .collect();
+    // The box's top ends at 0.1 m: the towel lies on it (within the margin) and hangs over its sides.
+    assert!(h[1] > 0.1 && h[1] < 0.13, "towel top {}", h[1]);
+    assert!(h[0] < 0.05, "towel sides hang below the top: {}", h[0]);
+    let status = |k: &str| field(&out, k)[0].parse::<i32>().unwrap();
+    assert_eq!(status("bad_index"), FcStatus::FC_ERROR_OUT_OF_RANGE as i32);
+    assert_eq!(status("bad_count"), FcStatus::FC_ERROR_INVALID_ARGUMENT as i32);
+    assert_eq!(status("null_xyz"), FcStatus::FC_ERROR_NULL_ARGUMENT as i32);
+    assert_eq!(
+        status("wrong_vertex_count"),
+        FcStatus::FC_ERROR_INVALID_ARGUMENT as i32
+    );
+    assert_eq!(status("no_such_id"), FcStatus::FC_ERROR_OUT_OF_RANGE as i32);
+    assert_eq!(status("removed"), FcStatus::FC_OK as i32);
+    assert_eq!(status("after_remove"), FcStatus::FC_ERROR_OUT_OF_RANGE as i32);
+}

@@ -269,3 +269,58 @@ fn a_towel_on_a_mesh_floor_in_a_current_keeps_its_contact() {
         "the current moves a towel on a frictionless floor: {slid}"
     );
 }
+
+/// A snapshot carries the mesh colliders and self-collision's remembered sides: a bake
+/// resumed from one into a new cloth continues bitwise identically.
+#[test]
+fn a_snapshot_resumes_a_bake_with_collisions_bitwise() {
+    // The drop of the first test onto a floor that is a mesh sliding slowly along x.
+    let floor = bar(Vec3::new(-1.0, -0.05, 0.0), Vec3::new(1.0, -0.05, 0.0), 0.05, 8);
+    let (tx, tt) = (
+        floor
+            .0
+            .iter()
+            .map(|p| Vec3::new(p.x, p.y, p.z * 20.0))
+            .collect::<Vec<_>>(),
+        floor.1,
+    );
+    let make = || {
+        let mut c = towel(21, 31, 0.02, 0.62, true, 0.005, Integrator::SymplecticEuler);
+        let wavy: Vec<Vec3> = c
+            .positions()
+            .iter()
+            .map(|p| Vec3::new(p.x, p.y, p.z + 0.02 * (20.0 * (0.62 - p.y)).sin()))
+            .collect();
+        c.set_positions(&wavy).unwrap();
+        c
+    };
+    let pose = |f: usize| -> Vec<Vec3> {
+        tx.iter()
+            .map(|p| p + Vec3::new(0.001 * f as f64, 0.0, 0.0))
+            .collect()
+    };
+    let mut a = make();
+    let id = a.add_mesh_collider(&pose(0), &tt, None).unwrap();
+    a.set_collider_friction(id, 0.4).unwrap();
+    for f in 1..=150 {
+        a.set_mesh_collider(id, &pose(f), None).unwrap();
+        a.step(1.0 / FPS).unwrap();
+    }
+    let pairs = a.self_collision_pairs().0.len();
+    let snap = a.save_snapshot().unwrap();
+    let mut b = make();
+    b.load_snapshot(&snap).unwrap();
+    assert_eq!(b.collider_friction(id), Some(0.4));
+    let mut touching = 0;
+    for f in 151..=170 {
+        a.set_mesh_collider(id, &pose(f), None).unwrap();
+        b.set_mesh_collider(id, &pose(f), None).unwrap();
+        a.step(1.0 / FPS).unwrap();
+        b.step(1.0 / FPS).unwrap();
+        touching += a.contacts().iter().filter(|c| c.len < 4).count();
+    }
+    println!("{pairs} self-collision pairs at the snapshot, {touching} mesh contacts after it");
+    assert!(pairs > 0 && touching > 0, "the scene has collisions to carry");
+    assert_eq!(a.positions(), b.positions());
+    assert_eq!(a.velocities(), b.velocities());
+}

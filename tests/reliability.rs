@@ -97,7 +97,9 @@ fn snapshots_with_a_valid_checksum_but_impossible_contents_are_refused() {
         refused(&mut c, &bytes, l.velocity0, f64::NAN, "velocity");
         refused(&mut c, &bytes, l.velocity0, 1e6, "max_speed");
         refused(&mut c, &bytes, l.velocity0 - 24 * N - 8 + 8, 1e300, "float range");
-        let tail = bytes.len() - 4;
+        // The end of the history state: before the collision state (three empty counts) and
+        // the checksum.
+        let tail = bytes.len() - 4 - 24;
         match scheme {
             Scheme::SumOfExponentials { .. } => {
                 // The first mode of the first particle, then the step sizes at the end.

@@ -285,6 +285,31 @@ public:
     void set_capsule(uint32_t id, const Vec3f& a, const Vec3f& b, float radius, const Vec3f& velocity = {}) {
         check(fc_cloth_set_capsule(handle_, id, a.data(), b.data(), radius, velocity.data()));
     }
+    /// A triangle-mesh collider from the host's buffers: `xyz` 3 floats a vertex (m), `indices`
+    /// 3 a triangle (counter-clockwise seen from outside on a closed mesh), `velocities` empty
+    /// (from the motion between steps) or 3 floats a vertex (m/s). Returns its id.
+    uint32_t add_mesh_collider(span<const float> xyz, span<const uint32_t> indices,
+                               span<const float> velocities = {}) {
+        if (xyz.size() % 3 != 0 || (velocities.size() && velocities.size() != xyz.size()))
+            throw Error(FC_ERROR_INVALID_ARGUMENT, "add_mesh_collider needs 3 floats a vertex (and as many velocities)");
+        uint32_t id = 0;
+        check(fc_cloth_add_mesh_collider(handle_, xyz.data(), xyz.size() / 3, indices.data(), indices.size(),
+                                         velocities.size() ? velocities.data() : nullptr, &id));
+        return id;
+    }
+    /// New positions of mesh collider `id`'s vertices (once a frame for a skinned mesh).
+    void set_mesh_collider(uint32_t id, span<const float> xyz, span<const float> velocities = {}) {
+        if (xyz.size() % 3 != 0 || (velocities.size() && velocities.size() != xyz.size()))
+            throw Error(FC_ERROR_INVALID_ARGUMENT, "set_mesh_collider needs 3 floats a vertex (and as many velocities)");
+        check(fc_cloth_set_mesh_collider(handle_, id, xyz.data(), xyz.size() / 3,
+                                         velocities.size() ? velocities.data() : nullptr));
+    }
+    /// (vertex count, triangle count) of mesh collider `id`.
+    std::array<std::size_t, 2> mesh_collider_size(uint32_t id) const {
+        std::array<std::size_t, 2> n{};
+        check(fc_cloth_get_mesh_collider(handle_, id, &n[0], &n[1]));
+        return n;
+    }
     void set_collider_friction(uint32_t id, float friction) {
         check(fc_cloth_set_collider_friction(handle_, id, friction));
     }

@@ -3,6 +3,7 @@
 //! Jacobian blocks the implicit system, their friction the friction pass).
 
 use super::Cloth;
+use crate::bytes::{ByteReader, ByteWriter};
 use crate::collide::self_collision::Pair;
 use crate::collide::{contact, Contact, MeshCollider};
 use crate::error::Error;
@@ -14,9 +15,8 @@ const MESH_SKIN_MARGINS: f64 = 2.0;
 /// Deepest penetration a mesh contact pushes with, in margins: a vertex found deep inside a
 /// closed mesh is pushed out at a bounded rate instead of being launched.
 const MESH_MAX_DEPTH_MARGINS: f64 = 3.0;
-/// Self-collision's step limit: no free vertex may move more than this fraction of the
-/// thickness in one step (else the step is refused as unstable and the automatic step takes
-/// more substeps).
+/// Self-collision's step limit: no free vertex moves more than this fraction of the thickness
+/// in one step (a faster one is slowed to it; `Cloth::limit_collision_step`).
 pub const SELF_COLLISION_STEP_LIMIT: f64 = 0.5;
 
 impl Cloth {
@@ -155,22 +155,147 @@ impl Cloth {
         )
     }
 
-    /// Self-collision's step limit ([`SELF_COLLISION_STEP_LIMIT`]).
-    pub(super) fn check_collision_step(&self, h: f64) -> Result<(), Error> {
+    /// Self-collision's step limit ([`SELF_COLLISION_STEP_LIMIT`]): a free vertex that would
+    /// move farther in this step is moved only that far, its velocity scaled alike (a cloth
+    /// pinched between two colliders, or flung faster than its thickness a step, cannot pass
+    /// through itself). Returns how many vertices were limited.
+    pub(super) fn limit_collision_step(&mut self) -> usize {
         let thickness = self.config.model.self_collision_thickness;
         if thickness <= 0.0 {
-            return Ok(());
+            return 0;
         }
         let limit = SELF_COLLISION_STEP_LIMIT * thickness;
-        let x_new = &self.scratch.x_new;
-        let far = (0..self.x.len()).find(|&i| !self.pinned[i] && (x_new[i] - self.x[i]).norm() > limit);
-        match far {
-            None => Ok(()),
-            Some(i) => Err(Error::unstable(format!(
-                "{} with dt = {h} s would move vertex {i} by {:.3e} m, more than half the self-collision thickness ({thickness} m), so a fold could pass through itself; state left unchanged, retry with a smaller dt (max_substep = FC_MAX_SUBSTEP_AUTO lets the library choose the substeps; or set max_substep, or call fc_cloth_step_substeps)",
-                self.config.integrator.name(),
-                (x_new[i] - self.x[i]).norm()
-            ))),
+        let s = &mut self.scratch;
+        let mut limited = 0;
+        for i in 0..self.x.len() {
+            let d = s.x_new[i] - self.x[i];
+            let len = d.norm();
+            if self.pinned[i] || !(len > limit) {
+                continue;
+            }
+            let scale = limit / len;
+            s.x_new[i] = self.x[i] + scale * d;
+            s.v_new[i] *= scale;
+            limited += 1;
         }
+        limited
+    }
+}
+
+/// What collisions keep across a snapshot: the mesh colliders by id and self-collision's
+/// remembered pairs.
+pub(super) struct CollisionState {
+    pub meshes: Vec<Option<MeshCollider>>,
+    pub vertex_triangle: Vec<Pair>,
+    pub edge_edge: Vec<Pair>,
+}
+
+impl Cloth {
+    /// Writes the collision state (snapshot format 5, after the histories).
+    pub(super) fn write_collision_state(&self, w: &mut ByteWriter) {
+        w.u64(self.mesh_slots.len() as u64);
+        for slot in &self.mesh_slots {
+            let Some(mesh) = slot else {
+                w.u8(0);
+                continue;
+            };
+            w.u8(1);
+            w.u64(mesh.vertex_count() as u64);
+            w.u64(mesh.triangles().len() as u64);
+            for t in mesh.triangles() {
+                t.iter().for_each(|&i| w.u32(i));
+            }
+            w.vec3s(mesh.start_positions());
+            w.vec3s(mesh.positions());
+            match mesh.given_velocities() {
+                None => w.u8(0),
+                Some(v) => {
+                    w.u8(1);
+                    w.vec3s(v);
+                }
+            }
+            w.f64(mesh.friction);
+        }
+        let (vt, ee) = self.self_collision.pairs();
+        for pairs in [vt, ee] {
+            w.u64(pairs.len() as u64);
+            for &(a, b, s) in pairs {
+                w.u32(a);
+                w.u32(b);
+                w.u8(s as u8);
+            }
+        }
+    }
+
+    /// Reads and checks what [`Self::write_collision_state`] wrote.
+    pub(super) fn read_collision_state(&self, r: &mut ByteReader) -> Result<CollisionState, Error> {
+        let bad = |what: &str| Error::invalid(format!("snapshot: bad {what}"));
+        let slots = r.len(None, 1)?;
+        let mut meshes = Vec::new();
+        for _ in 0..slots {
+            meshes.push(match r.u8()? {
+                0 => None,
+                1 => {
+                    let nv = r.len(None, 48)?;
+                    let nt = r.len(None, 12)?;
+                    let mut tris = Vec::with_capacity(nt);
+                    for _ in 0..nt {
+                        tris.push([r.u32()?, r.u32()?, r.u32()?]);
+                    }
+                    let (mut start, mut target, mut vel) = (Vec::new(), Vec::new(), Vec::new());
+                    r.vec3s_into(Some(nv), &mut start)?;
+                    r.vec3s_into(Some(nv), &mut target)?;
+                    let given = match r.u8()? {
+                        0 => None,
+                        1 => {
+                            r.vec3s_into(Some(nv), &mut vel)?;
+                            Some(&vel[..])
+                        }
+                        _ => return Err(bad("mesh collider velocity tag")),
+                    };
+                    let friction = r.f64()?;
+                    if !(friction.is_finite() && friction >= 0.0) {
+                        return Err(bad("mesh collider friction"));
+                    }
+                    let mut mesh = MeshCollider::new(&start, &tris, None)?;
+                    mesh.set(&target, given)?;
+                    mesh.friction = friction;
+                    Some(mesh)
+                }
+                _ => return Err(bad("mesh collider slot tag")),
+            });
+        }
+        let (n, tris, edges) = (
+            self.vertex_count(),
+            self.topology.triangles.len(),
+            self.self_collision.edge_count(),
+        );
+        let mut read_pairs = |first: usize, second: usize, what: &str| -> Result<Vec<Pair>, Error> {
+            let count = r.len(None, 9)?;
+            let mut out: Vec<Pair> = Vec::with_capacity(count);
+            for _ in 0..count {
+                let (a, b, s) = (r.u32()?, r.u32()?, r.u8()? as i8);
+                let sorted = out.last().is_none_or(|l| (l.0, l.1) < (a, b));
+                if a as usize >= first || b as usize >= second || !(s == 1 || s == -1) || !sorted {
+                    return Err(bad(what));
+                }
+                out.push((a, b, s));
+            }
+            Ok(out)
+        };
+        let vertex_triangle = read_pairs(n, tris, "self-collision vertex-triangle pair")?;
+        let edge_edge = read_pairs(edges, edges, "self-collision edge-edge pair")?;
+        Ok(CollisionState {
+            meshes,
+            vertex_triangle,
+            edge_edge,
+        })
+    }
+
+    /// Takes a snapshot's collision state.
+    pub(super) fn set_collision_state(&mut self, state: CollisionState) {
+        self.mesh_slots = state.meshes;
+        self.self_collision
+            .set_pairs(state.vertex_triangle, state.edge_edge);
     }
 }

@@ -1,12 +1,14 @@
 //! Snapshots: the complete state of a cloth as bytes, to save a bake and resume it later
 //! (or undo in a host), continuing bitwise identically.
 //!
-//! Format version 4, little-endian. Older versions are refused: version 1 stored the SOE modes
-//! in their in-memory block layout, version 2 unshifted modes, version 3 the SOE history's past
+//! Format version 5, little-endian; version 4 (no collision state) is read as a cloth with no
+//! mesh collider and no remembered self-collision pair. Older versions are refused: version 1
+//! stored the SOE modes in their in-memory block layout, version 2 unshifted modes, version 3
+//! the SOE history's past
 //! sum instead of the sample that waits to be folded (`history/soe.rs`).
 //!
 //! ```text
-//! header   b"FCSNAP\0\0"  u32 version = 4  u32 flags = 0  u64 payload_len
+//! header   b"FCSNAP\0\0"  u32 version = 5  u32 flags = 0  u64 payload_len
 //! payload  u64 vertex_count  u64 spring_count  u64 triangle_count  u64 topology_fingerprint
 //!          u8 history_tag  u64 history_config_fingerprint
 //!          f64 time  u64 steps  vec3 current  f64 solver_tolerance  u32 solver_max_iterations
@@ -14,6 +16,10 @@
 //!          vec3s pin_targets  u64 slots, per slot: u8 present [u8 kind, shape f64s, f64 friction]
 //!          history state (scheme specific: see history/*.rs `write_state`)
 //!          [history state of the springs, with rotation-invariant fractional springs only]
+//!          u64 mesh slots, per slot: u8 present [u64 nv, u64 nt, u32[3 nt] triangles,
+//!            vec3s start, vec3s target, u8 has_velocities [vec3s velocities], f64 friction]
+//!          u64 n + n (u32 vertex, u32 triangle, i8 side)  self-collision pairs
+//!          u64 n + n (u32 edge, u32 edge, i8 side)
 //! trailer  u32 CRC-32 (IEEE) of header and payload
 //! ```
 //!
@@ -33,7 +39,7 @@ use crate::integrate::SolverSettings;
 
 const MAGIC: &[u8; 8] = b"FCSNAP\0\0";
 /// Current format version.
-pub const SNAPSHOT_VERSION: u32 = 4;
+pub const SNAPSHOT_VERSION: u32 = 5;
 const HEADER: usize = 8 + 4 + 4 + 8;
 
 /// FNV-1a over a stream of u64 words: cheap identity checks, not security.
@@ -191,7 +197,9 @@ impl Cloth {
             }
         }
         self.history.write_state(w)?;
-        self.strain_history.write_state(w)
+        self.strain_history.write_state(w)?;
+        self.write_collision_state(w);
+        Ok(())
     }
 
     /// Restores a state saved by [`Cloth::save_snapshot`] from a cloth of the same topology and
@@ -205,9 +213,9 @@ impl Cloth {
         let mut r = ByteReader::new(bytes);
         r.bytes(8)?;
         let version = r.u32()?;
-        if version != SNAPSHOT_VERSION {
+        if version != SNAPSHOT_VERSION && version != 4 {
             return Err(Error::invalid(format!(
-                "snapshot format version {version}; this library reads version {SNAPSHOT_VERSION}"
+                "snapshot format version {version}; this library reads versions 4 and {SNAPSHOT_VERSION}"
             )));
         }
         let _flags = r.u32()?;
@@ -294,6 +302,25 @@ impl Cloth {
         history.read_state(&mut r)?;
         let mut strain_history: History = self.strain_history.clone();
         strain_history.read_state(&mut r)?;
+        let collisions = if version >= 5 {
+            self.read_collision_state(&mut r)?
+        } else {
+            super::collisions::CollisionState {
+                meshes: Vec::new(),
+                vertex_triangle: Vec::new(),
+                edge_edge: Vec::new(),
+            }
+        };
+        let clash = collisions
+            .meshes
+            .iter()
+            .zip(&collider_slots)
+            .position(|(m, c)| m.is_some() && c.is_some());
+        if let Some(id) = clash {
+            return Err(Error::invalid(format!(
+                "snapshot: collider id {id} is both a mesh and a shape"
+            )));
+        }
         if r.remaining() != 4 {
             return Err(Error::invalid("snapshot has trailing data"));
         }
@@ -353,6 +380,7 @@ impl Cloth {
         next.rebuild_colliders();
         next.history = history;
         next.strain_history = strain_history;
+        next.set_collision_state(collisions);
         next.trial_step()?;
         *self = next;
         Ok(())

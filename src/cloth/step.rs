@@ -155,9 +155,9 @@ impl Cloth {
             Route::Implicit => self.forces_and_implicit_step(h, w0, strain_w0)?,
         };
         let friction = self.friction(h) | self.contact_friction(h);
+        let limited = self.limit_collision_step() > 0;
         self.pins(h);
-        self.check(h, integrated_sound && !friction)?;
-        self.check_collision_step(h)?;
+        self.check(h, integrated_sound && !friction && !limited)?;
         self.commit(h);
         Ok(())
     }

@@ -189,6 +189,11 @@ impl MeshCollider {
         &self.target
     }
 
+    /// Where the vertices were when the current (or next) call began.
+    pub fn start_positions(&self) -> &[Vec3] {
+        &self.start
+    }
+
     /// The velocities the host gave, if it gave them.
     pub fn given_velocities(&self) -> Option<&[Vec3]> {
         (!self.given_velocity.is_empty()).then_some(&self.given_velocity[..])

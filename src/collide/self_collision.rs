@@ -11,7 +11,7 @@
 //! **Sides.** Each pair remembers which side of the triangle (of the two edges) it was on when
 //! it entered the list and keeps it for as long as it stays; a vertex pushed through a
 //! triangle in one step is pushed back, not on through. Together with the step limit (no
-//! vertex moves more than half the thickness in a step, `Cloth`'s check) no pair can cross
+//! vertex moves more than half the thickness in a step, `Cloth::limit_collision_step`) no pair can cross
 //! unnoticed. The sides are the only state self-collision keeps (snapshots carry them).
 //!
 //! Forces: the vertex or edge point is pushed along the remembered side's normal (outside the

@@ -198,8 +198,8 @@ pub struct FcClothDesc {
     pub added_mass_coefficient: f64,
     /// Self-collision: the distance the cloth keeps from itself, m (0 = off, the default).
     /// Keep it below the spacing of the mesh: pairs nearer than this at rest are not tested.
-    /// No vertex moves more than half of it in one substep (the automatic step takes more
-    /// substeps; a fixed step that would is refused as unstable). See docs/collisions.md.
+    /// No vertex moves more than half of it in one substep (a faster one is slowed to that).
+    /// See docs/collisions.md.
     pub self_collision_thickness: f64,
     /// Coulomb friction coefficient of the cloth against itself (>= 0). Default 0.
     pub self_collision_friction: f64,

@@ -108,14 +108,14 @@ mod tests {
     fn a_short_struct_reads_its_fields_and_defaults_the_rest() {
         let mut host = fc_cloth_desc_default();
         host.width = 7;
-        host.added_mass_coefficient = 0.5; // the last field: beyond a host 8 bytes shorter
+        host.self_collision_friction = 0.5; // the last field: beyond a host 8 bytes shorter
         host.struct_size = (DESC_SIZE - 8) as u32;
         // SAFETY: a whole struct is readable.
         let d = unsafe { read_desc(&host) }.expect("accepted");
         assert_eq!(d.width, 7);
         assert_eq!(
-            d.added_mass_coefficient,
-            fc_cloth_desc_default().added_mass_coefficient
+            d.self_collision_friction,
+            fc_cloth_desc_default().self_collision_friction
         );
         assert_eq!(d.struct_size as usize, DESC_SIZE);
     }

@@ -4,10 +4,14 @@ Physics > fraccloth panel (Properties editor, Physics tab). "Bake underwater clo
 - the active mesh object is the cloth (triangles and quads; apply its scale first);
 - vertices of the vertex group named in "Pin group" are pinned with their group weight
   (1 = held in place, less = a soft pin);
-- every other selected object is a collider: a flat one (one dimension near zero) is an
-  infinite plane through its origin along its local Z axis, a long one (longest dimension over
-  twice the next) a capsule along that axis, any other a sphere of half its largest dimension
-  around its origin; "Collider friction" applies to them all;
+- every other selected object is a collider. "Collider shape" Mesh (the default) uses each mesh
+  object as it is: its evaluated mesh every frame (armatures, shape keys, modifiers), closed
+  meshes with an inside the cloth is pushed out of. Fitted (faster) fits a shape instead: a flat
+  object (one dimension near zero) is an infinite plane through its origin along its local Z
+  axis, a long one (longest dimension over twice the next) a capsule along that axis, any other
+  a sphere of half its largest dimension around its origin (objects that are not meshes are
+  always fitted). "Collider friction" applies to them all;
+- "Self-collision" (a thickness in m, 0 = off) keeps the cloth from passing through itself;
 - the scene's frame range is baked at the scene's frame rate, each frame split into steps of
   "Time step"; the result is written to a PC2 (or MDD) point cache by the fraccloth library and
   attached with a Mesh Cache modifier.
@@ -57,6 +61,10 @@ INTEGRATOR_ITEMS = [
     ("IMPLICIT2", "Implicit, 2nd order", "Extrapolated implicit Euler: second order and stable at a frame; 3x the work per step"),
 ]
 FORMAT_ITEMS = [("PC2", "PC2", "PC2 point cache"), ("MDD", "MDD", "MDD point cache")]
+COLLIDER_ITEMS = [
+    ("MESH", "Mesh", "Each collider object's own mesh, as evaluated every frame (armatures, shape keys, modifiers)"),
+    ("FITTED", "Fitted (faster)", "A sphere, capsule or plane fitted to each collider object"),
+]
 
 
 DAMPING_ITEMS = [
@@ -162,9 +170,46 @@ class FracclothSettings(bpy.types.PropertyGroup):
     time_step: bpy.props.FloatProperty(name="Time step", description="Longest step when not automatic, s", default=5e-4, min=1e-6, max=0.1, precision=5)
     friction: bpy.props.FloatProperty(name="Collider friction", description="How much the colliders grip the cloth (0 = slippery, 1 = grippy)", default=0.0, min=0.0, soft_max=1.0)
     collision_margin: bpy.props.FloatProperty(name="Collision margin", description="Distance from a collider at which the cloth is pushed away, m", default=0.01, min=0.0, soft_max=0.05)
+    collider_shape: bpy.props.EnumProperty(name="Collider shape", items=COLLIDER_ITEMS, default="MESH",
+                                           description="How collider objects are seen: their own mesh every frame, or a fitted sphere, capsule or plane (faster)")
+    self_collision: bpy.props.FloatProperty(name="Self-collision", description="Distance the cloth keeps from itself, m (0 = off); keep it below the spacing of its vertices", default=0.0, min=0.0, soft_max=0.02, precision=4)
+    self_friction: bpy.props.FloatProperty(name="Self friction", description="How much the cloth grips itself where it touches (0 = slippery)", default=0.0, min=0.0, soft_max=1.0)
     cache_format: bpy.props.EnumProperty(name="Format", items=FORMAT_ITEMS, default="PC2")
     cache_path: bpy.props.StringProperty(name="Cache file", subtype="FILE_PATH", default="",
                                          description="Where the cache goes; empty: a 'fraccloth' folder next to the .blend, named after the object")
+
+
+def _mesh_spec(o):
+    """("mesh", world positions (N, 3), triangles (M, 3)) of a mesh object as Blender evaluates
+    it at the current frame (armature, shape keys, modifiers, parents)."""
+    deps = bpy.context.evaluated_depsgraph_get()
+    ev = o.evaluated_get(deps)
+    me = ev.to_mesh()
+    try:
+        co = np.empty(3 * len(me.vertices), dtype=np.float64)
+        me.vertices.foreach_get("co", co)
+        me.calc_loop_triangles()
+        tris = np.empty(3 * len(me.loop_triangles), dtype=np.uint32)
+        me.loop_triangles.foreach_get("vertices", tris)
+    finally:
+        ev.to_mesh_clear()
+    m = np.array(ev.matrix_world, dtype=np.float64)
+    co = co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3]
+    return ("mesh", co, tris.reshape(-1, 3))
+
+
+def collider_specs_for(s, others):
+    """The colliders at the current frame as the settings `s` see them: each mesh object as its
+    evaluated mesh ("Collider shape" Mesh), or fitted shapes (`_world_specs`)."""
+    if s.collider_shape != "MESH":
+        return _world_specs(others)
+    specs = []
+    for o in others:
+        if o.type == "MESH" and len(o.data.polygons) > 0:
+            specs.append(_mesh_spec(o))
+        else:
+            specs.extend(_world_specs([o]))
+    return specs
 
 
 def _world_specs(others):
@@ -287,6 +332,8 @@ def describe(s):
     desc.form_drag = s.form_drag
     desc.skin_drag = s.skin_drag
     desc.collision_margin = s.collision_margin
+    desc.self_collision_thickness = s.self_collision
+    desc.self_collision_friction = s.self_friction
     desc.history_scheme = {"SOE": fraccloth.HISTORY_SOE, "PAPER": fraccloth.HISTORY_TRUNCATED, "OFF": fraccloth.HISTORY_OFF}[s.history]
     desc.history_u = 3
     desc.integrator = {
@@ -321,8 +368,10 @@ def build_cloth(context, obj, others):
     if w.any():
         cloth.set_pin_weights(w)
     ids = []
-    for spec in _world_specs(others):
-        if spec[0] == "plane":
+    for spec in collider_specs_for(s, others):
+        if spec[0] == "mesh":
+            cid = cloth.add_mesh_collider(spec[1].astype(np.float32), spec[2])
+        elif spec[0] == "plane":
             cid = cloth.add_plane(spec[1], spec[2])
         elif spec[0] == "capsule":
             cid = cloth.add_capsule(spec[1], spec[2], spec[3])
@@ -361,14 +410,21 @@ def _simulate(context, obj, others):
     scene = context.scene
     scene.frame_set(scene.frame_start)
     cloth, (frame_dt, substeps), pinned, ids = build_cloth(context, obj, others)
-    previous = _world_specs(others)
+    s = obj.fraccloth
+    previous = collider_specs_for(s, others)
     for f in range(scene.frame_start, scene.frame_end + 1):
         if f > scene.frame_start:
             scene.frame_set(f)
             if len(pinned):
                 cloth.set_pin_targets(pinned, world_positions(obj)[pinned].astype(np.float32))
-            now = _world_specs(others)
+            now = collider_specs_for(s, others)
             for cid, old, new in zip(ids, previous, now):
+                if new[0] == "mesh":
+                    if len(new[1]) != len(old[1]):
+                        raise ValueError("a collider's modifiers change its vertex count from frame to frame; apply them or use Collider shape Fitted")
+                    # The library moves it there over the frame, with the velocity that takes it there.
+                    cloth.set_mesh_collider(cid, new[1].astype(np.float32))
+                    continue
                 velocity = (np.array(new[1]) - np.array(old[1])) / frame_dt
                 if new[0] == "plane":
                     cloth.set_plane(cid, new[1], new[2], velocity)
@@ -566,7 +622,7 @@ class FRACCLOTH_PT_panel(bpy.types.Panel):
                        "damping_mode", "spring_damping")),
             ("Water", ("water_density", "entrained_mass", "added_mass", "form_drag", "skin_drag", "history_drag",
                        "viscous_drag", "normal_drag", "current")),
-            ("Colliders", ("friction", "collision_margin")),
+            ("Colliders", ("collider_shape", "friction", "collision_margin", "self_collision", "self_friction")),
             ("Solver", ("history", "integrator", "auto_step", "time_step")),
             ("Cache", ("cache_format", "cache_path")),
         ):

@@ -64,6 +64,8 @@ def make_scene(tmp_path, fmt):
     s.time_step = 1e-3
     s.current = (0.05, 0.0, 0.0)
     s.friction = 0.2
+    # These tests are of the fitted shapes (a mesh collider test follows at the end).
+    s.collider_shape = "FITTED"
     return cloth, [ball, floor]
 
 
@@ -289,3 +291,48 @@ def test_a_long_object_is_a_capsule_that_holds_the_cloth(addon, tmp_path):
         assert d.min() >= r - margin - 1e-4, f"frame {frame}: {r - d.min():.4f} m inside the bar"
         closest = min(closest, d.min())
     assert closest < r + margin, closest  # it did reach the bar (contacts act at the vertices)
+
+
+def test_an_armature_animated_mesh_collider_pushes_the_cloth(addon, tmp_path):
+    """A box skinned to a bone, the bone animated (the object itself never moves): the add-on
+    reads the evaluated mesh every frame, the box rises through where the cloth hangs, pushes it
+    and no cloth vertex is ever inside it."""
+    cloth, _ = make_scene(tmp_path, "PC2")
+    s = cloth.fraccloth
+    s.collider_shape = "MESH"
+    s.self_collision = 0.004
+    s.auto_step = True
+    bpy.ops.object.armature_add(location=(0.1, -0.25, -0.25))
+    arm = bpy.context.active_object
+    bpy.ops.mesh.primitive_cube_add(size=0.1, location=(0.1, -0.25, -0.25))
+    box = bpy.context.active_object
+    mod = box.modifiers.new("skin", "ARMATURE")
+    mod.object = arm
+    box.vertex_groups.new(name="Bone").add(list(range(len(box.data.vertices))), 1.0, "REPLACE")
+    bone = arm.pose.bones["Bone"]
+    bone.location = (0.0, 0.0, 0.0)
+    bone.keyframe_insert("location", frame=1)
+    bone.location = (0.0, 0.5, 0.0)  # along the bone, world +z: 0.5 m up
+    bone.keyframe_insert("location", frame=24)
+    bpy.context.scene.frame_set(1)
+    for o in bpy.context.selected_objects:
+        o.select_set(False)
+    box.select_set(True)
+    cloth.select_set(True)
+    bpy.context.view_layer.objects.active = cloth
+    assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+    margin = s.collision_margin
+    closest, rose = np.inf, 0.0
+    for frame in range(1, 25):
+        x = world(cloth, frame)
+        bpy.context.scene.frame_set(frame)
+        corners = addon._mesh_spec(box)[1]
+        lo, hi = corners.min(axis=0), corners.max(axis=0)
+        assert box.matrix_world.translation.z == pytest.approx(-0.25)  # only the bone moved
+        # Outside-the-box distance of each vertex (negative inside).
+        d = np.maximum(lo - x, x - hi).max(axis=1)
+        assert d.min() > 0.0, f"frame {frame}: a cloth vertex {-d.min():.4f} m inside the box"
+        closest = min(closest, d.min())
+        rose = max(rose, x[:, 2].max())
+    assert closest < margin + 1e-3, f"the box never reached the cloth: {closest}"
+    assert lo[2] > 0.2 and rose > 0.2 + 0.05, f"the box lifted the cloth above its rest height: {rose}"

@@ -171,6 +171,9 @@ _SIGNATURES = {
     "fc_cloth_history_mode_count": (_c.c_uint32, [_P]),
     "fc_cloth_history_bytes_per_particle": (_c.c_size_t, [_P]),
     "fc_cloth_add_sphere": (_c.c_int, [_P, _F3, _c.c_float, _F3, _U32P]),
+    "fc_cloth_add_mesh_collider": (_c.c_int, [_P, _F3, _c.c_size_t, _U32P, _c.c_size_t, _F3, _U32P]),
+    "fc_cloth_set_mesh_collider": (_c.c_int, [_P, _c.c_uint32, _F3, _c.c_size_t, _F3]),
+    "fc_cloth_get_mesh_collider": (_c.c_int, [_P, _c.c_uint32, _c.POINTER(_c.c_size_t), _c.POINTER(_c.c_size_t)]),
     "fc_cloth_set_sphere": (_c.c_int, [_P, _c.c_uint32, _F3, _c.c_float, _F3]),
     "fc_cloth_add_plane": (_c.c_int, [_P, _F3, _F3, _F3, _U32P]),
     "fc_cloth_set_plane": (_c.c_int, [_P, _c.c_uint32, _F3, _F3, _F3]),
@@ -600,6 +603,37 @@ class Cloth:
         r = ctypes.c_float()
         _check(library.fc_cloth_get_capsule(self._h, id, _fp(a), _fp(b), ctypes.byref(r), _fp(v)))
         return a, b, r.value, v
+
+    def add_mesh_collider(self, positions, triangles, velocities=None) -> int:
+        """Adds a triangle-mesh collider: ``positions`` (m) shape (n, 3), ``triangles`` vertex
+        indices shape (m, 3) (counter-clockwise seen from outside on a closed mesh),
+        ``velocities`` (m/s) shape (n, 3) or None (from its motion between steps). Returns its
+        id (shared with the other colliders). A closed mesh pushes out a vertex that ends up
+        inside it; an open one is a two-sided shell."""
+        x = _floats(positions)
+        t = _u32(triangles)
+        v = None if velocities is None else _floats(velocities)
+        if v is not None and v.size != x.size:
+            raise ValueError(f"expected {x.size // 3} velocities, got {v.size // 3}")
+        out = ctypes.c_uint32()
+        _check(library.fc_cloth_add_mesh_collider(self._h, _fp(x), x.size // 3, t.ctypes.data_as(_U32P), t.size,
+                                                  None if v is None else _fp(v), ctypes.byref(out)))
+        return out.value
+
+    def set_mesh_collider(self, id: int, positions, velocities=None) -> None:
+        """Moves or deforms mesh collider ``id``: new positions (m) of the same vertices, where
+        it is at the end of the next step (it travels there over the step)."""
+        x = _floats(positions)
+        v = None if velocities is None else _floats(velocities)
+        if v is not None and v.size != x.size:
+            raise ValueError(f"expected {x.size // 3} velocities, got {v.size // 3}")
+        _check(library.fc_cloth_set_mesh_collider(self._h, id, _fp(x), x.size // 3, None if v is None else _fp(v)))
+
+    def mesh_collider_size(self, id: int) -> Tuple[int, int]:
+        """(vertex count, triangle count) of mesh collider ``id``."""
+        nv, nt = ctypes.c_size_t(), ctypes.c_size_t()
+        _check(library.fc_cloth_get_mesh_collider(self._h, id, ctypes.byref(nv), ctypes.byref(nt)))
+        return nv.value, nt.value
 
     def set_collider_friction(self, id: int, friction: float) -> None:
         """Coulomb friction coefficient (>= 0) of collider ``id``."""

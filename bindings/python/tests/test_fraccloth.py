@@ -287,3 +287,33 @@ def test_the_underwater_preset_steps_once_per_frame_with_the_automatic_step():
         cloth.desc = d
         cloth.step(1 / 30)
         assert cloth.step_stats() == fraccloth.StepStats(34, 0, 0.0)
+
+
+def test_triangle_mesh_collider_and_self_collision():
+    """A towel falls onto a box mesh moved each step: no vertex ends inside the box; bad
+    meshes raise with the library's status."""
+    desc = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
+    desc.width, desc.height, desc.spacing = 21, 21, 0.02
+    desc.self_collision_thickness = 0.005
+    box = np.array([[x, y, z] for y in (-0.05, 0.05) for (x, z) in ((-0.1, -0.1), (0.1, -0.1), (0.1, 0.1), (-0.1, 0.1))])
+    faces = [[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
+             [2, 3, 7], [2, 7, 6], [1, 2, 6], [1, 6, 5], [3, 0, 4], [3, 4, 7]]
+    with fraccloth.Cloth.grid(desc) as cloth:
+        p = cloth.positions
+        flat = np.stack([p[:, 0] - 0.2, np.full(len(p), 0.07), p[:, 1] + 0.2], axis=1)
+        cloth.positions = flat
+        mesh = cloth.add_mesh_collider(box, faces)
+        assert cloth.mesh_collider_size(mesh) == (8, 12)
+        for f in range(30):
+            cloth.set_mesh_collider(mesh, box + [0.0, 0.001 * f, 0.0])
+            cloth.step(1.0 / 30.0)
+        x = cloth.positions
+        top = 0.05 + 0.029
+        inside = (np.abs(x[:, 0]) < 0.1) & (np.abs(x[:, 2]) < 0.1) & (np.abs(x[:, 1] - 0.029) < 0.05)
+        assert not inside.any()
+        assert x[:, 1].max() < top + 0.03 and x[:, 1].min() < top - 0.05
+        with pytest.raises(fraccloth.Error) as e:
+            cloth.add_mesh_collider(box, [[0, 1, 99]])
+        assert e.value.status == 3
+        with pytest.raises(fraccloth.Error):
+            cloth.set_mesh_collider(mesh, box[:7])
