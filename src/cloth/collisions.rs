@@ -170,7 +170,7 @@ impl Cloth {
         for i in 0..self.x.len() {
             let d = s.x_new[i] - self.x[i];
             let len = d.norm();
-            if self.pinned[i] || !(len > limit) {
+            if self.pinned[i] || len <= limit || len.is_nan() {
                 continue;
             }
             let scale = limit / len;
