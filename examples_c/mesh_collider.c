@@ -10,10 +10,11 @@
 #include <stdlib.h>
 #include "fraccloth.h"
 
+/* Counter-clockwise seen from outside (the library also turns an inside-out closed mesh round). */
 static const uint32_t box_indices[36] = {
-    0, 2, 1, 0, 3, 2, /* bottom (-y) */ 4, 5, 6, 4, 6, 7, /* top (+y) */
-    0, 1, 5, 0, 5, 4, /* -z */ 2, 3, 7, 2, 7, 6, /* +z */
-    1, 2, 6, 1, 6, 5, /* +x */ 3, 0, 4, 3, 4, 7, /* -x */
+    0, 1, 2, 0, 2, 3, /* bottom (-y) */ 4, 6, 5, 4, 7, 6, /* top (+y) */
+    0, 5, 1, 0, 4, 5, /* -z */ 2, 7, 3, 2, 6, 7, /* +z */
+    1, 6, 2, 1, 5, 6, /* +x */ 3, 4, 0, 3, 7, 4, /* -x */
 };
 
 /* The box's 8 corners: half-size 0.1 x 0.05 x 0.1 m, turned by `angle` about y, centre height `cy`. */

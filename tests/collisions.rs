@@ -324,3 +324,47 @@ fn a_snapshot_resumes_a_bake_with_collisions_bitwise() {
     assert_eq!(a.positions(), b.positions());
     assert_eq!(a.velocities(), b.velocities());
 }
+
+/// The brisk swing (2 Hz, 8 cm: it crumples under its pins, docs/underwater.md) with
+/// self-collision on crosses itself far less than with it off. Not yet at none: the issue's
+/// target (no crossing at any frame) is not met here; docs/collisions.md gives the figures.
+#[test]
+fn the_brisk_swing_with_self_collision_does_not_cross_itself() {
+    use fraccloth::scenes::{Drive, SceneKind, SceneSpec, Variant};
+    let run = |thickness: f64| {
+        let drive = Drive {
+            amplitude: 0.08,
+            frequency: 2.0,
+            ..Drive::of(SceneKind::Swing, Variant::Underwater)
+        };
+        let spec = SceneSpec {
+            width: 31,
+            height: 21,
+            drive,
+            dt: 1.0 / FPS,
+            max_substep: fraccloth::cloth::AUTO,
+            integrator: Integrator::SymplecticEuler,
+            model: Some(Model {
+                self_collision_thickness: thickness,
+                ..Model::underwater()
+            }),
+            ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
+        };
+        let mut scene = spec.build().unwrap();
+        let tris = scene.cloth.topology().triangles.clone();
+        let mut worst = 0;
+        for f in 1..=120 {
+            scene.run_until(f as f64 / FPS).unwrap();
+            worst = worst.max(self_intersections(scene.cloth.positions(), &tris));
+        }
+        (worst, scene.cloth.self_collision_pairs().0.len())
+    };
+    let (with, pairs) = run(0.006);
+    let (without, _) = run(0.0);
+    println!("2 Hz swing, 31 x 21: {with} crossing pairs with self-collision ({pairs} pairs in reach at the end), {without} without");
+    assert!(without > 0, "the crumple crosses itself without self-collision");
+    assert!(
+        2 * with < without,
+        "self-collision at least halves the crossings: {with} vs {without}"
+    );
+}

@@ -276,7 +276,7 @@ impl Cloth {
             for _ in 0..count {
                 let (a, b, s) = (r.u32()?, r.u32()?, r.u8()? as i8);
                 let sorted = out.last().is_none_or(|l| (l.0, l.1) < (a, b));
-                if a as usize >= first || b as usize >= second || !(s == 1 || s == -1) || !sorted {
+                if a as usize >= first || b as usize >= second || !(-1..=1).contains(&s) || !sorted {
                     return Err(bad(what));
                 }
                 out.push((a, b, s));

@@ -9,12 +9,17 @@ use crate::Vec3;
 
 /// The number of crossing triangle pairs of `triangles` at positions `x`.
 pub fn self_intersections(x: &[Vec3], triangles: &[[u32; 3]]) -> usize {
+    crossing_pairs(x, triangles).len()
+}
+
+/// The crossing triangle pairs `(a, b)`, a < b, of `triangles` at positions `x`.
+pub fn crossing_pairs(x: &[Vec3], triangles: &[[u32; 3]]) -> Vec<(u32, u32)> {
     let boxes: Vec<Aabb> = triangles
         .iter()
         .map(|t| Aabb::of(t.iter().map(|&i| &x[i as usize])))
         .collect();
     let bvh = Bvh::build(&boxes);
-    let mut count = 0;
+    let mut pairs = Vec::new();
     for (a, ta) in triangles.iter().enumerate() {
         bvh.overlapping(&boxes[a], |b| {
             if (b as usize) <= a {
@@ -35,10 +40,12 @@ pub fn self_intersections(x: &[Vec3], triangles: &[[u32; 3]]) -> usize {
                 }
                 _ => false,
             };
-            count += usize::from(crossed);
+            if crossed {
+                pairs.push((a as u32, b));
+            }
         });
     }
-    count
+    pairs
 }
 
 /// Cloth vertices inside a closed mesh `(positions, triangles)`, by the winding number (the

@@ -116,8 +116,22 @@ impl MeshCollider {
         )?;
         let neighbours = neighbours(triangles);
         let closed = neighbours.iter().all(|t| t.iter().all(|&o| o != NONE));
+        let mut triangles = triangles.to_vec();
+        if closed && signed_volume(positions, &triangles) < 0.0 {
+            // Wound inside out (clockwise seen from outside, as after a normals flip): turn
+            // every triangle round, so its inside is the mesh's. Edges and neighbours are the
+            // same, their order within a triangle is not: recompute.
+            for t in &mut triangles {
+                t.swap(1, 2);
+            }
+        }
+        let neighbours = if closed {
+            self::neighbours(&triangles)
+        } else {
+            neighbours
+        };
         let mut mesh = MeshCollider {
-            triangles: triangles.to_vec(),
+            triangles,
             neighbours,
             closed,
             start: positions.to_vec(),
@@ -445,6 +459,18 @@ impl MeshCollider {
     }
 }
 
+/// Signed volume enclosed by closed triangles (positive when they face outward).
+fn signed_volume(x: &[Vec3], triangles: &[[u32; 3]]) -> f64 {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| x[i as usize]);
+            a.dot(&b.cross(&c))
+        })
+        .sum::<f64>()
+        / 6.0
+}
+
 /// The triangle across each edge (corner k to corner k+1) of each triangle, if exactly one.
 fn neighbours(triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
     let mut edges: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * triangles.len());
@@ -524,6 +550,29 @@ mod tests {
             // The facets sag inward by at most r (1 - cos(pi/12)) = 0.017.
             assert!((c.depth - expect).abs() < 0.02, "{p:?}: {} vs {expect}", c.depth);
         }
+    }
+
+    /// A closed mesh wound inside out (normals flipped) has the same inside.
+    #[test]
+    fn an_inside_out_mesh_is_turned_round() {
+        let (x, t) = uv_sphere(Vec3::zeros(), 0.5, 16, 8);
+        let flipped: Vec<[u32; 3]> = t.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        let mut m = MeshCollider::new(&x, &flipped, None).unwrap();
+        m.begin_call(1.0 / 30.0, 0.03);
+        let mut out = Vec::new();
+        // Just outside (not in contact) and just inside (pushed out).
+        m.contacts(
+            &[Vec3::new(0.0, 0.53, 0.0), Vec3::new(0.0, 0.45, 0.0)],
+            &[],
+            1.0,
+            0.01,
+            0.02,
+            1.0,
+            &mut out,
+        );
+        assert_eq!(out.len(), 1, "{out:?}");
+        assert_eq!(out[0].idx[0], 1);
+        assert!(out[0].dir.y > 0.9);
     }
 
     /// A mesh vertex within the margin of a cloth triangle pushes the triangle's vertices.

@@ -24,7 +24,9 @@ use super::contact::Contact;
 use super::geometry::{closest_on_segments, closest_on_triangle};
 use crate::Vec3;
 
-/// A remembered pair: the two elements and the side, +1 or -1.
+/// A remembered pair: the two elements and the side, +1 or -1 (0: not known yet, until the
+/// vertex first comes over the triangle's face, or the edges' closest points first lie inside
+/// both).
 pub type Pair = (u32, u32, i8);
 
 /// Self-collision's search and memory; see the module docs.
@@ -117,7 +119,7 @@ impl SelfCollision {
             self.look(x, rest, triangles, thickness + skin, thickness);
         }
         let cap = 2.0 * thickness;
-        for &(p, t, s) in &self.vertex_triangle {
+        for (p, t, s) in self.vertex_triangle.iter_mut().map(|q| (q.0, q.1, &mut q.2)) {
             let tri = &triangles[t as usize];
             let (d, w, r) = vertex_triangle(x, p, tri);
             if d >= thickness {
@@ -128,10 +130,14 @@ impl SelfCollision {
             let Some(normal) = (b - a).cross(&(c - a)).try_normalize(0.0) else {
                 continue;
             };
-            let side_n = f64::from(s) * normal;
+            if *s == 0 && interior {
+                // First over the triangle's face: the side it comes from is known now.
+                *s = side(r.dot(&normal));
+            }
+            let side_n = f64::from(*s) * normal;
             let (dist, dir) = if interior && r.dot(&side_n) <= 0.0 {
                 (-d, side_n)
-            } else if interior {
+            } else if interior && *s != 0 {
                 (r.dot(&side_n), side_n)
             } else if d > 1e-12 {
                 (d, r / d)
@@ -151,7 +157,7 @@ impl SelfCollision {
                 friction,
             });
         }
-        for &(e, f, s) in &self.edge_edge {
+        for (e, f, s) in self.edge_edge.iter_mut().map(|p| (p.0, p.1, &mut p.2)) {
             let (ee, ff) = (&self.edges[e as usize], &self.edges[f as usize]);
             let (d, a, b, r, n) = edge_edge(x, ee, ff);
             if d >= thickness || !(a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0) {
@@ -160,7 +166,10 @@ impl SelfCollision {
             let Some(n) = n.try_normalize(1e-12) else {
                 continue;
             };
-            let side_n = f64::from(s) * n;
+            if *s == 0 {
+                *s = side(r.dot(&n));
+            }
+            let side_n = f64::from(*s) * n;
             let along = r.dot(&side_n);
             let (dist, dir) = if along <= 0.0 { (-d, side_n) } else { (d, r / d) };
             if dist >= thickness {
@@ -227,9 +236,14 @@ impl SelfCollision {
                     return;
                 }
                 let s = remembered(&old_vt, p, t).unwrap_or_else(|| {
+                    // Known only where the vertex is over the face (beside it, the plane's side
+                    // says nothing): else 0, set when it first comes over the face.
                     let [a, b, c] = tri.map(|i| x[i as usize]);
-                    let _ = w;
-                    side(r.dot(&(b - a).cross(&(c - a))))
+                    if w.iter().all(|&wk| wk > 0.0) {
+                        side(r.dot(&(b - a).cross(&(c - a))))
+                    } else {
+                        0
+                    }
                 });
                 vt.push((p, t, s));
             });
@@ -246,11 +260,12 @@ impl SelfCollision {
                 if edge.iter().any(|v| other.contains(v)) {
                     return;
                 }
-                let (d, _, _, r, n) = edge_edge(x, edge, other);
+                let (d, a, b, r, n) = edge_edge(x, edge, other);
                 if d >= reach || edge_edge(rest, edge, other).0 < thickness {
                     return;
                 }
-                let s = remembered(&old_ee, e, f).unwrap_or_else(|| side(r.dot(&n)));
+                let interior = a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0;
+                let s = remembered(&old_ee, e, f).unwrap_or(if interior { side(r.dot(&n)) } else { 0 });
                 ee.push((e, f, s));
             });
         }

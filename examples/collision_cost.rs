@@ -1,0 +1,138 @@
+//! What collisions cost, as ratios within one run (docs/collisions.md, docs/benchmarks.md):
+//! the underwater swing (the preset's automatic step, 30 fps frames, 0.5 Hz and 2 Hz) with and
+//! without self-collision, at 61 x 41 and 201 x 201, and with a 10k-triangle sphere mesh
+//! collider the towel swings against. Each configuration is baked alternately with its
+//! baseline, best of `rounds`, so both see the same machine. Prints seconds of bake per
+//! simulated second, the ratio, substeps a frame, self-collision looks a frame and the most
+//! crossing triangle pairs at any frame.
+//!
+//! `cargo run --release --example collision_cost -- [rounds]` (default 3)
+
+use std::time::Instant;
+
+use fraccloth::collide::intersections::self_intersections;
+use fraccloth::collide::shapes::uv_sphere;
+use fraccloth::scenes::{Drive, SceneKind, SceneSpec, Variant};
+use fraccloth::{Integrator, Model, Vec3};
+
+const FPS: f64 = 30.0;
+
+#[derive(Clone, Copy)]
+struct Case {
+    width: u32,
+    height: u32,
+    frequency: f64,
+    amplitude: f64,
+    thickness: f64,
+    mesh: bool,
+    seconds: f64,
+}
+
+/// (wall seconds, substeps a frame, looks a frame, most crossing pairs, contacts at the end).
+fn bake(c: Case) -> (f64, f64, f64, usize, usize) {
+    let drive = Drive {
+        amplitude: c.amplitude,
+        frequency: c.frequency,
+        ..Drive::of(SceneKind::Swing, Variant::Underwater)
+    };
+    let spec = SceneSpec {
+        width: c.width,
+        height: c.height,
+        drive,
+        dt: 1.0 / FPS,
+        max_substep: fraccloth::cloth::AUTO,
+        integrator: Integrator::SymplecticEuler,
+        model: Some(Model {
+            self_collision_thickness: c.thickness,
+            ..Model::underwater()
+        }),
+        ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
+    };
+    let mut scene = spec.build().expect("scene");
+    if c.mesh {
+        // A 10k-triangle ball of 10 cm radius the towel's lower half swings into.
+        let (x, t) = uv_sphere(Vec3::new(0.3, -0.3, 0.1), 0.1, 100, 51);
+        assert!(t.len() >= 10_000);
+        scene.cloth.add_mesh_collider(&x, &t, None).expect("mesh");
+    }
+    let tris = scene.cloth.topology().triangles.clone();
+    let frames = (c.seconds * FPS) as usize;
+    let (mut wall, mut substeps, mut worst) = (0.0, 0u64, 0);
+    let looks0 = scene.cloth.self_collision_looks();
+    for f in 1..=frames {
+        let t0 = Instant::now();
+        scene.run_until(f as f64 / FPS).expect("frame");
+        wall += t0.elapsed().as_secs_f64();
+        substeps += u64::from(scene.cloth.step_stats().substeps);
+        if f % 10 == 0 {
+            worst = worst.max(self_intersections(scene.cloth.positions(), &tris));
+        }
+    }
+    let looks = (scene.cloth.self_collision_looks() - looks0) as f64 / frames as f64;
+    (
+        wall,
+        substeps as f64 / frames as f64,
+        looks,
+        worst,
+        scene.cloth.contacts().len(),
+    )
+}
+
+fn main() {
+    let rounds: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(3);
+    println!(
+        "{:<34} {:>9} {:>9} {:>6} {:>9} {:>7} {:>9} {:>9}",
+        "case", "base s/s", "with s/s", "ratio", "substeps", "looks", "crossing", "contacts"
+    );
+    let towel = |frequency, amplitude| Case {
+        width: 61,
+        height: 41,
+        frequency,
+        amplitude,
+        thickness: 0.0,
+        mesh: false,
+        seconds: 4.0,
+    };
+    let cases = [
+        ("61x41 0.5 Hz 4 cm, self 4 mm", towel(0.5, 0.04), 0.004, false),
+        ("61x41 2 Hz 8 cm, self 4 mm", towel(2.0, 0.08), 0.004, false),
+        (
+            "201x201 0.5 Hz 4 cm, self 1.5 mm",
+            Case {
+                width: 201,
+                height: 201,
+                seconds: 1.0,
+                ..towel(0.5, 0.04)
+            },
+            0.0015,
+            false,
+        ),
+        ("61x41 0.5 Hz 4 cm, 10k-tri mesh", towel(0.5, 0.04), 0.0, true),
+    ];
+    for (name, base, thickness, mesh) in cases {
+        let with = Case {
+            thickness,
+            mesh,
+            ..base
+        };
+        let (mut b, mut w) = (f64::INFINITY, f64::INFINITY);
+        let mut stats = (0.0, 0.0, 0, 0);
+        for _ in 0..rounds {
+            b = b.min(bake(base).0);
+            let r = bake(with);
+            w = w.min(r.0);
+            stats = (r.1, r.2, r.3, r.4);
+        }
+        let s = base.seconds;
+        println!(
+            "{name:<34} {:>9.3} {:>9.3} {:>6.2} {:>9.1} {:>7.2} {:>9} {:>9}",
+            b / s,
+            w / s,
+            w / b,
+            stats.0,
+            stats.1,
+            stats.2,
+            stats.3
+        );
+    }
+}

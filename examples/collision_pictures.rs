@@ -1,0 +1,217 @@
+//! The pictures of docs/collisions.md: the scenes of `tests/collisions.rs`, drawn as wireframes
+//! seen from the side (crossing triangles in red, colliders in grey), a row of frames each.
+//!
+//! `cargo run --release --example collision_pictures` writes `docs/collisions/*.png`.
+
+use fraccloth::collide::intersections::{crossing_pairs, self_intersections};
+use fraccloth::collide::shapes::{bar, torus};
+use fraccloth::forces::{Collider, Plane};
+use fraccloth::{Cloth, ClothConfig, Integrator, Model, Scheme, Vec3};
+use plotters::prelude::*;
+
+const FPS: f64 = 30.0;
+
+/// An underwater towel as in the tests, flat at height `y` or hanging from it.
+fn towel(w: u32, h: u32, spacing: f64, y: f64, hanging: bool, thickness: f64) -> Cloth {
+    let area = spacing * spacing * f64::from((w - 1) * (h - 1));
+    let grid = fraccloth::topology::GridSpec {
+        width: w,
+        height: h,
+        spacing,
+        total_mass: area,
+    }
+    .build()
+    .expect("grid");
+    let model = Model {
+        self_collision_thickness: thickness,
+        self_collision_friction: 0.3,
+        ..Model::underwater()
+    };
+    let config = ClothConfig {
+        model,
+        scheme: Scheme::DEFAULT,
+        integrator: Integrator::SymplecticEuler,
+        max_substep: fraccloth::cloth::AUTO,
+        ..ClothConfig::default()
+    };
+    let mut cloth = Cloth::new(grid, config).expect("cloth");
+    let (cx, cy) = (
+        0.5 * spacing * f64::from(w - 1),
+        -0.5 * spacing * f64::from(h - 1),
+    );
+    let placed: Vec<Vec3> = cloth
+        .topology()
+        .rest_positions
+        .iter()
+        .map(|p| {
+            if hanging {
+                Vec3::new(p.x - cx, y + p.y, p.z + 0.02 * (20.0 * -p.y).sin())
+            } else {
+                Vec3::new(p.x - cx, y, p.y - cy)
+            }
+        })
+        .collect();
+    cloth.set_positions(&placed).expect("positions");
+    cloth
+}
+
+/// One panel: the cloth's triangle edges projected with `view` (crossing ones red) and the
+/// collider's edges in grey.
+fn panel(
+    area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    title: &str,
+    cloth: &Cloth,
+    collider: Option<(&[Vec3], &[[u32; 3]])>,
+    view: fn(&Vec3) -> (f64, f64),
+    range: ((f64, f64), (f64, f64)),
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 16))
+        .margin(6)
+        .build_cartesian_2d(range.0 .0..range.0 .1, range.1 .0..range.1 .1)?;
+    if let Some((x, t)) = collider {
+        for tri in t {
+            let p: Vec<(f64, f64)> = tri
+                .iter()
+                .chain(std::iter::once(&tri[0]))
+                .map(|&i| view(&x[i as usize]))
+                .collect();
+            chart.draw_series(std::iter::once(PathElement::new(p, RGBColor(170, 170, 170))))?;
+        }
+    }
+    let x = cloth.positions();
+    let tris = &cloth.topology().triangles;
+    for tri in tris {
+        let p: Vec<(f64, f64)> = tri
+            .iter()
+            .chain(std::iter::once(&tri[0]))
+            .map(|&i| view(&x[i as usize]))
+            .collect();
+        chart.draw_series(std::iter::once(PathElement::new(p, RGBColor(30, 80, 160))))?;
+    }
+    // Crossing pairs: both triangles in red.
+    for (a, b) in crossing_pairs(x, tris) {
+        {
+            for t in [tris[a as usize], tris[b as usize]] {
+                let p: Vec<(f64, f64)> = t
+                    .iter()
+                    .chain(std::iter::once(&t[0]))
+                    .map(|&i| view(&x[i as usize]))
+                    .collect();
+                chart.draw_series(std::iter::once(PathElement::new(p, RED.stroke_width(2))))?;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn side(p: &Vec3) -> (f64, f64) {
+    (p.z, p.y)
+}
+fn front(p: &Vec3) -> (f64, f64) {
+    (p.x, p.y)
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    std::fs::create_dir_all("docs/collisions")?;
+    let floor = Collider::Plane(Plane {
+        point: Vec3::zeros(),
+        normal: Vec3::y(),
+        velocity: Vec3::zeros(),
+    });
+
+    // 1. The drop, with and without self-collision: side view at 1, 2.5 and 5 s.
+    let root = BitMapBackend::new("docs/collisions/drop.png", (1500, 900)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let rows = root.split_evenly((2, 3));
+    for (r, thickness) in [0.005, 0.0].into_iter().enumerate() {
+        let mut cloth = towel(21, 31, 0.02, 0.62, true, thickness);
+        cloth.add_collider(floor)?;
+        let mut f = 0;
+        for (k, until) in [30, 75, 150].into_iter().enumerate() {
+            while f < until {
+                cloth.step(1.0 / FPS)?;
+                f += 1;
+            }
+            let n = self_intersections(cloth.positions(), &cloth.topology().triangles);
+            let label = if thickness > 0.0 {
+                "self-collision 5 mm"
+            } else {
+                "no self-collision"
+            };
+            panel(
+                &rows[3 * r + k],
+                &format!("{label}, {:.1} s: {n} crossing pairs", f as f64 / FPS),
+                &cloth,
+                None,
+                side,
+                ((-0.35, 0.35), (-0.02, 0.65)),
+            )?;
+        }
+    }
+    root.present()?;
+
+    // 2. A towel over a turning torus: front view at 0.5, 1.5 and 3 s.
+    let (tx, tt) = torus(Vec3::zeros(), 0.12, 0.05, 48, 16);
+    let root = BitMapBackend::new("docs/collisions/torus.png", (1500, 450)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let cells = root.split_evenly((1, 3));
+    let mut cloth = towel(25, 25, 0.016, 0.08, false, 0.0);
+    let id = cloth.add_mesh_collider(&tx, &tt, None)?;
+    cloth.set_collider_friction(id, 0.5)?;
+    let mut f = 0;
+    for (k, until) in [15, 45, 90].into_iter().enumerate() {
+        let mut posed = tx.clone();
+        while f < until {
+            f += 1;
+            let a = 0.5 * f as f64 / FPS;
+            let rot = nalgebra::Rotation3::from_axis_angle(&Vec3::y_axis(), a)
+                * nalgebra::Rotation3::from_axis_angle(&Vec3::x_axis(), 0.2 * a.sin());
+            posed = tx.iter().map(|p| rot * p).collect();
+            cloth.set_mesh_collider(id, &posed, None)?;
+            cloth.step(1.0 / FPS)?;
+        }
+        let inside = fraccloth::collide::intersections::vertices_inside(cloth.positions(), &posed, &tt);
+        panel(
+            &cells[k],
+            &format!("torus mesh, {:.1} s: {inside} vertices inside", f as f64 / FPS),
+            &cloth,
+            Some((&posed, &tt)),
+            front,
+            ((-0.3, 0.3), (-0.25, 0.15)),
+        )?;
+    }
+    root.present()?;
+
+    // 3. A 4 mm bar through a hanging towel of 2 cm spacing: side view at 0.5, 1 and 2 s.
+    let root = BitMapBackend::new("docs/collisions/bar.png", (1500, 450)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let cells = root.split_evenly((1, 3));
+    let mut cloth = towel(21, 21, 0.02, 0.0, true, 0.0);
+    let top: Vec<u32> = (0..21).collect();
+    cloth.set_pinned(&top)?;
+    let (bx, bt) = bar(Vec3::new(-0.4, -0.3, 0.0), Vec3::new(0.4, -0.3, 0.0), 0.002, 1);
+    let at = |z: f64| -> Vec<Vec3> { bx.iter().map(|p| p + Vec3::new(0.0, 0.0, z)).collect() };
+    let id = cloth.add_mesh_collider(&at(0.1), &bt, None)?;
+    let (mut z, mut f) = (0.1, 0);
+    for (k, until) in [15, 30, 60].into_iter().enumerate() {
+        while f < until {
+            f += 1;
+            z -= 0.1 / FPS;
+            cloth.set_mesh_collider(id, &at(z), None)?;
+            cloth.step(1.0 / FPS)?;
+        }
+        let posed = at(z);
+        panel(
+            &cells[k],
+            &format!("4 mm bar, {:.1} s (bar at z = {z:.2} m)", f as f64 / FPS),
+            &cloth,
+            Some((&posed, &bt)),
+            side,
+            ((-0.2, 0.15), (-0.45, 0.02)),
+        )?;
+    }
+    root.present()?;
+    println!("wrote docs/collisions/drop.png, torus.png, bar.png");
+    Ok(())
+}
