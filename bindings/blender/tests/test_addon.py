@@ -335,4 +335,4 @@ def test_an_armature_animated_mesh_collider_pushes_the_cloth(addon, tmp_path):
         closest = min(closest, d.min())
         rose = max(rose, x[:, 2].max())
     assert closest < margin + 1e-3, f"the box never reached the cloth: {closest}"
-    assert lo[2] > 0.2 and rose > 0.2 + 0.05, f"the box lifted the cloth above its rest height: {rose}"
+    assert lo[2] > 0.19 and rose > 0.2 + 0.05, f"the box lifted the cloth above its rest height: {rose}"
