@@ -6,7 +6,8 @@
 //! simulated second, the ratio, substeps a frame, self-collision looks a frame and the most
 //! crossing triangle pairs at any frame.
 //!
-//! `cargo run --release --example collision_cost -- [rounds]` (default 3)
+//! `cargo run --release --example collision_cost -- [rounds] [case]` (default 3 rounds, every
+//! case; `case` 0-3 runs one)
 
 use std::time::Instant;
 
@@ -109,7 +110,11 @@ fn main() {
         ),
         ("61x41 0.5 Hz 4 cm, 10k-tri mesh", towel(0.5, 0.04), 0.0, true),
     ];
-    for (name, base, thickness, mesh) in cases {
+    let only: Option<usize> = std::env::args().nth(2).and_then(|s| s.parse().ok());
+    for (k, (name, base, thickness, mesh)) in cases.into_iter().enumerate() {
+        if only.is_some_and(|o| o != k) {
+            continue;
+        }
         let with = Case {
             thickness,
             mesh,

@@ -11,7 +11,7 @@ use crate::Vec3;
 
 /// How far (in collision margins) a mesh collider's candidates reach beyond the margin before
 /// a cloth vertex looks again (`collide/mesh.rs`).
-const MESH_SKIN_MARGINS: f64 = 2.0;
+const MESH_SKIN_MARGINS: f64 = 0.5;
 /// Deepest penetration a mesh contact pushes with, in margins: a vertex found deep inside a
 /// closed mesh is pushed out at a bounded rate instead of being launched.
 const MESH_MAX_DEPTH_MARGINS: f64 = 3.0;

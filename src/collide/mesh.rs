@@ -66,6 +66,8 @@ struct Candidates {
     vertex_at: Vec<Vec3>,
     triangle: Vec<Vec<u32>>,
     triangle_at: Vec<Vec3>,
+    /// Each cloth vertex's nearest triangle at the last substep (tested first).
+    nearest: Vec<u32>,
     /// Every list must be looked up again (the mesh moved, or the cloth changed).
     stale: bool,
 }
@@ -351,16 +353,28 @@ impl MeshCollider {
         out: &mut Vec<Contact>,
     ) {
         self.refresh_candidates(x, cloth_triangles, margin, skin);
+        self.cache.nearest.resize(x.len(), NONE);
         let friction = self.friction;
         // Cloth vertex against the nearest mesh triangle.
         for (i, cands) in self.cache.vertex.iter().enumerate() {
             let p = &x[i];
             let mut best: Option<(f64, Vec3, u32, [f64; 3])> = None;
-            for &t in cands {
+            // The last nearest first; then only triangles whose swept box is nearer than the
+            // best so far (the box holds the triangle at every fraction of the call).
+            let hint = self.cache.nearest.get(i).copied().filter(|t| cands.contains(t));
+            for &t in hint.iter().chain(cands.iter().filter(|&&t| Some(t) != hint)) {
+                if let Some(b) = &best {
+                    if self.tri_boxes[t as usize].distance2(p) >= b.0 * b.0 {
+                        continue;
+                    }
+                }
                 let (d, dir, w) = self.probe(t, f, p);
                 if best.is_none_or(|b| d.abs() < b.0.abs()) {
                     best = Some((d, dir, t, w));
                 }
+            }
+            if let (Some(b), Some(slot)) = (&best, self.cache.nearest.get_mut(i)) {
+                *slot = b.2;
             }
             if let Some((d, dir, t, w)) = best {
                 if d < margin {
@@ -380,8 +394,12 @@ impl MeshCollider {
         for (t, cands) in self.cache.triangle.iter().enumerate() {
             let tri = cloth_triangles[t];
             let [a, b, c] = tri.map(|i| x[i as usize]);
+            let near = Aabb::of([&a, &b, &c]).inflated(margin);
             for &m in cands {
                 let q = self.at(m, f);
+                if !near.contains(&q) {
+                    continue;
+                }
                 let w = closest_on_triangle(&q, &a, &b, &c);
                 // Only where the mesh vertex faces the triangle's inside: at an edge or a corner
                 // the neighbouring triangle or the vertex contact takes it.

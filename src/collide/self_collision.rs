@@ -5,8 +5,8 @@
 //! rebuilt) and kept in a list while they are within `thickness + skin` of each other; the
 //! list is looked up again once some vertex has moved `skin / 2` since the last look (a Verlet
 //! list, `skin = thickness`). No pair outside the list can come within the thickness before
-//! the next look. Pairs nearer than the thickness at rest (neighbours of a fine mesh) are left
-//! out, so a flat cloth has no pairs at all.
+//! the next look. Pairs nearer than twice the thickness at rest (neighbours of a fine mesh)
+//! are left out, found once, so a flat cloth has no pairs at all.
 //!
 //! **Sides.** Each pair remembers which side of the triangle (of the two edges) it was on when
 //! it entered the list and keeps it for as long as it stays; a vertex pushed through a
@@ -23,6 +23,12 @@ use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
 use super::geometry::{closest_on_segments, closest_on_triangle};
 use crate::Vec3;
+
+/// The skin of the pair list, in thicknesses: pairs within `(1 + SKIN)` thicknesses are kept,
+/// and the list is looked up again when the cloth has deformed by half the skin.
+pub const SKIN: f64 = 1.0;
+/// Pairs nearer than this many thicknesses at rest are never tested (neighbours).
+pub const EXCLUDED: f64 = 2.0;
 
 /// A remembered pair: the two elements and the side, +1 or -1 (0: not known yet, until the
 /// vertex first comes over the triangle's face, or the edges' closest points first lie inside
@@ -45,6 +51,88 @@ pub struct SelfCollision {
     pub(crate) edge_edge: Vec<Pair>,
     /// How many times the list was looked up again (for benchmarks).
     pub looks: u64,
+    /// Pairs never tested: nearer than twice the thickness at rest (neighbours), per vertex and
+    /// per edge, for the thickness they were found at.
+    excluded: Exclusions,
+}
+
+/// Each vertex's (edge's) excluded triangles (edges), sorted, as compressed rows.
+#[derive(Clone, Debug, Default)]
+struct Exclusions {
+    radius: f64,
+    vt_start: Vec<u32>,
+    vt: Vec<u32>,
+    ee_start: Vec<u32>,
+    ee: Vec<u32>,
+}
+
+impl Exclusions {
+    /// The pairs nearer than `radius` at the rest positions `rest`.
+    fn new(rest: &[Vec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], radius: f64) -> Exclusions {
+        let boxes: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize])).inflated(radius))
+            .collect();
+        let bvh = Bvh::build(&boxes);
+        let (mut vt_start, mut vt) = (vec![0u32], Vec::new());
+        for p in 0..rest.len() as u32 {
+            let first = vt.len();
+            let q = Aabb {
+                min: rest[p as usize],
+                max: rest[p as usize],
+            };
+            bvh.overlapping(&q, |t| {
+                let tri = &triangles[t as usize];
+                if tri.contains(&p) || vertex_triangle(rest, p, tri).0 < radius {
+                    vt.push(t);
+                }
+            });
+            vt[first..].sort_unstable();
+            vt_start.push(vt.len() as u32);
+        }
+        let boxes: Vec<Aabb> = edges
+            .iter()
+            .map(|e| Aabb::of(e.iter().map(|&i| &rest[i as usize])).inflated(0.5 * radius))
+            .collect();
+        let bvh = Bvh::build(&boxes);
+        let (mut ee_start, mut ee) = (vec![0u32], Vec::new());
+        for (e, edge) in edges.iter().enumerate() {
+            let first = ee.len();
+            bvh.overlapping(&boxes[e], |f| {
+                let other = &edges[f as usize];
+                if f as usize > e
+                    && (edge.iter().any(|v| other.contains(v)) || edge_edge(rest, edge, other).0 < radius)
+                {
+                    ee.push(f);
+                }
+            });
+            ee[first..].sort_unstable();
+            ee_start.push(ee.len() as u32);
+        }
+        Exclusions {
+            radius,
+            vt_start,
+            vt,
+            ee_start,
+            ee,
+        }
+    }
+
+    fn vertex_excludes(&self, p: u32, t: u32) -> bool {
+        let (a, b) = (
+            self.vt_start[p as usize] as usize,
+            self.vt_start[p as usize + 1] as usize,
+        );
+        self.vt[a..b].binary_search(&t).is_ok()
+    }
+
+    fn edge_excludes(&self, e: u32, f: u32) -> bool {
+        let (a, b) = (
+            self.ee_start[e as usize] as usize,
+            self.ee_start[e as usize + 1] as usize,
+        );
+        self.ee[a..b].binary_search(&f).is_ok()
+    }
 }
 
 /// The unique edges of some triangles, `[i, j]` with i < j, sorted.
@@ -110,13 +198,9 @@ impl SelfCollision {
         friction: f64,
         out: &mut Vec<Contact>,
     ) {
-        let skin = thickness;
-        let moved = self.looked_at.len() != x.len()
-            || x.iter()
-                .zip(&self.looked_at)
-                .any(|(p, q)| (p - q).norm_squared() > 0.25 * skin * skin);
-        if moved {
-            self.look(x, rest, triangles, thickness + skin, thickness);
+        let skin = SKIN * thickness;
+        if self.deformed(x, skin) {
+            self.look(x, rest, triangles, thickness + skin, EXCLUDED * thickness);
         }
         let cap = 2.0 * thickness;
         for (p, t, s) in self.vertex_triangle.iter_mut().map(|q| (q.0, q.1, &mut q.2)) {
@@ -187,10 +271,30 @@ impl SelfCollision {
         }
     }
 
+    /// Whether the cloth at `x` may have brought a pair from beyond `thickness + skin` to
+    /// within `thickness` since the last look: some vertex moved more than `skin / 2` relative
+    /// to the centre of all the displacements' box. Two points' distance changes by at most
+    /// the difference of their displacements, at most twice that, so a swing that carries the
+    /// whole cloth along does not look again for the carrying.
+    fn deformed(&self, x: &[Vec3], skin: f64) -> bool {
+        if self.looked_at.len() != x.len() {
+            return true;
+        }
+        let mut b = Aabb::empty();
+        for (p, q) in x.iter().zip(&self.looked_at) {
+            b.grow(&(p - q));
+        }
+        let c = 0.5 * (b.min + b.max);
+        let limit = 0.25 * skin * skin;
+        x.iter()
+            .zip(&self.looked_at)
+            .any(|(p, q)| (p - q - c).norm_squared() > limit)
+    }
+
     /// Looks the pairs up again at positions `x`: every pair within `reach`, not neighbours
-    /// (sharing a vertex, or nearer than `thickness` at rest), with its side from the old list
+    /// ([`Exclusions`]: nearer than `reach` at rest), with its side from the old list
     /// or, when new, from where it is now.
-    fn look(&mut self, x: &[Vec3], rest: &[Vec3], triangles: &[[u32; 3]], reach: f64, thickness: f64) {
+    fn look(&mut self, x: &[Vec3], rest: &[Vec3], triangles: &[[u32; 3]], reach: f64, excluded_within: f64) {
         self.looks += 1;
         self.looked_at.clear();
         self.looked_at.extend_from_slice(x);
@@ -213,6 +317,10 @@ impl SelfCollision {
             self.tri_bvh = Bvh::build(&self.tri_boxes);
             self.edge_bvh = Bvh::build(&self.edge_boxes);
         }
+        if self.excluded.radius != excluded_within || self.excluded.vt_start.len() != x.len() + 1 {
+            self.excluded = Exclusions::new(rest, triangles, &self.edges, excluded_within);
+        }
+        let excluded = &self.excluded;
         let old_vt = std::mem::take(&mut self.vertex_triangle);
         let old_ee = std::mem::take(&mut self.edge_edge);
         let remembered = |old: &[Pair], a: u32, b: u32| {
@@ -220,55 +328,76 @@ impl SelfCollision {
                 .ok()
                 .map(|k| old[k].2)
         };
-        let mut vt = Vec::new();
-        for p in 0..x.len() as u32 {
-            let q = Aabb {
-                min: x[p as usize],
-                max: x[p as usize],
-            };
-            self.tri_bvh.overlapping(&q, |t| {
-                let tri = &triangles[t as usize];
-                if tri.contains(&p) {
-                    return;
-                }
-                let (d, w, r) = vertex_triangle(x, p, tri);
-                if d >= reach || vertex_triangle(rest, p, tri).0 < thickness {
-                    return;
-                }
-                let s = remembered(&old_vt, p, t).unwrap_or_else(|| {
-                    // Known only where the vertex is over the face (beside it, the plane's side
-                    // says nothing): else 0, set when it first comes over the face.
-                    let [a, b, c] = tri.map(|i| x[i as usize]);
-                    if w.iter().all(|&wk| wk > 0.0) {
-                        side(r.dot(&(b - a).cross(&(c - a))))
-                    } else {
-                        0
+        // Vertex by vertex and edge by edge, in parallel chunks, in order.
+        use rayon::prelude::*;
+        let par = crate::parallel::worth_it_heavy(x.len());
+        let chunk = 256usize;
+        let tri_bvh = &self.tri_bvh;
+        let vertex_pairs = |lo: usize| -> Vec<Pair> {
+            let mut out = Vec::new();
+            for p in lo as u32..(lo + chunk).min(x.len()) as u32 {
+                let q = Aabb {
+                    min: x[p as usize],
+                    max: x[p as usize],
+                };
+                tri_bvh.overlapping(&q, |t| {
+                    if excluded.vertex_excludes(p, t) {
+                        return;
                     }
+                    let tri = &triangles[t as usize];
+                    let (d, w, r) = vertex_triangle(x, p, tri);
+                    if d >= reach {
+                        return;
+                    }
+                    let s = remembered(&old_vt, p, t).unwrap_or_else(|| {
+                        // Known only where the vertex is over the face (beside it, the plane's
+                        // side says nothing): else 0, set when it first comes over the face.
+                        let [a, b, c] = tri.map(|i| x[i as usize]);
+                        if w.iter().all(|&wk| wk > 0.0) {
+                            side(r.dot(&(b - a).cross(&(c - a))))
+                        } else {
+                            0
+                        }
+                    });
+                    out.push((p, t, s));
                 });
-                vt.push((p, t, s));
-            });
-        }
+            }
+            out
+        };
+        let starts: Vec<usize> = (0..x.len()).step_by(chunk).collect();
+        let mut vt: Vec<Pair> = if par {
+            starts.par_iter().flat_map_iter(|&lo| vertex_pairs(lo)).collect()
+        } else {
+            starts.iter().flat_map(|&lo| vertex_pairs(lo)).collect()
+        };
         vt.sort_unstable();
-        let mut ee = Vec::new();
-        for (e, edge) in self.edges.iter().enumerate() {
-            let e = e as u32;
-            self.edge_bvh.overlapping(&self.edge_boxes[e as usize], |f| {
-                if f <= e {
-                    return;
-                }
-                let other = &self.edges[f as usize];
-                if edge.iter().any(|v| other.contains(v)) {
-                    return;
-                }
-                let (d, a, b, r, n) = edge_edge(x, edge, other);
-                if d >= reach || edge_edge(rest, edge, other).0 < thickness {
-                    return;
-                }
-                let interior = a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0;
-                let s = remembered(&old_ee, e, f).unwrap_or(if interior { side(r.dot(&n)) } else { 0 });
-                ee.push((e, f, s));
-            });
-        }
+        let (edges, edge_bvh, edge_boxes) = (&self.edges, &self.edge_bvh, &self.edge_boxes);
+        let edge_pairs = |lo: usize| -> Vec<Pair> {
+            let mut out = Vec::new();
+            for e in lo as u32..(lo + chunk).min(edges.len()) as u32 {
+                let edge = &edges[e as usize];
+                edge_bvh.overlapping(&edge_boxes[e as usize], |f| {
+                    if f <= e || excluded.edge_excludes(e, f) {
+                        return;
+                    }
+                    let other = &edges[f as usize];
+                    let (d, a, b, r, n) = edge_edge(x, edge, other);
+                    if d >= reach {
+                        return;
+                    }
+                    let interior = a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0;
+                    let s = remembered(&old_ee, e, f).unwrap_or(if interior { side(r.dot(&n)) } else { 0 });
+                    out.push((e, f, s));
+                });
+            }
+            out
+        };
+        let starts: Vec<usize> = (0..edges.len()).step_by(chunk).collect();
+        let mut ee: Vec<Pair> = if par {
+            starts.par_iter().flat_map_iter(|&lo| edge_pairs(lo)).collect()
+        } else {
+            starts.iter().flat_map(|&lo| edge_pairs(lo)).collect()
+        };
         ee.sort_unstable();
         self.vertex_triangle = vt;
         self.edge_edge = ee;

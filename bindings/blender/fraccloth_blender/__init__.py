@@ -4,7 +4,7 @@ Physics > fraccloth panel (Properties editor, Physics tab). "Bake underwater clo
 - the active mesh object is the cloth (triangles and quads; apply its scale first);
 - vertices of the vertex group named in "Pin group" are pinned with their group weight
   (1 = held in place, less = a soft pin);
-- every other selected object is a collider. "Collider shape" Mesh (the default) uses each mesh
+- every other selected mesh object is a collider (cameras, lights and empties are not). "Collider shape" Mesh (the default) uses each mesh
   object as it is: its evaluated mesh every frame (armatures, shape keys, modifiers), closed
   meshes with an inside the cloth is pushed out of. Fitted (faster) fits a shape instead: a flat
   object (one dimension near zero) is an infinite plane through its origin along its local Z
@@ -172,7 +172,7 @@ class FracclothSettings(bpy.types.PropertyGroup):
     collision_margin: bpy.props.FloatProperty(name="Collision margin", description="Distance from a collider at which the cloth is pushed away, m", default=0.01, min=0.0, soft_max=0.05)
     collider_shape: bpy.props.EnumProperty(name="Collider shape", items=COLLIDER_ITEMS, default="MESH",
                                            description="How collider objects are seen: their own mesh every frame, or a fitted sphere, capsule or plane (faster)")
-    self_collision: bpy.props.FloatProperty(name="Self-collision", description="Distance the cloth keeps from itself, m (0 = off); keep it below the spacing of its vertices", default=0.0, min=0.0, soft_max=0.02, precision=4)
+    self_collision: bpy.props.FloatProperty(name="Self-collision", description="Distance the cloth keeps from itself, m (0 = off); a few mm for a cloth of 1-2 cm spacing", default=0.0, min=0.0, soft_max=0.02, precision=4)
     self_friction: bpy.props.FloatProperty(name="Self friction", description="How much the cloth grips itself where it touches (0 = slippery)", default=0.0, min=0.0, soft_max=1.0)
     cache_format: bpy.props.EnumProperty(name="Format", items=FORMAT_ITEMS, default="PC2")
     cache_path: bpy.props.StringProperty(name="Cache file", subtype="FILE_PATH", default="",
@@ -207,8 +207,6 @@ def collider_specs_for(s, others):
     for o in others:
         if o.type == "MESH" and len(o.data.polygons) > 0:
             specs.append(_mesh_spec(o))
-        else:
-            specs.extend(_world_specs([o]))
     return specs
 
 
@@ -221,6 +219,8 @@ def _world_specs(others):
     radius is half its largest dimension."""
     specs = []
     for o in others:
+        if o.type != "MESH":
+            continue  # a camera, a light, an empty: selected, but not a collider
         dims = o.dimensions
         center = o.matrix_world.translation.copy()
         order = sorted(range(3), key=lambda k: dims[k])
@@ -364,6 +364,10 @@ def build_cloth(context, obj, others):
         # refused frame with more): FC_MAX_SUBSTEP_AUTO.
         desc.max_substep = fraccloth.MAX_SUBSTEP_AUTO
     cloth = fraccloth.Cloth.mesh(desc, pos.astype(np.float32), faces)
+    if s.pin_group and obj.vertex_groups.get(s.pin_group) is None:
+        names = ", ".join(g.name for g in obj.vertex_groups) or "none"
+        raise ValueError(f"{obj.name}: no vertex group named '{s.pin_group}' for the pins (its groups: {names}); "
+                         "pick one in Pin group, or clear it for a cloth with no pins")
     w = pin_weights(obj, s.pin_group)
     if w.any():
         cloth.set_pin_weights(w)
@@ -472,10 +476,18 @@ class BakeJob:
         self.done = 0
         self.cache = None
         self.return_to = scene.frame_current
-        # Remove an earlier cache modifier first, so the rest shape is the mesh's own.
-        for m in list(obj.modifiers):
-            if m.type == "MESH_CACHE" and m.name == "fraccloth":
-                obj.modifiers.remove(m)
+        # The new bake goes to a file of its own; an earlier bake (its cache modifier, hidden
+        # while this one reads the mesh, and its file) stays until this one is complete, so a
+        # refused or cancelled re-bake loses nothing.
+        self.partial = self.path + ".baking"
+        # Check the setup before anything is written: the cloth is built here (and again by the
+        # simulation); a bad setup raises now.
+        scene.frame_set(scene.frame_start)
+        try:
+            build_cloth(context, obj, others)
+        except Exception:
+            scene.frame_set(self.return_to)
+            raise
         self.frames_left = simulate(context, obj, others)
 
     def step(self):
@@ -484,7 +496,7 @@ class BakeJob:
         scene = self.context.scene
         f, cloth, local = next(self.frames_left)
         if self.cache is None:
-            self.cache = fraccloth.Cache(self.path, self.format, cloth, float(scene.frame_start), self.fps, self.frames)
+            self.cache = fraccloth.Cache(self.partial, self.format, cloth, float(scene.frame_start), self.fps, self.frames)
         self.cache.write_positions(local)
         self.done += 1
         if self.done < self.frames:
@@ -493,6 +505,11 @@ class BakeJob:
         self.cache.close()
         self.cache = None
         scene.frame_set(self.return_to)
+        # Complete: the new cache replaces the earlier bake.
+        for m in list(self.obj.modifiers):
+            if m.type == "MESH_CACHE" and m.name == "fraccloth":
+                self.obj.modifiers.remove(m)
+        os.replace(self.partial, self.path)
         s = self.obj.fraccloth
         mod = self.obj.modifiers.new("fraccloth", "MESH_CACHE")
         mod.cache_format = s.cache_format
@@ -513,8 +530,8 @@ class BakeJob:
             except fraccloth.Error:
                 pass
             self.cache = None
-        if os.path.exists(self.path):
-            os.remove(self.path)
+        if os.path.exists(self.partial):
+            os.remove(self.partial)
         self.context.scene.frame_set(self.return_to)
 
 

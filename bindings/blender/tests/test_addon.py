@@ -203,6 +203,7 @@ def test_two_cloths_bake_to_their_own_caches(addon, tmp_path):
     bpy.ops.mesh.primitive_grid_add(x_subdivisions=6, y_subdivisions=4, size=0.2, location=(1.0, 0.0, 0.3))
     second = bpy.context.active_object
     second.name = "Second towel"
+    second.fraccloth.pin_group = ""  # no pins: it falls
     for o in bpy.context.selected_objects:
         o.select_set(False)
     results = []
@@ -228,9 +229,9 @@ def test_a_cancelled_bake_leaves_no_cache(addon, tmp_path):
     job = addon.BakeJob(bpy.context, cloth, others)
     for _ in range(10):
         assert job.step() is False
-    assert Path(job.path).exists()  # partly written
+    assert Path(job.partial).exists() and not Path(job.path).exists()  # partly written, aside
     job.cancel()
-    assert not Path(job.path).exists()
+    assert not Path(job.partial).exists() and not Path(job.path).exists()
     assert cloth.modifiers.get("fraccloth") is None
     assert scene.frame_current == 5
     # Run to the end, the same job attaches a complete cache.
@@ -336,3 +337,40 @@ def test_an_armature_animated_mesh_collider_pushes_the_cloth(addon, tmp_path):
         rose = max(rose, x[:, 2].max())
     assert closest < margin + 1e-3, f"the box never reached the cloth: {closest}"
     assert lo[2] > 0.19 and rose > 0.2 + 0.05, f"the box lifted the cloth above its rest height: {rose}"
+
+
+def test_a_refused_rebake_keeps_the_good_bake(addon, tmp_path):
+    """After a good bake, a Subdivision modifier makes the setup invalid: the re-bake is refused
+    with the reason, and the first bake's modifier and cache file are still there."""
+    cloth, _ = make_scene(tmp_path, "PC2")
+    assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+    path = Path(cloth.modifiers["fraccloth"].filepath)
+    before = path.read_bytes()
+    sub = cloth.modifiers.new("sub", "SUBSURF")
+    with pytest.raises(RuntimeError, match="vertex count"):
+        bpy.ops.fraccloth.bake()
+    assert cloth.modifiers.get("fraccloth") is not None
+    assert path.exists() and path.read_bytes() == before
+    assert not Path(str(path) + ".baking").exists()
+    cloth.modifiers.remove(sub)
+
+
+def test_select_all_leaves_camera_and_light_out(addon, tmp_path):
+    """Select-all with a camera and a light in the scene: they are not colliders, the bake works."""
+    cloth, others = make_scene(tmp_path, "PC2")
+    bpy.ops.object.camera_add(location=(0.0, -1.0, 0.3))
+    bpy.ops.object.light_add(type="POINT", location=(0.5, 0.5, 1.0))
+    for o in bpy.context.scene.objects:
+        o.select_set(True)
+    bpy.context.view_layer.objects.active = cloth
+    selected = [o for o in bpy.context.selected_objects if o is not cloth]
+    assert len(addon._world_specs(selected)) == len(others)
+    assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+
+
+def test_a_missing_pin_group_is_an_error(addon, tmp_path):
+    cloth, _ = make_scene(tmp_path, "PC2")
+    cloth.fraccloth.pin_group = "pinz"
+    with pytest.raises(RuntimeError, match="no vertex group named 'pinz'.*pins"):
+        bpy.ops.fraccloth.bake()
+    assert cloth.modifiers.get("fraccloth") is None
