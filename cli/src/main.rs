@@ -1,10 +1,10 @@
 //! `fraccloth`: bakes a built-in underwater cloth scene to a PC2 point cache plus an OBJ rest
 //! mesh that Blender, Maya or 3ds Max can load (Mesh Cache modifier), with preview pictures: a
 //! contact sheet (PNG) and an animated GIF. `--compare` bakes one scene with the paper's three
-//! regular models, its fractional preset and the accurate default side by side, and measures
-//! the look of each (`fraccloth::look`).
+//! regular models, its fractional preset, the fractional model with the accurate history and
+//! the underwater preset side by side, and measures the look of each (`fraccloth::look`).
 //!
-//! With no arguments it bakes the fractional `swing` scene (61 x 41, 8 s) into `out/`.
+//! With no arguments it bakes the underwater `swing` scene (61 x 41, 12 s) into `out/`.
 //! `fraccloth look CACHE --rest REST.obj` measures the look of any point cache.
 
 // Picture loops walk several arrays with one index; that reads better than zips.
@@ -134,8 +134,9 @@ struct Args {
     /// Skip the preview pictures.
     #[arg(long)]
     no_preview: bool,
-    /// Bake the scene with five models side by side (three regular, the paper's fractional
-    /// preset, the accurate default) into one comparison sheet, and measure their look.
+    /// Bake the scene with six models side by side (three regular, the paper's fractional
+    /// preset, the fractional model with the accurate history, the underwater preset) into one
+    /// comparison sheet, and measure their look.
     #[arg(long)]
     compare: bool,
     /// Also write every frame as an OBJ (NAME_0001.obj, ...).

@@ -148,6 +148,8 @@ pub struct TurningScratch {
     faces: Vec<Vec3>,
     rates: Vec<Vec3>,
     patches: Vec<Vec3>,
+    /// Each face's gradients at its corners b and c (a's is minus their sum).
+    gradients: Vec<[Vec3; 2]>,
 }
 
 /// The unit normal of every vertex and how much of its patch's rest area faces along it.
@@ -209,6 +211,7 @@ pub fn turning_forces(
         faces,
         rates,
         patches,
+        gradients,
     } = scratch;
     faces.clear();
     rates.clear();
@@ -234,16 +237,19 @@ pub fn turning_forces(
         // w_i, kept in `patches` (its area vector is no longer needed).
         patches.push((k * av * scale) * v[i]);
     }
-    // W of every face, then each vertex gathers its faces' gradients (no scatter).
-    for (f, t) in faces.iter_mut().zip(triangles) {
-        *f = t.iter().map(|&i| patches[i as usize]).sum();
-    }
+    // W of every face and its gradients at its corners once, then each vertex gathers its
+    // faces' (no scatter).
+    gradients.clear();
+    gradients.extend(triangles.iter().map(|t| {
+        let w: Vec3 = t.iter().map(|&i| patches[i as usize]).sum();
+        let [a, b, c] = t.map(|i| i as usize);
+        let (e1, e2) = (x[b] - x[a], x[c] - x[a]);
+        [e2.cross(&w), w.cross(&e1)]
+    }));
     for (i, o) in out.iter_mut().enumerate() {
         for &t in vertex_triangles.row(i) {
-            let [a, b, c] = triangles[t as usize];
-            let w = faces[t as usize];
-            let (e1, e2) = (x[b as usize] - x[a as usize], x[c as usize] - x[a as usize]);
-            let (gb, gc) = (e2.cross(&w), w.cross(&e1));
+            let [_, b, c] = triangles[t as usize];
+            let [gb, gc] = gradients[t as usize];
             *o += if i == b as usize {
                 gb
             } else if i == c as usize {

@@ -640,7 +640,7 @@ class Cloth:
         _check(library.fc_cloth_set_collider_friction(self._h, id, friction))
 
     def remove_collider(self, id: int) -> None:
-        """Removes collider ``id``; its id is not reused."""
+        """Removes collider ``id`` (any kind, meshes too); its id may be reused by a later add."""
         _check(library.fc_cloth_remove_collider(self._h, id))
 
     def write_obj(self, path: Union[str, os.PathLike]) -> None:
