@@ -27,6 +27,9 @@ use crate::Vec3;
 /// The skin of the pair list, in thicknesses: pairs within `(1 + SKIN)` thicknesses are kept,
 /// and the list is looked up again when the cloth has deformed by half the skin.
 pub const SKIN: f64 = 1.0;
+/// Edges whose directions make a smaller sine than this are near parallel: their side is not
+/// kept relative to `e x f`.
+const PARALLEL_SINE: f64 = 0.05;
 /// Pairs nearer than this many thicknesses at rest are never tested (neighbours).
 pub const EXCLUDED: f64 = 2.0;
 
@@ -206,14 +209,19 @@ impl SelfCollision {
         for (p, t, s) in self.vertex_triangle.iter_mut().map(|q| (q.0, q.1, &mut q.2)) {
             let tri = &triangles[t as usize];
             let (d, w, r) = vertex_triangle(x, p, tri);
-            if d >= thickness {
-                continue;
-            }
             let [a, b, c] = tri.map(|i| x[i as usize]);
             let interior = w.iter().all(|&wk| wk > 0.0);
             let Some(normal) = (b - a).cross(&(c - a)).try_normalize(0.0) else {
                 continue;
             };
+            if d >= thickness {
+                // Apart: nothing crosses, so the side is learnt afresh (a triangle that turned
+                // over).
+                if interior {
+                    *s = side(r.dot(&normal));
+                }
+                continue;
+            }
             if *s == 0 && interior {
                 // First over the triangle's face: the side it comes from is known now.
                 *s = side(r.dot(&normal));
@@ -244,18 +252,40 @@ impl SelfCollision {
         for (e, f, s) in self.edge_edge.iter_mut().map(|p| (p.0, p.1, &mut p.2)) {
             let (ee, ff) = (&self.edges[e as usize], &self.edges[f as usize]);
             let (d, a, b, r, n) = edge_edge(x, ee, ff);
-            if d >= thickness || !(a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0) {
+            if !(a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0) {
                 continue;
             }
-            let Some(n) = n.try_normalize(1e-12) else {
+            // The side is kept relative to e x f, which means something only while the edges
+            // are not near parallel (and flips as they turn through parallel).
+            let lengths = (x[ee[1] as usize] - x[ee[0] as usize]).norm()
+                * (x[ff[1] as usize] - x[ff[0] as usize]).norm();
+            let n_len = n.norm();
+            let conditioned = n_len > PARALLEL_SINE * lengths;
+            if d >= thickness {
+                // Apart: nothing crosses, so the side is learnt afresh (edges that turned).
+                if conditioned {
+                    *s = side(r.dot(&n));
+                }
+                continue;
+            }
+            let (dist, dir) = if conditioned {
+                let n = n / n_len;
+                if *s == 0 {
+                    *s = side(r.dot(&n));
+                }
+                let side_n = f64::from(*s) * n;
+                if r.dot(&side_n) <= 0.0 {
+                    (-d, side_n)
+                } else {
+                    (d, r / d)
+                }
+            } else if d > 1e-12 {
+                // Near parallel: pushed apart along the line between them (the vertex-triangle
+                // pairs of their triangles keep the sides).
+                (d, r / d)
+            } else {
                 continue;
             };
-            if *s == 0 {
-                *s = side(r.dot(&n));
-            }
-            let side_n = f64::from(*s) * n;
-            let along = r.dot(&side_n);
-            let (dist, dir) = if along <= 0.0 { (-d, side_n) } else { (d, r / d) };
             if dist >= thickness {
                 continue;
             }
