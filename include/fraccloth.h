@@ -394,7 +394,7 @@ typedef struct {
   double added_mass_coefficient;
   /**
    * Self-collision: the distance the cloth keeps from itself, m (0 = off, the default).
-   * Points nearer than twice this at rest (neighbours) are not tested: a few millimetres
+   * Points nearer than 2.2 times this at rest (neighbours) are not tested: a few millimetres
    * for a cloth of 1-2 cm spacing.
    * No vertex moves more than half of it in one substep (a faster one is slowed to that).
    * See docs/collisions.md.

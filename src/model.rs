@@ -60,7 +60,7 @@ pub struct Model {
     /// Distance from a collider surface below which the repulsion acts, m.
     pub collision_margin: f64,
     /// Self-collision: the distance the cloth keeps from itself, m (0 = off, and costs
-    /// nothing). Pairs nearer than twice this at rest (neighbours) are not tested
+    /// nothing). Pairs nearer than 2.2 times this at rest (neighbours) are not tested
     /// (`collide/self_collision.rs`).
     pub self_collision_thickness: f64,
     /// Coulomb friction coefficient of the cloth against itself (>= 0).

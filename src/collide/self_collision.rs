@@ -5,7 +5,7 @@
 //! rebuilt) and kept in a list while they are within `thickness + skin` of each other; the
 //! list is looked up again once some vertex has moved `skin / 2` since the last look (a Verlet
 //! list, `skin = thickness`). No pair outside the list can come within the thickness before
-//! the next look. Pairs nearer than twice the thickness at rest (neighbours of a fine mesh)
+//! the next look. Pairs nearer than 2.2 thicknesses at rest (neighbours of a fine mesh)
 //! are left out, found once, so a flat cloth has no pairs at all.
 //!
 //! **Sides.** Each pair remembers which side of the triangle (of the two edges) it was on when
@@ -31,7 +31,7 @@ pub const SKIN: f64 = 1.0;
 /// kept relative to `e x f`.
 const PARALLEL_SINE: f64 = 0.05;
 /// Pairs nearer than this many thicknesses at rest are never tested (neighbours).
-pub const EXCLUDED: f64 = 2.0;
+pub const EXCLUDED: f64 = 2.2;
 
 /// A remembered pair: the two elements and the side, +1 or -1 (0: not known yet, until the
 /// vertex first comes over the triangle's face, or the edges' closest points first lie inside
@@ -54,7 +54,7 @@ pub struct SelfCollision {
     pub(crate) edge_edge: Vec<Pair>,
     /// How many times the list was looked up again (for benchmarks).
     pub looks: u64,
-    /// Pairs never tested: nearer than twice the thickness at rest (neighbours), per vertex and
+    /// Pairs never tested: nearer than 2.2 thicknesses at rest (neighbours), per vertex and
     /// per edge, for the thickness they were found at.
     excluded: Exclusions,
 }
