@@ -2,7 +2,7 @@
 //! (a mesh's triangles, a cloth's edges), refitted in linear time when they move, queried for
 //! every item whose box overlaps a box, or for the nearest item to a point.
 //!
-//! Median split on the longest axis of the centroids, at most [`LEAF`] items a leaf; nodes are
+//! Median split on the longest axis of the centroids, at most four items a leaf; nodes are
 //! stored parent before children, so a refit is one backward sweep.
 
 use crate::Vec3;
