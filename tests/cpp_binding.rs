@@ -135,3 +135,22 @@ fn the_wrapper_covers_the_whole_abi_and_builds_with_strict_warnings() {
     assert!(out.contains("tour ok"), "{out}");
     assert_eq!(line(&out, "default width"), ["61"]);
 }
+
+/// The engine example: the cloth on a simulation thread, a render thread reading a double
+/// buffer, one tick refused on purpose. The renderer never sees a torn or older frame, the
+/// refused tick changes nothing (the run equals one without it but for that tick's pins), and
+/// the result does not depend on the render thread's timing (two runs agree bit for bit).
+#[test]
+fn engine_example_survives_a_refused_tick_and_never_shows_a_torn_frame() {
+    let dir = scratch_dir("cpp-engine");
+    let exe = common::compile_cpp_with("engine.cpp", &["-pthread", "-Wshadow", "-Wconversion"], &dir);
+    let first = run(&exe, &["120"]);
+    let second = run(&exe, &["120"]);
+    assert_eq!(line(&first, "ticks "), ["120", "refused", "1", "published", "119"], "{first}");
+    assert!(first.contains("tick 60 refused: status 4"), "{first}");
+    let seen = line(&first, "render reads ");
+    assert!(seen[0].parse::<u64>().unwrap() > 0, "the renderer read frames: {first}");
+    assert_eq!(&seen[1..], ["torn", "0", "backwards", "0"]);
+    assert_eq!(line(&first, "last tick "), ["120"]);
+    assert_eq!(line(&first, "corner "), line(&second, "corner "));
+}
