@@ -6,53 +6,15 @@
 use fraccloth::collide::intersections::{crossing_pairs, self_intersections};
 use fraccloth::collide::shapes::{bar, torus};
 use fraccloth::forces::{Collider, Plane};
-use fraccloth::{Cloth, ClothConfig, Integrator, Model, Scheme, Vec3};
+use fraccloth::scenes::{collision_towel, TowelPose};
+use fraccloth::{Cloth, Integrator, Vec3};
 use plotters::prelude::*;
 
 const FPS: f64 = 30.0;
 
-/// An underwater towel as in the tests, flat at height `y` or hanging from it.
-fn towel(w: u32, h: u32, spacing: f64, y: f64, hanging: bool, thickness: f64) -> Cloth {
-    let area = spacing * spacing * f64::from((w - 1) * (h - 1));
-    let grid = fraccloth::topology::GridSpec {
-        width: w,
-        height: h,
-        spacing,
-        total_mass: area,
-    }
-    .build()
-    .expect("grid");
-    let model = Model {
-        self_collision_thickness: thickness,
-        self_collision_friction: 0.3,
-        ..Model::underwater()
-    };
-    let config = ClothConfig {
-        model,
-        scheme: Scheme::DEFAULT,
-        integrator: Integrator::SymplecticEuler,
-        max_substep: fraccloth::cloth::AUTO,
-        ..ClothConfig::default()
-    };
-    let mut cloth = Cloth::new(grid, config).expect("cloth");
-    let (cx, cy) = (
-        0.5 * spacing * f64::from(w - 1),
-        -0.5 * spacing * f64::from(h - 1),
-    );
-    let placed: Vec<Vec3> = cloth
-        .topology()
-        .rest_positions
-        .iter()
-        .map(|p| {
-            if hanging {
-                Vec3::new(p.x - cx, y + p.y, p.z + 0.02 * (20.0 * -p.y).sin())
-            } else {
-                Vec3::new(p.x - cx, y, p.y - cy)
-            }
-        })
-        .collect();
-    cloth.set_positions(&placed).expect("positions");
-    cloth
+/// The collision scenes' towel (`scenes::collision_towel`), stepped with symplectic Euler.
+fn towel(w: u32, h: u32, spacing: f64, y: f64, pose: TowelPose, thickness: f64) -> Cloth {
+    collision_towel(w, h, spacing, y, pose, thickness, Integrator::SymplecticEuler).expect("towel")
 }
 
 /// One panel: the cloth's triangle edges projected with `view` (crossing ones red) and the
@@ -125,7 +87,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     root.fill(&WHITE)?;
     let rows = root.split_evenly((2, 3));
     for (r, thickness) in [0.005, 0.0].into_iter().enumerate() {
-        let mut cloth = towel(21, 31, 0.02, 0.62, true, thickness);
+        let mut cloth = towel(21, 31, 0.02, 0.62, TowelPose::Wavy, thickness);
         cloth.add_collider(floor)?;
         let mut f = 0;
         for (k, until) in [30, 75, 150].into_iter().enumerate() {
@@ -156,7 +118,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = BitMapBackend::new("docs/collisions/torus.png", (1500, 450)).into_drawing_area();
     root.fill(&WHITE)?;
     let cells = root.split_evenly((1, 3));
-    let mut cloth = towel(25, 25, 0.016, 0.08, false, 0.0);
+    let mut cloth = towel(25, 25, 0.016, 0.08, TowelPose::Flat, 0.0);
     let id = cloth.add_mesh_collider(&tx, &tt, None)?;
     cloth.set_collider_friction(id, 0.5)?;
     let mut f = 0;
@@ -187,7 +149,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = BitMapBackend::new("docs/collisions/bar.png", (1500, 450)).into_drawing_area();
     root.fill(&WHITE)?;
     let cells = root.split_evenly((1, 3));
-    let mut cloth = towel(21, 21, 0.02, 0.0, true, 0.0);
+    let mut cloth = towel(21, 21, 0.02, 0.0, TowelPose::Hanging, 0.0);
     let top: Vec<u32> = (0..21).collect();
     cloth.set_pinned(&top)?;
     let (bx, bt) = bar(Vec3::new(-0.4, -0.3, 0.0), Vec3::new(0.4, -0.3, 0.0), 0.002, 1);

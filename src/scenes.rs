@@ -492,3 +492,70 @@ impl Scene {
         &self.top
     }
 }
+
+/// How [`collision_towel`] places its towel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TowelPose {
+    /// Flat in the x-z plane at the height given, centred over the origin.
+    Flat,
+    /// Hanging in the x-y plane from the height given, centred in x.
+    Hanging,
+    /// Hanging, with a 2 cm wave across it (period 31 cm down the towel) so that it folds
+    /// when it lands: the drop of `tests/collisions.rs` and `docs/collisions.md`.
+    Wavy,
+}
+
+/// The towel of the collision scenes (`tests/collisions.rs`, `examples/collision_pictures.rs`,
+/// `examples/collision_cost.rs`): `w x h` vertices `spacing` apart at 1 kg/m^2 (the C preset's),
+/// the underwater preset's model with self-collision `thickness` (friction 0.3), the automatic
+/// step, placed by `pose` at height `y`.
+pub fn collision_towel(
+    w: u32,
+    h: u32,
+    spacing: f64,
+    y: f64,
+    pose: TowelPose,
+    thickness: f64,
+    integrator: Integrator,
+) -> Result<Cloth, Error> {
+    let area = spacing * spacing * f64::from((w.max(2) - 1) * (h.max(2) - 1));
+    let grid = GridSpec {
+        width: w,
+        height: h,
+        spacing,
+        total_mass: area,
+    }
+    .build()?;
+    let model = Model {
+        self_collision_thickness: thickness,
+        self_collision_friction: 0.3,
+        ..Model::underwater()
+    };
+    let config = ClothConfig {
+        model,
+        scheme: Scheme::DEFAULT,
+        integrator,
+        max_substep: crate::cloth::AUTO,
+        ..ClothConfig::default()
+    };
+    let mut cloth = Cloth::new(grid, config)?;
+    let (cx, cy) = (
+        0.5 * spacing * f64::from(w - 1),
+        -0.5 * spacing * f64::from(h - 1),
+    );
+    let placed: Vec<Vec3> = cloth
+        .topology()
+        .rest_positions
+        .iter()
+        .map(|p| match pose {
+            TowelPose::Flat => Vec3::new(p.x - cx, y, p.y - cy),
+            TowelPose::Hanging => Vec3::new(p.x - cx, y + p.y, p.z),
+            TowelPose::Wavy => {
+                let (hx, hy) = (p.x - cx, y + p.y);
+                Vec3::new(hx, hy, p.z + 0.02 * (20.0 * (y - hy)).sin())
+            }
+        })
+        .collect();
+    cloth.set_positions(&placed)?;
+    Ok(cloth)
+}

@@ -7,63 +7,22 @@
 use fraccloth::collide::intersections::{self_intersections, vertices_inside};
 use fraccloth::collide::shapes::{bar, torus};
 use fraccloth::forces::{Collider, Plane};
-use fraccloth::{Cloth, ClothConfig, Integrator, Model, Scheme, Vec3};
+use fraccloth::scenes::{collision_towel, TowelPose};
+use fraccloth::{Cloth, Integrator, Model, Vec3};
 
 const FPS: f64 = 30.0;
 
-/// An underwater towel of `w x h` vertices `spacing` apart, lying flat at height `y` (or hanging
-/// from `y` when `hanging`), with the library's automatic step and the given self-collision
-/// thickness.
+/// The collision scenes' towel (`scenes::collision_towel`).
 fn towel(
     w: u32,
     h: u32,
     spacing: f64,
     y: f64,
-    hanging: bool,
+    pose: TowelPose,
     thickness: f64,
     integrator: Integrator,
 ) -> Cloth {
-    // A wet towel: 1 kg/m^2, as the C preset.
-    let area = spacing * spacing * f64::from((w - 1) * (h - 1));
-    let grid = fraccloth::topology::GridSpec {
-        width: w,
-        height: h,
-        spacing,
-        total_mass: area,
-    }
-    .build()
-    .unwrap();
-    let model = Model {
-        self_collision_thickness: thickness,
-        self_collision_friction: 0.3,
-        ..Model::underwater()
-    };
-    let config = ClothConfig {
-        model,
-        scheme: Scheme::DEFAULT,
-        integrator,
-        max_substep: fraccloth::cloth::AUTO,
-        ..ClothConfig::default()
-    };
-    let mut cloth = Cloth::new(grid, config).unwrap();
-    let rest = cloth.topology().rest_positions.clone();
-    let (cx, cy) = (
-        0.5 * spacing * f64::from(w - 1),
-        -0.5 * spacing * f64::from(h - 1),
-    );
-    let placed: Vec<Vec3> = rest
-        .iter()
-        .map(|p| {
-            if hanging {
-                Vec3::new(p.x - cx, y + p.y, p.z)
-            } else {
-                // Flat in the x-z plane, centred over the origin.
-                Vec3::new(p.x - cx, y, p.y - cy)
-            }
-        })
-        .collect();
-    cloth.set_positions(&placed).unwrap();
-    cloth
+    collision_towel(w, h, spacing, y, pose, thickness, integrator).unwrap()
 }
 
 /// The most self-intersections over `frames` frames, stepping with `each` before each frame.
@@ -78,40 +37,33 @@ fn worst_intersections(cloth: &mut Cloth, frames: usize, mut each: impl FnMut(&m
     worst
 }
 
+/// The drop: a 21 x 31 towel of 2 cm spacing hanging with a wave from 0.62 m falls onto a floor
+/// and piles up in folds over 5 s. Returns the most crossing triangle pairs at any frame, the
+/// pile's top at the end and the self-collision pairs in reach then.
+fn drop(thickness: f64, integrator: Integrator) -> (usize, f64, usize) {
+    let mut cloth = towel(21, 31, 0.02, 0.62, TowelPose::Wavy, thickness, integrator);
+    let floor = Plane {
+        point: Vec3::zeros(),
+        normal: Vec3::y(),
+        velocity: Vec3::zeros(),
+    };
+    cloth.add_collider(Collider::Plane(floor)).unwrap();
+    let worst = worst_intersections(&mut cloth, 150, |_, _| {});
+    let top = cloth
+        .positions()
+        .iter()
+        .map(|p| p.y)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let (vt, ee) = cloth.self_collision_pairs();
+    (worst, top, vt.len() + ee.len())
+}
+
 /// A towel dropped edge-first onto the floor piles up in folds: with self-collision no
 /// triangle pair crosses at any frame; without it, they do (the test can fail).
 #[test]
 fn a_towel_dropped_on_the_floor_folds_without_crossing_itself() {
-    let run = |thickness: f64| {
-        let mut cloth = towel(21, 31, 0.02, 0.62, true, thickness, Integrator::SymplecticEuler);
-        // Tilted a little so it folds over rather than straight down.
-        let tilted: Vec<Vec3> = cloth
-            .positions()
-            .iter()
-            .map(|p| Vec3::new(p.x, p.y, p.z + 0.02 * (20.0 * (0.62 - p.y)).sin()))
-            .collect();
-        cloth.set_positions(&tilted).unwrap();
-        cloth
-            .add_collider(Collider::Plane(Plane {
-                point: Vec3::zeros(),
-                normal: Vec3::y(),
-                velocity: Vec3::zeros(),
-            }))
-            .unwrap();
-        let worst = worst_intersections(&mut cloth, 150, |_, _| {});
-        let top = cloth
-            .positions()
-            .iter()
-            .map(|p| p.y)
-            .fold(f64::NEG_INFINITY, f64::max);
-        (
-            worst,
-            top,
-            cloth.self_collision_pairs().0.len() + cloth.self_collision_pairs().1.len(),
-        )
-    };
-    let (with, top, pairs) = run(0.005);
-    let (without, _, _) = run(0.0);
+    let (with, top, pairs) = drop(0.005, Integrator::SymplecticEuler);
+    let (without, _, _) = drop(0.0, Integrator::SymplecticEuler);
     println!("self-intersections: {with} with self-collision ({pairs} pairs, pile top {top:.3} m), {without} without");
     assert!(top < 0.3, "the towel has landed: top at {top} m");
     assert!(pairs > 0, "it folded onto itself");
@@ -124,7 +76,15 @@ fn a_towel_dropped_on_the_floor_folds_without_crossing_itself() {
 #[test]
 fn a_towel_on_a_turning_torus_stays_outside_it() {
     let (tx, tt) = torus(Vec3::zeros(), 0.12, 0.05, 48, 16);
-    let mut cloth = towel(25, 25, 0.016, 0.08, false, 0.0, Integrator::SymplecticEuler);
+    let mut cloth = towel(
+        25,
+        25,
+        0.016,
+        0.08,
+        TowelPose::Flat,
+        0.0,
+        Integrator::SymplecticEuler,
+    );
     let id = cloth.add_mesh_collider(&tx, &tt, None).unwrap();
     cloth.set_collider_friction(id, 0.5).unwrap();
     let mut worst = 0;
@@ -165,7 +125,15 @@ fn a_towel_on_a_turning_torus_stays_outside_it() {
 /// sideways: the bar catches the towel and carries it, no vertex slips past.
 #[test]
 fn a_bar_thinner_than_the_spacing_catches_the_towel() {
-    let mut cloth = towel(21, 21, 0.02, 0.0, true, 0.0, Integrator::SymplecticEuler);
+    let mut cloth = towel(
+        21,
+        21,
+        0.02,
+        0.0,
+        TowelPose::Hanging,
+        0.0,
+        Integrator::SymplecticEuler,
+    );
     let top: Vec<u32> = (0..21).collect();
     cloth.set_pinned(&top).unwrap();
     // A horizontal bar along x through the towel's lower half, 10 cm in front of it (z).
@@ -195,26 +163,7 @@ fn a_bar_thinner_than_the_spacing_catches_the_towel() {
 /// are in its system, and the pile does not cross itself either.
 #[test]
 fn the_drop_with_implicit_euler_does_not_cross_itself() {
-    let mut cloth = towel(21, 31, 0.02, 0.62, true, 0.005, Integrator::ImplicitEuler);
-    let wavy: Vec<Vec3> = cloth
-        .positions()
-        .iter()
-        .map(|p| Vec3::new(p.x, p.y, p.z + 0.02 * (20.0 * (0.62 - p.y)).sin()))
-        .collect();
-    cloth.set_positions(&wavy).unwrap();
-    cloth
-        .add_collider(Collider::Plane(Plane {
-            point: Vec3::zeros(),
-            normal: Vec3::y(),
-            velocity: Vec3::zeros(),
-        }))
-        .unwrap();
-    let worst = worst_intersections(&mut cloth, 150, |_, _| {});
-    let top = cloth
-        .positions()
-        .iter()
-        .map(|p| p.y)
-        .fold(f64::NEG_INFINITY, f64::max);
+    let (worst, top, _) = drop(0.005, Integrator::ImplicitEuler);
     println!("implicit: {worst} self-intersections, pile top {top:.3} m");
     assert!(top < 0.3);
     assert_eq!(worst, 0);
@@ -231,7 +180,15 @@ fn a_towel_on_a_mesh_floor_in_a_current_keeps_its_contact() {
     // in z: widen it to 2 m by scaling z.
     let fx: Vec<Vec3> = floor.0.iter().map(|p| Vec3::new(p.x, p.y, p.z * 20.0)).collect();
     let run = |friction: f64| {
-        let mut cloth = towel(21, 21, 0.02, 0.01, false, 0.0, Integrator::SymplecticEuler);
+        let mut cloth = towel(
+            21,
+            21,
+            0.02,
+            0.01,
+            TowelPose::Flat,
+            0.0,
+            Integrator::SymplecticEuler,
+        );
         let id = cloth.add_mesh_collider(&fx, &floor.1, None).unwrap();
         cloth.set_collider_friction(id, friction).unwrap();
         for _ in 0..30 {
@@ -285,14 +242,15 @@ fn a_snapshot_resumes_a_bake_with_collisions_bitwise() {
         floor.1,
     );
     let make = || {
-        let mut c = towel(21, 31, 0.02, 0.62, true, 0.005, Integrator::SymplecticEuler);
-        let wavy: Vec<Vec3> = c
-            .positions()
-            .iter()
-            .map(|p| Vec3::new(p.x, p.y, p.z + 0.02 * (20.0 * (0.62 - p.y)).sin()))
-            .collect();
-        c.set_positions(&wavy).unwrap();
-        c
+        towel(
+            21,
+            31,
+            0.02,
+            0.62,
+            TowelPose::Wavy,
+            0.005,
+            Integrator::SymplecticEuler,
+        )
     };
     let pose = |f: usize| -> Vec<Vec3> {
         tx.iter()

@@ -146,10 +146,17 @@ fn engine_example_survives_a_refused_tick_and_never_shows_a_torn_frame() {
     let exe = common::compile_cpp_with("engine.cpp", &["-pthread", "-Wshadow", "-Wconversion"], &dir);
     let first = run(&exe, &["120"]);
     let second = run(&exe, &["120"]);
-    assert_eq!(line(&first, "ticks "), ["120", "refused", "1", "published", "119"], "{first}");
+    assert_eq!(
+        line(&first, "ticks "),
+        ["120", "refused", "1", "published", "119"],
+        "{first}"
+    );
     assert!(first.contains("tick 60 refused: status 4"), "{first}");
     let seen = line(&first, "render reads ");
-    assert!(seen[0].parse::<u64>().unwrap() > 0, "the renderer read frames: {first}");
+    assert!(
+        seen[0].parse::<u64>().unwrap() > 0,
+        "the renderer read frames: {first}"
+    );
     assert_eq!(&seen[1..], ["torn", "0", "backwards", "0"]);
     assert_eq!(line(&first, "last tick "), ["120"]);
     assert_eq!(line(&first, "corner "), line(&second, "corner "));

@@ -206,6 +206,21 @@ impl SelfCollision {
             self.look(x, rest, triangles, thickness + skin, EXCLUDED * thickness);
         }
         let cap = 2.0 * thickness;
+        // A contact between four vertices at signed distance `dist` along `dir`, if within the
+        // thickness.
+        let push = |out: &mut Vec<Contact>, idx: [u32; 4], coef: [f64; 4], dist: f64, dir: Vec3| {
+            if dist < thickness {
+                out.push(Contact {
+                    idx,
+                    coef,
+                    len: 4,
+                    dir,
+                    depth: (thickness - dist).min(cap),
+                    surface_velocity: Vec3::zeros(),
+                    friction,
+                });
+            }
+        };
         for (p, t, s) in self.vertex_triangle.iter_mut().map(|q| (q.0, q.1, &mut q.2)) {
             let tri = &triangles[t as usize];
             let (d, w, r) = vertex_triangle(x, p, tri);
@@ -236,18 +251,13 @@ impl SelfCollision {
             } else {
                 continue;
             };
-            if dist >= thickness {
-                continue;
-            }
-            out.push(Contact {
-                idx: [p, tri[0], tri[1], tri[2]],
-                coef: [1.0, -w[0], -w[1], -w[2]],
-                len: 4,
+            push(
+                out,
+                [p, tri[0], tri[1], tri[2]],
+                [1.0, -w[0], -w[1], -w[2]],
+                dist,
                 dir,
-                depth: (thickness - dist).min(cap),
-                surface_velocity: Vec3::zeros(),
-                friction,
-            });
+            );
         }
         for (e, f, s) in self.edge_edge.iter_mut().map(|p| (p.0, p.1, &mut p.2)) {
             let (ee, ff) = (&self.edges[e as usize], &self.edges[f as usize]);
@@ -286,18 +296,13 @@ impl SelfCollision {
             } else {
                 continue;
             };
-            if dist >= thickness {
-                continue;
-            }
-            out.push(Contact {
-                idx: [ee[0], ee[1], ff[0], ff[1]],
-                coef: [1.0 - a, a, -(1.0 - b), -b],
-                len: 4,
+            push(
+                out,
+                [ee[0], ee[1], ff[0], ff[1]],
+                [1.0 - a, a, -(1.0 - b), -b],
+                dist,
                 dir,
-                depth: (thickness - dist).min(cap),
-                surface_velocity: Vec3::zeros(),
-                friction,
-            });
+            );
         }
     }
 

@@ -179,23 +179,33 @@ class FracclothSettings(bpy.types.PropertyGroup):
                                          description="Where the cache goes; empty: a 'fraccloth' folder next to the .blend, named after the object")
 
 
-def _mesh_spec(o):
-    """("mesh", world positions (N, 3), triangles (M, 3)) of a mesh object as Blender evaluates
-    it at the current frame (armature, shape keys, modifiers, parents)."""
+def _evaluated(obj, triangles=False):
+    """World positions (N, 3) of `obj`'s mesh as Blender evaluates it at the current frame
+    (object transform, parents, armatures, shape keys, hooks, modifiers), and its triangles
+    (M, 3) when asked."""
     deps = bpy.context.evaluated_depsgraph_get()
-    ev = o.evaluated_get(deps)
+    ev = obj.evaluated_get(deps)
     me = ev.to_mesh()
+    tris = None
     try:
         co = np.empty(3 * len(me.vertices), dtype=np.float64)
         me.vertices.foreach_get("co", co)
-        me.calc_loop_triangles()
-        tris = np.empty(3 * len(me.loop_triangles), dtype=np.uint32)
-        me.loop_triangles.foreach_get("vertices", tris)
+        if triangles:
+            me.calc_loop_triangles()
+            tris = np.empty(3 * len(me.loop_triangles), dtype=np.uint32)
+            me.loop_triangles.foreach_get("vertices", tris)
+            tris = tris.reshape(-1, 3)
     finally:
         ev.to_mesh_clear()
     m = np.array(ev.matrix_world, dtype=np.float64)
-    co = co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3]
-    return ("mesh", co, tris.reshape(-1, 3))
+    return co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3], tris
+
+
+def _mesh_spec(o):
+    """("mesh", world positions (N, 3), triangles (M, 3)) of a mesh object as Blender evaluates
+    it at the current frame (armature, shape keys, modifiers, parents)."""
+    co, tris = _evaluated(o, triangles=True)
+    return ("mesh", co, tris)
 
 
 def collider_specs_for(s, others):
@@ -248,17 +258,7 @@ def collider_specs(obj, others):
 def world_positions(obj):
     """The evaluated mesh's vertex positions in world coordinates at the current frame (object
     transform, parents, armatures, shape keys, hooks: whatever Blender evaluates), (N, 3)."""
-    deps = bpy.context.evaluated_depsgraph_get()
-    ev = obj.evaluated_get(deps)
-    me = ev.to_mesh()
-    try:
-        co = np.empty(3 * len(me.vertices), dtype=np.float64)
-        me.vertices.foreach_get("co", co)
-    finally:
-        ev.to_mesh_clear()
-    m = np.array(ev.matrix_world, dtype=np.float64)
-    co = co.reshape(-1, 3)
-    return co @ m[:3, :3].T + m[:3, 3]
+    return _evaluated(obj)[0]
 
 
 def to_local(obj, world):
