@@ -378,6 +378,20 @@ impl SceneSpec {
         } else {
             topology
         };
+        // The pinned edge: the top row, or the foot of the kelp.
+        let row = if self.kind == SceneKind::Kelp {
+            self.height - 1
+        } else {
+            0
+        };
+        let top: Vec<u32> = (0..self.width).map(|i| grid_index(self.width, i, row)).collect();
+        self.build_on(topology, &top, spacing)
+    }
+
+    /// The scene on any topology (a host's own mesh), pinned at `pins` (vertex indices), with
+    /// the model of the variant at the mesh's `spacing` (m; its drag coefficients are given
+    /// per 1 cm spacing, `scale_drags`) unless the spec has its own. The drive moves the pins.
+    pub fn build_on(&self, topology: crate::Topology, pins: &[u32], spacing: f64) -> Result<Scene, Error> {
         let mut model = self.variant.model(spacing);
         if self.kind == SceneKind::Kelp {
             model.cloth_density = KELP_DENSITY;
@@ -397,13 +411,7 @@ impl SceneSpec {
             ..ClothConfig::default()
         };
         let mut cloth = Cloth::new(topology, config)?;
-        // The pinned edge: the top row, or the foot of the kelp.
-        let row = if self.kind == SceneKind::Kelp {
-            self.height - 1
-        } else {
-            0
-        };
-        let top: Vec<u32> = (0..self.width).map(|i| grid_index(self.width, i, row)).collect();
+        let top = pins.to_vec();
         cloth.set_pinned(&top)?;
         let top_rest = top.iter().map(|&i| cloth.positions()[i as usize]).collect();
         let sphere = match self.kind {

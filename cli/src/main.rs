@@ -101,6 +101,23 @@ struct Args {
     /// to 15 % of the spacing, random diagonals) instead of the grid.
     #[arg(long)]
     jittered: bool,
+    /// Bake your own mesh (an OBJ: triangles or quads, y up, metres; vertex order kept in the
+    /// caches) instead of the built-in towel, with the scene's drive on its pins and every
+    /// water option. 1 kg/m^2. Pins: --pin-group, --pin-file or --pin-top (default: the top
+    /// row).
+    #[arg(long)]
+    mesh: Option<PathBuf>,
+    /// With --mesh: pin the vertices of the OBJ group (`g` or `o` name) NAME.
+    #[arg(long)]
+    pin_group: Option<String>,
+    /// With --mesh: pin the vertices listed in FILE (0-based indices, separated by spaces,
+    /// commas or new lines).
+    #[arg(long)]
+    pin_file: Option<PathBuf>,
+    /// With --mesh: pin the ROWS highest rows of vertices (those within ROWS - 1/2 mean edge
+    /// lengths of the highest vertex). Default 1 when no other pin option is given.
+    #[arg(long)]
+    pin_top: Option<f64>,
     /// Simulated seconds.
     #[arg(long, default_value_t = 12.0)]
     seconds: f64,
@@ -257,6 +274,89 @@ fn spec_from(args: &Args, variant: Variant, scheme: Scheme) -> Result<SceneSpec,
     })
 }
 
+/// The user's mesh (`--mesh`): its topology (quads kept when every face is one), the pinned
+/// vertices and the mean edge length.
+fn user_mesh(args: &Args, path: &Path) -> Result<(fraccloth::Topology, Vec<u32>, f64), String> {
+    use fraccloth::topology::{MeshMass, MeshSpec};
+    let obj = read_obj(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if obj.faces.is_empty() {
+        return Err(format!("{}: no faces", path.display()));
+    }
+    let quads = obj.faces.iter().all(|f| f.len() == 4);
+    let indices: Vec<u32> = if quads {
+        obj.faces.iter().flatten().copied().collect()
+    } else {
+        obj.triangles.iter().flatten().copied().collect()
+    };
+    let topology = MeshSpec {
+        positions: &obj.positions,
+        indices: &indices,
+        face_size: if quads { 4 } else { 3 },
+        mass: MeshMass::ArealDensity(1.0),
+    }
+    .build()
+    .map_err(|e| format!("{}: {e}", path.display()))?;
+    let edges: Vec<f64> = obj
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .map(|(a, b)| (obj.positions[a as usize] - obj.positions[b as usize]).norm())
+        .collect();
+    let spacing = edges.iter().sum::<f64>() / edges.len() as f64;
+    let n = obj.positions.len();
+    let mut pins: Vec<u32> = Vec::new();
+    if let Some(name) = &args.pin_group {
+        let names: Vec<&str> = obj.groups.iter().map(|(g, _)| g.as_str()).collect();
+        pins.extend(obj.group_vertices(name).ok_or_else(|| {
+            format!(
+                "{}: no group named {name:?} (its groups: {})",
+                path.display(),
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            )
+        })?);
+    }
+    if let Some(file) = &args.pin_file {
+        let text = std::fs::read_to_string(file).map_err(io(file))?;
+        for tok in text
+            .split(|c: char| c.is_whitespace() || c == ',')
+            .filter(|t| !t.is_empty())
+        {
+            let i: u32 = tok
+                .parse()
+                .map_err(|e| format!("{}: {tok:?} is not a vertex index: {e}", file.display()))?;
+            if i as usize >= n {
+                return Err(format!(
+                    "{}: vertex {i} does not exist (the mesh has {n})",
+                    file.display()
+                ));
+            }
+            pins.push(i);
+        }
+    }
+    let rows = match args.pin_top {
+        Some(r) if !(r.is_finite() && r > 0.0) => return Err(format!("--pin-top must be positive, got {r}")),
+        Some(r) => Some(r),
+        None if pins.is_empty() => Some(1.0),
+        None => None,
+    };
+    if let Some(rows) = rows {
+        let top = obj
+            .positions
+            .iter()
+            .map(|p| p.y)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let below = (rows - 0.5) * spacing;
+        pins.extend((0..n as u32).filter(|&i| obj.positions[i as usize].y >= top - below));
+    }
+    pins.sort_unstable();
+    pins.dedup();
+    Ok((topology, pins, spacing))
+}
+
 /// The fixed camera of a scene.
 fn camera_for(scene: &Scene, width: u32, height: u32) -> Camera {
     Camera::for_rest_shape(&scene.cloth.topology().rest_positions, width, height)
@@ -363,9 +463,25 @@ fn bake(args: &Args) -> Result<(), String> {
         )
     })?;
     let spec = spec_from(args, variant, scheme_from(args)?)?;
-    let mut scene = spec.build().map_err(|e| e.to_string())?;
+    if args.mesh.is_none() && (args.pin_group.is_some() || args.pin_file.is_some() || args.pin_top.is_some())
+    {
+        return Err("--pin-group, --pin-file and --pin-top go with --mesh".into());
+    }
+    let (mut scene, stem) = match &args.mesh {
+        None => (
+            spec.build().map_err(|e| e.to_string())?,
+            format!("{}-{}", spec.kind.name(), variant.name()),
+        ),
+        Some(path) => {
+            let (topology, pins, spacing) = user_mesh(args, path)?;
+            let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
+            let scene = spec
+                .build_on(topology, &pins, spacing)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            (scene, format!("{name}-{}", variant.name()))
+        }
+    };
     std::fs::create_dir_all(&args.out).map_err(io(&args.out))?;
-    let stem = format!("{}-{}", spec.kind.name(), variant.name());
     let path = |ext: &str| args.out.join(format!("{stem}{ext}"));
     let topo = scene.cloth.topology().clone();
     let obj_path = path(".obj");
@@ -468,11 +584,13 @@ fn bake(args: &Args) -> Result<(), String> {
     let n = topo.vertex_count();
     let history = &scene.cloth.history();
     let mut summary = format!(
-        "scene        {}\nvariant      {}\ngrid         {} x {} ({} vertices, {} springs)\nhistory      {} ({} modes, {} bytes/particle)\nintegrator   {}\ndt           {}\nsimulated    {:.3} s in {} steps\nframes       {} at {} fps (+ frame 0)\nwall time    {:.3} s simulating ({:.2} M particle-steps/s), {:.3} s drawing previews\npoint caches {} (PC2), {} (MDD)\nrest mesh    {}\n",
+        "scene        {}\nvariant      {}\ncloth        {} ({} vertices, {} springs)\nhistory      {} ({} modes, {} bytes/particle)\nintegrator   {}\ndt           {}\nsimulated    {:.3} s in {} steps\nframes       {} at {} fps (+ frame 0)\nwall time    {:.3} s simulating ({:.2} M particle-steps/s), {:.3} s drawing previews\npoint caches {} (PC2), {} (MDD)\nrest mesh    {}\n",
         spec.kind.name(),
         variant.name(),
-        spec.width,
-        spec.height,
+        match &args.mesh {
+            Some(p) => format!("{} ({} pinned)", p.display(), scene.top_row().len()),
+            None => format!("grid {} x {}", spec.width, spec.height),
+        },
         n,
         topo.springs.len(),
         if history.is_off() { Scheme::Off.name() } else { spec.scheme.name() },
@@ -542,7 +660,12 @@ fn bake(args: &Args) -> Result<(), String> {
         }
     }
     // A still cloth in a current: how far it leans and how its free edge flutters.
-    if !driven {
+    if !driven && args.mesh.is_some() {
+        let _ = writeln!(
+            summary,
+            "stream       not measured on a mesh of your own (the lean is measured on the built-in scenes)"
+        );
+    } else if !driven {
         let (w, h) = (spec.width as usize, spec.height as usize);
         let root = scene.top_row()[w / 2] as usize;
         let tip = if spec.kind == SceneKind::Kelp {

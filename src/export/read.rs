@@ -129,20 +129,58 @@ pub fn read_cache(path: &Path) -> io::Result<CacheFrames> {
     }
 }
 
-/// A mesh read from OBJ: vertex positions and faces split into triangles (fans).
+/// A mesh read from OBJ: vertex positions and faces split into triangles (fans); the faces
+/// as written; and the named groups (`g` and `o` lines) with the faces each holds.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ObjMesh {
     pub positions: Vec<Vec3>,
     pub triangles: Vec<[u32; 3]>,
+    /// Every face's vertex indices (0-based), in the file's order.
+    pub faces: Vec<Vec<u32>>,
+    /// (name, face indices) of every `g` or `o` name, in the order first seen; a face belongs
+    /// to every name of the `g` line (and the `o`) before it.
+    pub groups: Vec<(String, Vec<u32>)>,
+}
+
+impl ObjMesh {
+    /// The vertices of the faces of group `name` (sorted, each once), or None without it.
+    pub fn group_vertices(&self, name: &str) -> Option<Vec<u32>> {
+        let (_, faces) = self.groups.iter().find(|(g, _)| g == name)?;
+        let mut v: Vec<u32> = faces
+            .iter()
+            .flat_map(|&f| self.faces[f as usize].iter().copied())
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        Some(v)
+    }
 }
 
 /// Parses OBJ text: `v` lines and `f` lines (1-based or negative indices, `a/b/c` forms
 /// accepted; texture and normal indices ignored); other lines are skipped.
 pub fn parse_obj(text: &str) -> io::Result<ObjMesh> {
     let mut mesh = ObjMesh::default();
+    // The names faces now belong to (indices into `mesh.groups`): the `o` name, the `g` names.
+    let (mut object, mut current): (Option<usize>, Vec<usize>) = (None, Vec::new());
+    let group = |groups: &mut Vec<(String, Vec<u32>)>, name: &str| -> usize {
+        match groups.iter().position(|(g, _)| g == name) {
+            Some(k) => k,
+            None => {
+                groups.push((name.to_string(), Vec::new()));
+                groups.len() - 1
+            }
+        }
+    };
     for (n, line) in text.lines().enumerate() {
         let mut it = line.split_whitespace();
         match it.next() {
+            Some("o") => {
+                let name: Vec<&str> = it.collect();
+                object = (!name.is_empty()).then(|| group(&mut mesh.groups, &name.join(" ")));
+            }
+            Some("g") => {
+                current = it.map(|name| group(&mut mesh.groups, name)).collect();
+            }
             Some("v") => {
                 let c: Vec<f64> = it
                     .take(3)
@@ -177,11 +215,34 @@ pub fn parse_obj(text: &str) -> io::Result<ObjMesh> {
                 for k in 1..idx.len() - 1 {
                     mesh.triangles.push([idx[0], idx[k], idx[k + 1]]);
                 }
+                let face = mesh.faces.len() as u32;
+                for &g in object.iter().chain(&current) {
+                    mesh.groups[g].1.push(face);
+                }
+                mesh.faces.push(idx);
             }
             _ => {}
         }
     }
     Ok(mesh)
+}
+
+#[cfg(test)]
+mod group_tests {
+    use super::*;
+
+    /// `g` and `o` names collect their faces; quads stay quads in `faces`.
+    #[test]
+    fn groups_and_faces_are_read() {
+        let text = "o towel\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\ng hem top\nf 1 2 3 4\ng\nf 2 5 6 3\n";
+        let m = parse_obj(text).unwrap();
+        assert_eq!(m.faces, vec![vec![0, 1, 2, 3], vec![1, 4, 5, 2]]);
+        assert_eq!(m.triangles.len(), 4);
+        assert_eq!(m.group_vertices("hem"), Some(vec![0, 1, 2, 3]));
+        assert_eq!(m.group_vertices("top"), Some(vec![0, 1, 2, 3]));
+        assert_eq!(m.group_vertices("towel"), Some(vec![0, 1, 2, 3, 4, 5]));
+        assert_eq!(m.group_vertices("none"), None);
+    }
 }
 
 /// Reads an OBJ file.
