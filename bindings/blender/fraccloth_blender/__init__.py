@@ -49,9 +49,9 @@ if _here not in sys.path:
     sys.path.append(_here)  # a vendored `fraccloth` package next to the add-on
 
 HISTORY_ITEMS = [
-    ("SOE", "Accurate (SOE)", "Full fractional memory at constant cost (the default)"),
+    ("SOE", "Accurate memory", "The fractional terms' whole memory at constant cost (sum of exponentials)"),
     ("PAPER", "Paper (u = 3)", "The paper's truncated history, to reproduce its pictures"),
-    ("OFF", "Off", "No memory (regular cloth)"),
+    ("OFF", "Off", "No memory: the underwater towel's (its look comes from the water's inertia and drag)"),
 ]
 INTEGRATOR_ITEMS = [
     ("SYMPLECTIC", "Symplectic Euler", "Fast; small time steps (about 1 ms)"),
@@ -99,6 +99,8 @@ PRESETS = {
         "history": "SOE", "integrator": "SYMPLECTIC"}),
 }
 PRESET_ITEMS = [("CUSTOM", "Custom", "Your own values")] + [(k, v[0], v[1]) for k, v in PRESETS.items()]
+# A new object starts on "Underwater towel": the values' defaults below are the library's
+# FC_PRESET_UNDERWATER (a test compares them with the library's own).
 
 
 def _library_preset():
@@ -136,36 +138,54 @@ def _library_preset():
     }
 
 
+# True while a preset writes its values (so that they do not count as the artist's edits).
+_APPLYING = [False]
+
+
 def _apply_preset(self, context):
     values = PRESETS.get(self.preset)
     if values is None:
         return
-    for name, value in (values[2] or _library_preset()).items():
-        setattr(self, name, value)
+    _APPLYING[0] = True
+    try:
+        for name, value in (values[2] or _library_preset()).items():
+            setattr(self, name, value)
+    finally:
+        _APPLYING[0] = False
+
+
+def _edited(self, context):
+    """An artist's edit of a value a preset sets: the label says Custom from then on."""
+    if not _APPLYING[0] and self.preset != "CUSTOM":
+        _APPLYING[0] = True
+        try:
+            self.preset = "CUSTOM"
+        finally:
+            _APPLYING[0] = False
 
 
 class FracclothSettings(bpy.types.PropertyGroup):
-    preset: bpy.props.EnumProperty(name="Preset", items=PRESET_ITEMS, default="CUSTOM", update=_apply_preset,
+    preset: bpy.props.EnumProperty(name="Preset", items=PRESET_ITEMS, default="UNDERWATER", update=_apply_preset,
                                    description="Set every value below from a preset (then change what you like)")
     pin_group: bpy.props.StringProperty(name="Pin group", description="Vertex group of pinned vertices (weight = how firmly)", default="pins")
-    stretch_stiffness: bpy.props.FloatProperty(name="Stretch", description="How hard the cloth resists stretching (spring constant, N/m)", default=10.0, min=0.0, soft_max=200.0)
-    shear_stiffness: bpy.props.FloatProperty(name="Shear", description="How hard it resists shearing (N/m)", default=2.0, min=0.0, soft_max=50.0)
-    bend_stiffness: bpy.props.FloatProperty(name="Bend", description="How hard it resists bending (N/m); low values give fine folds", default=0.5, min=0.0, soft_max=20.0)
-    damping_mode: bpy.props.EnumProperty(name="Spring damping", items=DAMPING_ITEMS, default="FRACTIONAL")
-    spring_damping: bpy.props.FloatProperty(name="Damping", description="How much the springs damp their own motion (N s^1/2/m fractional, N s/m ordinary)", default=0.35, min=0.0, soft_max=1.0, precision=4)
-    history_drag: bpy.props.FloatProperty(name="History drag", description="Water's memory drag per 1 cm^2 of cloth (N s^1/2/m)", default=2e-3, min=0.0, soft_max=0.05, precision=5)
-    viscous_drag: bpy.props.FloatProperty(name="Viscous drag", description="Drag in proportion to speed, per 1 cm^2 of cloth (N s/m)", default=1e-3, min=0.0, soft_max=0.05, precision=5)
-    normal_drag: bpy.props.FloatProperty(name="Normal drag", description="Drag on motion across the cloth, per 1 cm^2 (N s/m)", default=0.0, min=0.0, soft_max=0.05, precision=5)
-    mass_per_area: bpy.props.FloatProperty(name="Weight", description="Mass of the wet cloth per square metre (kg/m^2)", default=1.0, min=1e-6, soft_max=5.0)
-    cloth_density: bpy.props.FloatProperty(name="Cloth density", description="Density of the wet cloth (kg/m^3): above the water's it sinks, below it floats", default=1100.0, min=1.0, soft_min=500.0, soft_max=3000.0)
-    water_density: bpy.props.FloatProperty(name="Water density", description="kg/m^3 (1000 fresh water, 1025 sea water, 0 for air)", default=1000.0, min=0.0, soft_max=1100.0)
-    entrained_mass: bpy.props.FloatProperty(name="Water carried", description="Water the cloth drags along as it moves, kg per m^2 of cloth: makes it slow and heavy in the water", default=0.0, min=0.0, soft_max=40.0)
-    added_mass: bpy.props.FloatProperty(name="Added mass (across)", description="Water moved by motion across the cloth only, kg per m^2", default=0.0, min=0.0, soft_max=40.0)
-    form_drag: bpy.props.FloatProperty(name="Form drag", description="Drag coefficient of the cloth moving face first through water (1 to 2 for a sheet)", default=0.0, min=0.0, soft_max=4.0)
-    skin_drag: bpy.props.FloatProperty(name="Skin drag", description="Drag of water sliding along the cloth, N s/m^3", default=0.0, min=0.0, soft_max=5.0)
+    stretch_stiffness: bpy.props.FloatProperty(name="Stretch", description="How hard the cloth resists stretching (spring constant, N/m)", default=10.0, min=0.0, soft_max=200.0, update=_edited)
+    shear_stiffness: bpy.props.FloatProperty(name="Shear", description="How hard it resists shearing (N/m)", default=2.0, min=0.0, soft_max=50.0, update=_edited)
+    bend_stiffness: bpy.props.FloatProperty(name="Bend", description="How hard it resists bending (N/m); low values give fine folds", default=0.5, min=0.0, soft_max=20.0, update=_edited)
+    damping_mode: bpy.props.EnumProperty(name="Spring damping", items=DAMPING_ITEMS, default="VELOCITY", update=_edited)
+    spring_damping: bpy.props.FloatProperty(name="Damping", description="How much the springs damp their own motion (N s^1/2/m fractional, N s/m ordinary)", default=0.003, min=0.0, soft_max=1.0, precision=4, update=_edited)
+    history_drag: bpy.props.FloatProperty(name="History drag", description="Water's memory drag per 1 cm^2 of cloth (N s^1/2/m)", default=0.0, min=0.0, soft_max=0.05, precision=5, update=_edited)
+    viscous_drag: bpy.props.FloatProperty(name="Viscous drag", description="Drag in proportion to speed, per 1 cm^2 of cloth (N s/m)", default=0.0, min=0.0, soft_max=0.05, precision=5, update=_edited)
+    normal_drag: bpy.props.FloatProperty(name="Normal drag", description="Drag on motion across the cloth, per 1 cm^2 (N s/m)", default=0.0, min=0.0, soft_max=0.05, precision=5, update=_edited)
+    mass_per_area: bpy.props.FloatProperty(name="Weight", description="Mass of the wet cloth per square metre (kg/m^2)", default=1.0, min=1e-6, soft_max=5.0, update=_edited)
+    cloth_density: bpy.props.FloatProperty(name="Cloth density", description="Density of the wet cloth (kg/m^3): above the water's it sinks, below it floats", default=1100.0, min=1.0, soft_min=500.0, soft_max=3000.0, update=_edited)
+    water_density: bpy.props.FloatProperty(name="Water density", description="kg/m^3 (1000 fresh water, 1025 sea water, 0 for air)", default=1000.0, min=0.0, soft_max=1100.0, update=_edited)
+    entrained_mass: bpy.props.FloatProperty(name="Water carried", description="Water the cloth drags along as it moves, kg per m^2 of cloth: makes it slow and heavy in the water", default=0.0, min=0.0, soft_max=40.0, update=_edited)
+    added_mass: bpy.props.FloatProperty(name="Added mass (across)", description="Water moved by motion across the cloth only, kg per m^2", default=10.0, min=0.0, soft_max=40.0, update=_edited)
+    form_drag: bpy.props.FloatProperty(name="Form drag", description="Drag coefficient of the cloth moving face first through water (1 to 2 for a sheet)", default=1.0, min=0.0, soft_max=4.0, update=_edited)
+    skin_drag: bpy.props.FloatProperty(name="Skin drag", description="Drag of water sliding along the cloth, N s/m^3", default=1.15, min=0.0, soft_max=5.0, update=_edited)
     current: bpy.props.FloatVectorProperty(name="Current", description="Water current, m/s (world)", default=(0.0, 0.0, 0.0), size=3)
-    history: bpy.props.EnumProperty(name="History", items=HISTORY_ITEMS, default="SOE")
-    integrator: bpy.props.EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="SYMPLECTIC")
+    history: bpy.props.EnumProperty(name="History", items=HISTORY_ITEMS, default="OFF", update=_edited)
+    integrator: bpy.props.EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="SYMPLECTIC", update=_edited)
     auto_step: bpy.props.BoolProperty(name="Automatic time step", description="The library splits each frame into as few steps as the cloth needs (from its springs, weight, water, colliders and pins) and retries a frame that fails with more", default=True)
     time_step: bpy.props.FloatProperty(name="Time step", description="Longest step when not automatic, s", default=5e-4, min=1e-6, max=0.1, precision=5)
     friction: bpy.props.FloatProperty(name="Collider friction", description="How much the colliders grip the cloth (0 = slippery, 1 = grippy)", default=0.0, min=0.0, soft_max=1.0)
@@ -334,6 +354,10 @@ def describe(s):
     desc.collision_margin = s.collision_margin
     desc.self_collision_thickness = s.self_collision
     desc.self_collision_friction = s.self_friction
+    fractional = s.damping_mode in ("FRACTIONAL", "STRAIN") and s.spring_damping > 0.0 or s.history_drag > 0.0
+    if fractional and s.history == "OFF":
+        raise ValueError("fractional damping or a history drag needs a History (Accurate or Paper): with History Off "
+                         "they do nothing; choose a History, or Ordinary spring damping and no history drag")
     desc.history_scheme = {"SOE": fraccloth.HISTORY_SOE, "PAPER": fraccloth.HISTORY_TRUNCATED, "OFF": fraccloth.HISTORY_OFF}[s.history]
     desc.history_u = 3
     desc.integrator = {

@@ -374,3 +374,23 @@ def test_a_missing_pin_group_is_an_error(addon, tmp_path):
     with pytest.raises(RuntimeError, match="no vertex group named 'pinz'.*pins"):
         bpy.ops.fraccloth.bake()
     assert cloth.modifiers.get("fraccloth") is None
+
+
+def test_a_new_cloth_starts_on_the_librarys_underwater_towel_and_edits_say_custom(addon, tmp_path):
+    """A new object's settings are the library's FC_PRESET_UNDERWATER, labelled so; changing a
+    value relabels it Custom; fractional damping with the history Off is refused with the reason."""
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=4, y_subdivisions=4, size=0.1)
+    fresh = bpy.context.active_object.fraccloth
+    assert fresh.preset == "UNDERWATER"
+    for name, value in addon._library_preset().items():
+        got = getattr(fresh, name)
+        assert got == (pytest.approx(value, rel=1e-6) if isinstance(value, float) else value), name
+    fresh.bend_stiffness = 1.0
+    assert fresh.preset == "CUSTOM"
+    fresh.preset = "SILK"
+    assert fresh.preset == "SILK" and fresh.mass_per_area < 0.5
+    cloth, _ = make_scene(tmp_path, "PC2")
+    s = cloth.fraccloth
+    s.damping_mode, s.spring_damping, s.history = "FRACTIONAL", 0.35, "OFF"
+    with pytest.raises(RuntimeError, match="needs a History"):
+        bpy.ops.fraccloth.bake()
