@@ -58,6 +58,10 @@ pub use integrate::Integrator;
 pub use model::{Model, RegularDrag, SpringDamping};
 /// Fewest particles for which a step uses more than one thread.
 pub use plumbing::parallel::MIN_PARALLEL;
-/// The vector width the loops run at on this machine ("avx512", "avx2" or "scalar").
+/// The vector width the loops run at on this machine ("avx512", "avx2" or "baseline"; capped
+/// by the environment variable `FRACCLOTH_SIMD` for measurement).
 pub use plumbing::simd::level as simd_level;
+/// The vector width the loops run at, and the environment variable that caps it.
+#[doc(hidden)]
+pub use plumbing::simd::{width as simd_width, Width as SimdWidth, WIDTH_VARIABLE as SIMD_WIDTH_VARIABLE};
 pub use topology::{GridSpec, Topology};

@@ -11,23 +11,58 @@
 //! library's `fma`, which rounds identically (correctly rounded by IEEE 754), only slower:
 //! the bits are still the same on every CPU.
 
-/// Widest vector extension this CPU offers, as chosen by `simd_dispatch!`.
-pub fn level() -> &'static str {
+/// A vector width the hot loops can run at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Width {
+    Baseline,
+    Avx2,
+    Avx512,
+}
+
+/// Environment variable that caps the vector width (`avx512`, `avx2` or `baseline`), for
+/// measuring one against another on the same machine; never wider than the CPU offers.
+pub const WIDTH_VARIABLE: &str = "FRACCLOTH_SIMD";
+
+/// The widest width this CPU offers.
+fn offered() -> Width {
     #[cfg(target_arch = "x86_64")]
     {
         if std::is_x86_feature_detected!("avx512f") {
-            return "avx512";
+            return Width::Avx512;
         }
         if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
-            return "avx2";
+            return Width::Avx2;
         }
     }
-    "baseline"
+    Width::Baseline
+}
+
+/// The width `simd_dispatch!` runs at: the widest this CPU offers, capped by
+/// [`WIDTH_VARIABLE`] when it is set (read once). Every width gives the same bits.
+pub fn width() -> Width {
+    static CHOSEN: std::sync::OnceLock<Width> = std::sync::OnceLock::new();
+    *CHOSEN.get_or_init(|| {
+        let cap = match std::env::var(WIDTH_VARIABLE).as_deref() {
+            Ok("baseline") | Ok("scalar") => Width::Baseline,
+            Ok("avx2") => Width::Avx2,
+            _ => Width::Avx512,
+        };
+        offered().min(cap)
+    })
+}
+
+/// The vector width `simd_dispatch!` runs at, by name ("avx512", "avx2" or "baseline").
+pub fn level() -> &'static str {
+    match width() {
+        Width::Avx512 => "avx512",
+        Width::Avx2 => "avx2",
+        Width::Baseline => "baseline",
+    }
 }
 
 /// `simd_dispatch! { fn name(a: A, b: B) => body }` defines `fn name(a: A, b: B)` that calls
 /// the `#[inline(always)]` function `body(a, b)` compiled for AVX-512, AVX2 or the baseline,
-/// whichever is the widest this CPU has.
+/// as [`width`] chooses.
 #[macro_export]
 #[doc(hidden)]
 macro_rules! simd_dispatch {
@@ -43,13 +78,12 @@ macro_rules! simd_dispatch {
                 unsafe fn wide256($($p: $t),*) $(-> $ret)? {
                     $body($($p),*)
                 }
-                if std::is_x86_feature_detected!("avx512f") {
-                    // SAFETY: the CPU supports AVX-512F (checked just above).
-                    return unsafe { wide512($($p),*) };
-                }
-                if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
-                    // SAFETY: the CPU supports AVX2 and FMA (checked just above).
-                    return unsafe { wide256($($p),*) };
+                match $crate::simd_width() {
+                    // SAFETY: `simd_width` is never wider than the CPU offers (AVX-512F here).
+                    $crate::SimdWidth::Avx512 => return unsafe { wide512($($p),*) },
+                    // SAFETY: likewise (AVX2 and FMA here).
+                    $crate::SimdWidth::Avx2 => return unsafe { wide256($($p),*) },
+                    $crate::SimdWidth::Baseline => {}
                 }
             }
             $body($($p),*)
