@@ -23,10 +23,10 @@ use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
 use crate::forces::{self, Collider, Plane, Sphere};
 use crate::history::{History, Scheme};
 use crate::integrate::{Integrator, SolverSettings, SolverStats};
+use crate::math::Vec3;
 use crate::model::Model;
 use crate::parallel::Threads;
 use crate::topology::Topology;
-use crate::Vec3;
 
 /// Everything that configures a cloth besides its topology.
 #[derive(Clone, Debug, PartialEq)]

@@ -89,7 +89,7 @@ pub(crate) fn check_positive(name: &str, value: f64) -> Result<(), Error> {
 }
 
 /// Checks that every component of a vector is finite.
-pub(crate) fn check_finite_vec(name: &str, v: &crate::Vec3) -> Result<(), Error> {
+pub(crate) fn check_finite_vec(name: &str, v: &crate::math::Vec3) -> Result<(), Error> {
     if v.iter().all(|c| c.is_finite()) {
         Ok(())
     } else {

@@ -46,8 +46,8 @@ pub mod scenes;
 mod testing;
 pub mod topology;
 
-/// 3-vector of f64, the core's only vector type.
-pub type Vec3 = nalgebra::Vector3<f64>;
+pub mod math;
+pub use math::Vec3;
 
 pub(crate) use plumbing::{aligned, bytes, memory, parallel, soa};
 

@@ -5,8 +5,8 @@
 //! m s^{-1/2}, so `history_drag` and a fractional `spring_damping` are in N s^{1/2} / m.
 
 use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
+use crate::math::Vec3;
 use crate::topology::SpringKind;
-use crate::Vec3;
 
 /// How a spring resists the rate of change of its length.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -11,9 +11,9 @@ use crate::cloth::{Cloth, ClothConfig};
 use crate::error::Error;
 use crate::history::Scheme;
 use crate::integrate::Integrator;
+use crate::math::Vec3;
 use crate::model::{Model, SpringDamping};
 use crate::topology::GridSpec;
-use crate::Vec3;
 
 /// Parameters of `m x'' + c D^{1/2}x + k x = F`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -33,9 +33,9 @@ use crate::error::Error;
 use crate::forces::Sphere;
 use crate::history::Scheme;
 use crate::integrate::Integrator;
+use crate::math::Vec3;
 use crate::model::{Model, RegularDrag};
 use crate::topology::{grid_index, GridSpec};
-use crate::Vec3;
 
 /// Cloth width, m.
 pub const CLOTH_WIDTH: f64 = 0.6;

@@ -30,8 +30,8 @@
 
 use crate::forces::Inertia;
 use crate::integrate::Integrator;
+use crate::math::Vec3;
 use crate::model::{Model, SpringDamping};
-use crate::Vec3;
 
 use super::Cloth;
 

@@ -7,7 +7,7 @@ use crate::bytes::{ByteReader, ByteWriter};
 use crate::collide::self_collision::Pair;
 use crate::collide::{contact, Contact, MeshCollider};
 use crate::error::Error;
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// How far (in collision margins) a mesh collider's candidates reach beyond the margin before
 /// a cloth vertex looks again (`collide/mesh.rs`).

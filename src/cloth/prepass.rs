@@ -2,7 +2,7 @@
 //! vector unit the CPU has ([`crate::simd`]): they move every particle's numbers between
 //! `Vec3` arrays and component arrays, which vectorises only with wide shuffles.
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 crate::simd_dispatch! { pub(super) fn velocities_and_positions(x: &[Vec3], v: &[Vec3], current: Vec3, v_step: &mut [Vec3], v_rel: &mut [Vec3], sx: [&mut [f64]; 3]) => velocities_and_positions_kernel }
 

@@ -12,8 +12,8 @@ use crate::error::Error;
 use crate::forces::{self, ForceInput, ForceScratch, SpringInputs, TILE};
 use crate::history::History;
 use crate::integrate::{self, implicit_euler, ImplicitInput, ImplicitScratch, StepSoa};
+use crate::math::Vec3;
 use crate::parallel;
-use crate::Vec3;
 
 /// How a step goes from forces to the new state, chosen by [`Route::of`]:
 ///

@@ -5,7 +5,7 @@
 //! Median split on the longest axis of the centroids, at most four items a leaf; nodes are
 //! stored parent before children, so a refit is one backward sweep.
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Items in a leaf, at most.
 const LEAF: usize = 4;

@@ -13,7 +13,7 @@
 //! `df_j/dv_l = -c c_j c_l n n^T` (the change of `n` with position is left out, as for the
 //! analytic colliders). Friction is a velocity correction after the step, as for the others.
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Most vertices in one element.
 pub const MAX_VERTICES: usize = 4;

@@ -6,7 +6,7 @@
 //! are exact up to rounding: a segment crosses a triangle when its ends lie strictly on
 //! opposite sides of the triangle's plane and the crossing point is inside the triangle.
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Closest point of triangle `(a, b, c)` to `p`, as barycentric weights `[wa, wb, wc]` (each in
 /// [0, 1], summing to 1). A degenerate triangle gives the closest point of its longest edge.

@@ -5,7 +5,7 @@
 
 use super::bvh::{Aabb, Bvh};
 use super::geometry::{triangles_cross, triangles_sharing_a_vertex_cross};
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// The number of crossing triangle pairs of `triangles` at positions `x`.
 pub fn self_intersections(x: &[Vec3], triangles: &[[u32; 3]]) -> usize {

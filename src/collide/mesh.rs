@@ -26,7 +26,7 @@ use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
 use super::geometry::closest_on_triangle;
 use crate::error::Error;
-use crate::Vec3;
+use crate::math::Vec3;
 
 const NONE: u32 = u32::MAX;
 

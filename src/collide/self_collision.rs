@@ -22,7 +22,7 @@
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
 use super::geometry::{closest_on_segments, closest_on_triangle};
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// The skin of the pair list, in thicknesses: pairs within `(1 + SKIN)` thicknesses are kept,
 /// and the list is looked up again when the cloth has deformed by half the skin.

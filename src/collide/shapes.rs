@@ -1,7 +1,7 @@
 //! Closed triangle meshes of simple solids, outward-facing (counter-clockwise seen from
 //! outside): the colliders of the built-in scenes and of the tests.
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// A mesh: vertices and triangles.
 pub type Mesh = (Vec<Vec3>, Vec<[u32; 3]>);

@@ -18,7 +18,7 @@ use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use super::{write_obj, MddWriter, Pc2Writer};
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Largest |start frame| a cache accepts (PC2 stores it as a float, OBJ sequences number
 /// their files from it).

@@ -11,7 +11,7 @@ use std::fs::{File, OpenOptions};
 use std::io::{self, Read, Seek, SeekFrom, Write};
 use std::path::Path;
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// At most this many frames may be announced: the frame times come first, and are written
 /// when the file is opened (4 bytes each: 4 MB here).

@@ -14,7 +14,7 @@ pub use read::{parse_mdd, parse_obj, parse_pc2, read_cache, read_obj, CacheFrame
 
 /// One frame as f32 triples, little- or big-endian (the caches' only difference in encoding).
 /// A position beyond the float range is an error (it would be written as infinite).
-pub(crate) fn encode_frame(positions: &[crate::Vec3], big_endian: bool) -> std::io::Result<Vec<u8>> {
+pub(crate) fn encode_frame(positions: &[crate::math::Vec3], big_endian: bool) -> std::io::Result<Vec<u8>> {
     let mut buf = Vec::new();
     buf.try_reserve_exact(12 * positions.len())
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::OutOfMemory, e.to_string()))?;

@@ -2,7 +2,7 @@
 
 use std::io::{self, Write};
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Writes `v x y z` lines then 1-based `f a b c` lines, and flushes: a write that fails only
 /// when the buffer drains (a full disk) is an error, not a silently short file.

@@ -8,7 +8,7 @@
 
 use std::io::{self, Seek, SeekFrom, Write};
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Streaming PC2 writer.
 pub struct Pc2Writer<W: Write + Seek> {

@@ -6,7 +6,7 @@
 use std::io;
 use std::path::Path;
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Frames read from a point cache.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -1,7 +1,7 @@
 //! Colliders, addressed by small integer ids.
 
 use crate::forces::{Capsule, Collider, Plane, Sphere};
-use crate::Vec3;
+use crate::math::Vec3;
 
 use super::cloth::{handle, handle_mut, slice_in, triples};
 use super::status::{guard, FcStatus, FfiError};
@@ -270,7 +270,7 @@ pub unsafe extern "C" fn fc_cloth_get_sphere(
 ///
 /// # Safety
 /// `out` NULL or 3 writable floats.
-unsafe fn put3(out: *mut f32, v: &crate::Vec3) {
+unsafe fn put3(out: *mut f32, v: &crate::math::Vec3) {
     if !out.is_null() {
         // SAFETY: non-NULL; the caller promises 3 writable floats.
         let o = unsafe { std::slice::from_raw_parts_mut(out, 3) };

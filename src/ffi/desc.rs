@@ -9,9 +9,9 @@
 use crate::cloth::ClothConfig;
 use crate::history::Scheme;
 use crate::integrate::{Integrator, SolverSettings};
+use crate::math::Vec3;
 use crate::model::{Model, RegularDrag, SpringDamping};
 use crate::topology::GridSpec;
-use crate::Vec3;
 
 use super::desc_size::{read_desc, write_desc, DESC_SIZE};
 use super::status::{guard, FcStatus, FfiError};

@@ -2,7 +2,7 @@
 
 use super::cloth::{check_float_count, handle, to_f32, write_triples, FcCloth};
 use super::status::{guard, FcStatus, FfiError};
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Copies the triangles (three vertex indices each, counter-clockwise seen from the side the
 /// normals point to; quads of a mesh split on one diagonal, grids as the OBJ and caches write

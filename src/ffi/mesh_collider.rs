@@ -1,6 +1,6 @@
 //! Triangle-mesh colliders: any mesh, static, moving or deforming (a skinned character).
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 use super::cloth::{handle, handle_mut, slice_in, triples, FcCloth};
 use super::status::{guard, FcStatus, FfiError};

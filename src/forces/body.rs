@@ -1,7 +1,7 @@
 //! Gravity and buoyancy, Eq. 2: `F_g = (rho_c - rho_w) V_c g` with `V_c = m / rho_c`.
 
+use crate::math::Vec3;
 use crate::model::Model;
-use crate::Vec3;
 
 /// Net weight in water of a particle of mass `m` (N): `m` times [`body_acceleration`].
 pub fn body_force(model: &Model, m: f64) -> Vec3 {

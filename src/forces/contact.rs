@@ -11,8 +11,8 @@
 //! most μ times the normal velocity change the contact gave, and never reverses), which is
 //! stable at any step size.
 
+use crate::math::Vec3;
 use crate::model::Model;
-use crate::Vec3;
 
 /// A sphere collider, moved by the host between steps.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -8,8 +8,8 @@
 //! to a tile's forces as component arrays ([`super::terms`] decides when), in a loop over the
 //! tile that the compiler vectorises.
 
+use crate::math::Vec3;
 use crate::model::Model;
-use crate::Vec3;
 
 crate::simd_dispatch! { pub(super) fn add_viscous(m: &Model, v: [&[f64]; 3], areas: &[f64], f: [&mut [f64]; 3]) => add_viscous_kernel }
 

@@ -23,9 +23,9 @@
 
 use nalgebra::Matrix3;
 
+use crate::math::Vec3;
 use crate::model::Model;
 use crate::topology::Topology;
-use crate::Vec3;
 
 /// The inertia of one particle: `M = (mass + entrained) I + normal_mass n n^T`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -12,7 +12,7 @@
 //! ahead of the springs that read them: the window stays in cache.
 
 use super::springs::{Params, SpringRate};
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// The step's arrays a window copies from: positions always, velocities and half-derivatives
 /// when some reader needs them (all of one length).

@@ -17,8 +17,8 @@ use nalgebra::Matrix3;
 
 use super::terms::{self, Context, Particle};
 use super::{body_acceleration, ForceInput};
+use crate::math::Vec3;
 use crate::model::SpringDamping;
-use crate::Vec3;
 
 /// A spring's 3x3 block in the form every spring block has: `along dir dir^T + across I`
 /// (40 bytes instead of a matrix's 72; applying it is two dot-product-sized operations).

@@ -1,8 +1,8 @@
 //! Area-weighted vertex normals from the triangle list.
 
+use crate::math::Vec3;
 use crate::parallel;
 use crate::topology::Adjacency;
-use crate::Vec3;
 
 /// Unit normal of every vertex (zero for a vertex in no non-degenerate triangle).
 pub fn vertex_normals(x: &[Vec3], triangles: &[[u32; 3]], out: &mut [Vec3]) {

@@ -13,11 +13,11 @@ use super::springs::{self, spring_rate, SpringRate};
 use super::terms::{self, Context, Tile};
 use super::tiles::{self, TILE};
 use super::{body_acceleration, Collider};
+use crate::math::Vec3;
 use crate::model::Model;
 use crate::parallel;
 use crate::soa::Soa3;
 use crate::topology::Topology;
-use crate::Vec3;
 
 /// Everything the forces read at one instant.
 pub struct ForceInput<'a> {

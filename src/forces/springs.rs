@@ -79,7 +79,7 @@ pub(super) fn params<'a>(
     fill: bool,
 ) -> Params<'a> {
     let m = input.model;
-    let rate: Option<&[crate::Vec3]> = match spring_rate(m) {
+    let rate: Option<&[crate::math::Vec3]> = match spring_rate(m) {
         SpringRate::None => None,
         SpringRate::Velocity => Some(input.v),
         SpringRate::HalfDerivative => Some(input.half_derivative),

@@ -16,9 +16,9 @@
 //! three springs to a `Vec3` entry: every scheme is linear and acts component by component).
 //! The implicit integrator treats `k_d w0` as the spring's damping, as for Eq. 5.
 
+use crate::math::Vec3;
 use crate::model::Model;
 use crate::topology::Topology;
-use crate::Vec3;
 
 /// History entries (`Vec3`) for `springs` springs.
 pub fn entries(springs: usize) -> usize {

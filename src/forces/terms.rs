@@ -16,8 +16,8 @@ use super::body::add_weight_widest;
 use super::contact;
 use super::drag;
 use super::Collider;
+use crate::math::Vec3;
 use crate::model::Model;
-use crate::Vec3;
 
 /// A tile of consecutive particles `p0 ..` as the terms read it: component arrays of one
 /// length, `[x, y, z]`.

@@ -480,9 +480,9 @@ fn add3(
 #[cfg(test)]
 mod tests {
     use super::super::{total_forces, ForceInput, ForceScratch};
+    use crate::math::Vec3;
     use crate::model::Model;
     use crate::topology::{GridSpec, Topology};
-    use crate::Vec3;
 
     /// Spring forces the plain way: every spring once, f64 square root and division, scattered.
     fn reference(m: &Model, t: &Topology, x: &[Vec3], q: &[Vec3]) -> Vec<Vec3> {

@@ -8,7 +8,7 @@
 
 use super::kernel::panel_weights;
 use super::HalfDerivative;
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Every past velocity of every particle, with its time.
 #[derive(Debug)]

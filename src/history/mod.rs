@@ -35,7 +35,7 @@ pub use soe_kernel::SoeKernel;
 pub use truncated::{eq6_weights, Truncated};
 
 use crate::error::Error;
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Which scheme evaluates D^{1/2}x (configuration; see [`History`] for the state).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -36,8 +36,8 @@ use std::sync::Arc;
 
 use super::soe_kernel::SoeKernel;
 use super::HalfDerivative;
+use crate::math::Vec3;
 use crate::parallel;
-use crate::Vec3;
 
 /// Largest cut-off exponent of [`SumOfExponentials::active_modes`].
 const SKIP_EXPONENT: f64 = 50.0;

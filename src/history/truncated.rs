@@ -29,7 +29,7 @@
 //! the newest step size.
 
 use super::HalfDerivative;
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Eq. 6 state: the last `u` velocities of every particle.
 #[derive(Debug)]

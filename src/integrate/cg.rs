@@ -3,8 +3,8 @@
 
 use nalgebra::Matrix3;
 
+use crate::math::Vec3;
 use crate::parallel;
-use crate::Vec3;
 
 /// Tolerance and iteration cap of the solver.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -5,7 +5,7 @@
 //! must be large enough for the stiffest mode: h ω² < c), see `docs/`.
 
 use super::{step_soa_with, StepInput};
-use crate::Vec3;
+use crate::math::Vec3;
 
 crate::simd_dispatch! { pub fn explicit_euler_soa(s: &StepInput<'_>, x_new: &mut [Vec3], v_new: &mut [Vec3]) -> bool => explicit_euler_soa_kernel }
 

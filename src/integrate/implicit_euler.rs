@@ -17,9 +17,9 @@ use super::cg::{self, CgScratch, SolverSettings, SolverStats};
 use crate::collide::{contact, Contact};
 use crate::forces::add_spring_values;
 use crate::forces::{Linearisation, SpringBlock};
+use crate::math::Vec3;
 use crate::parallel;
 use crate::topology::{for_each_piece, Topology};
-use crate::Vec3;
 
 /// Work memory of the implicit step.
 #[derive(Clone, Debug, Default)]

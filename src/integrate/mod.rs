@@ -9,7 +9,7 @@ mod explicit_euler;
 mod implicit_euler;
 mod symplectic_euler;
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 pub use cg::{SolverSettings, SolverStats};
 pub use explicit_euler::explicit_euler_soa;

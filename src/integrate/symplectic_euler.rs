@@ -5,7 +5,7 @@
 //! explicit.
 
 use super::{step_soa_with, StepInput};
-use crate::Vec3;
+use crate::math::Vec3;
 
 crate::simd_dispatch! { pub fn symplectic_euler_soa(s: &StepInput<'_>, x_new: &mut [Vec3], v_new: &mut [Vec3]) -> bool => symplectic_euler_soa_kernel }
 

@@ -4,7 +4,7 @@
 
 use super::harmonic::dominant_frequency;
 use crate::error::Error;
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Flutter below this (m, rms) is stillness: no frequency is reported.
 pub const STILL: f64 = 1e-4;

@@ -1,7 +1,7 @@
 //! Little-endian byte writer and bounds-checked reader for the snapshot format.
 
 use crate::error::Error;
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Appends little-endian values to a byte vector, or only counts them (to size a snapshot
 /// without building it).

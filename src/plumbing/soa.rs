@@ -10,8 +10,8 @@
 //! [`crate::forces`]' `inputs` module.)
 
 use crate::aligned::AlignedF64;
+use crate::math::Vec3;
 use crate::parallel;
-use crate::Vec3;
 
 /// Three component arrays of equal length, each starting on a cache line.
 #[derive(Clone, Debug, Default)]

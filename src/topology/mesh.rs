@@ -18,7 +18,7 @@ use std::collections::HashMap;
 
 use super::{Spring, SpringKind, Topology};
 use crate::error::Error;
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Largest vertex count a mesh may have (keeps u32 indices and memory sane).
 pub const MAX_MESH_VERTICES: usize = 1 << 24;

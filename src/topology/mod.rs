@@ -18,7 +18,7 @@ pub use runs::{for_each_piece, SpringRun, TileRuns};
 pub use spring::{Spring, SpringKind};
 pub use tiling::{TileLayout, GATHER_RUNS};
 
-use crate::Vec3;
+use crate::math::Vec3;
 
 /// Rest geometry and connectivity of a cloth.
 #[derive(Clone, Debug)]
