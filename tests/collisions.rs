@@ -12,19 +12,6 @@ use fraccloth::{Cloth, Integrator, Model, Vec3};
 
 const FPS: f64 = 30.0;
 
-/// The collision scenes' towel (`scenes::collision_towel`).
-fn towel(
-    w: u32,
-    h: u32,
-    spacing: f64,
-    y: f64,
-    pose: TowelPose,
-    thickness: f64,
-    integrator: Integrator,
-) -> Cloth {
-    collision_towel(w, h, spacing, y, pose, thickness, integrator).unwrap()
-}
-
 /// The most self-intersections over `frames` frames, stepping with `each` before each frame.
 fn worst_intersections(cloth: &mut Cloth, frames: usize, mut each: impl FnMut(&mut Cloth, usize)) -> usize {
     let tris = cloth.topology().triangles.clone();
@@ -41,7 +28,7 @@ fn worst_intersections(cloth: &mut Cloth, frames: usize, mut each: impl FnMut(&m
 /// and piles up in folds over 5 s. Returns the most crossing triangle pairs at any frame, the
 /// pile's top at the end and the self-collision pairs in reach then.
 fn drop(thickness: f64, integrator: Integrator) -> (usize, f64, usize) {
-    let mut cloth = towel(21, 31, 0.02, 0.62, TowelPose::Wavy, thickness, integrator);
+    let mut cloth = collision_towel(21, 31, 0.02, 0.62, TowelPose::Wavy, thickness, integrator).unwrap();
     let floor = Plane {
         point: Vec3::zeros(),
         normal: Vec3::y(),
@@ -76,7 +63,7 @@ fn a_towel_dropped_on_the_floor_folds_without_crossing_itself() {
 #[test]
 fn a_towel_on_a_turning_torus_stays_outside_it() {
     let (tx, tt) = torus(Vec3::zeros(), 0.12, 0.05, 48, 16);
-    let mut cloth = towel(
+    let mut cloth = collision_towel(
         25,
         25,
         0.016,
@@ -84,7 +71,8 @@ fn a_towel_on_a_turning_torus_stays_outside_it() {
         TowelPose::Flat,
         0.0,
         Integrator::SymplecticEuler,
-    );
+    )
+    .unwrap();
     let id = cloth.add_mesh_collider(&tx, &tt, None).unwrap();
     cloth.set_collider_friction(id, 0.5).unwrap();
     let mut worst = 0;
@@ -125,7 +113,7 @@ fn a_towel_on_a_turning_torus_stays_outside_it() {
 /// sideways: the bar catches the towel and carries it, no vertex slips past.
 #[test]
 fn a_bar_thinner_than_the_spacing_catches_the_towel() {
-    let mut cloth = towel(
+    let mut cloth = collision_towel(
         21,
         21,
         0.02,
@@ -133,7 +121,8 @@ fn a_bar_thinner_than_the_spacing_catches_the_towel() {
         TowelPose::Hanging,
         0.0,
         Integrator::SymplecticEuler,
-    );
+    )
+    .unwrap();
     let top: Vec<u32> = (0..21).collect();
     cloth.set_pinned(&top).unwrap();
     // A horizontal bar along x through the towel's lower half, 10 cm in front of it (z).
@@ -180,7 +169,7 @@ fn a_towel_on_a_mesh_floor_in_a_current_keeps_its_contact() {
     // in z: widen it to 2 m by scaling z.
     let fx: Vec<Vec3> = floor.0.iter().map(|p| Vec3::new(p.x, p.y, p.z * 20.0)).collect();
     let run = |friction: f64| {
-        let mut cloth = towel(
+        let mut cloth = collision_towel(
             21,
             21,
             0.02,
@@ -188,7 +177,8 @@ fn a_towel_on_a_mesh_floor_in_a_current_keeps_its_contact() {
             TowelPose::Flat,
             0.0,
             Integrator::SymplecticEuler,
-        );
+        )
+        .unwrap();
         let id = cloth.add_mesh_collider(&fx, &floor.1, None).unwrap();
         cloth.set_collider_friction(id, friction).unwrap();
         for _ in 0..30 {
@@ -242,7 +232,7 @@ fn a_snapshot_resumes_a_bake_with_collisions_bitwise() {
         floor.1,
     );
     let make = || {
-        towel(
+        collision_towel(
             21,
             31,
             0.02,
@@ -251,6 +241,7 @@ fn a_snapshot_resumes_a_bake_with_collisions_bitwise() {
             0.005,
             Integrator::SymplecticEuler,
         )
+        .unwrap()
     };
     let pose = |f: usize| -> Vec<Vec3> {
         tx.iter()
