@@ -87,6 +87,13 @@ class FcClothDesc(ctypes.Structure):
     __slots__ = ()
     _fields_ = [(name, ctype) for name, ctype, _ in _abi.DESC_FIELDS]
 
+    def __repr__(self) -> str:
+        """Every field and its value, one per line (`print(desc)`)."""
+        def show(value):
+            return "(" + ", ".join(repr(v) for v in value) + ")" if isinstance(value, ctypes.Array) else repr(value)
+
+        return "FcClothDesc(\n" + "".join(f"    {name}={show(getattr(self, name))},\n" for name, _, _ in _abi.DESC_FIELDS) + ")"
+
 
 FcClothDesc.__doc__ = _desc_doc()
 _ENUMS = _abi.ENUMS

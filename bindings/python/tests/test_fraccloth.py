@@ -317,3 +317,10 @@ def test_triangle_mesh_collider_and_self_collision():
         assert e.value.status == 3
         with pytest.raises(fraccloth.Error):
             cloth.set_mesh_collider(mesh, box[:7])
+
+
+def test_a_description_prints_its_fields():
+    desc = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
+    text = repr(desc)
+    assert text.startswith("FcClothDesc(") and "added_mass=10.0" in text and "gravity=(0.0, -9.81, 0.0)" in text
+    assert str(desc) == text and text.count("=") == len(fraccloth.FcClothDesc._fields_)
