@@ -86,6 +86,11 @@ class BuildWithLibrary(build_py):
         dest = Path(self.build_lib) / "fraccloth" / "_lib"
         dest.mkdir(parents=True, exist_ok=True)
         shutil.copy2(find_or_build_library(), dest / library_name())
+        # The release build keeps line tables for profiling; the package does not need them
+        # (the exported symbols stay): a third of the size.
+        strip = shutil.which("strip")
+        if strip:
+            subprocess.run([strip, "--strip-debug", str(dest / library_name())], check=False)
         # The license texts travel with the wheel.
         for name in ("LICENSE-MIT", "LICENSE-APACHE"):
             if (REPO / name).exists():
