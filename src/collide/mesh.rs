@@ -296,11 +296,11 @@ impl MeshCollider {
     /// Outward pseudo-normal of the feature of triangle `t` at barycentric weights `w`.
     fn pseudo_normal(&self, t: u32, w: [f64; 3]) -> Vec3 {
         let tri = &self.triangles[t as usize];
-        let zero: Vec<usize> = (0..3).filter(|&k| w[k] <= 0.0).collect();
         let face = self.face_normal[t as usize];
-        match zero.as_slice() {
+        match [w[0] <= 0.0, w[1] <= 0.0, w[2] <= 0.0] {
             // On the edge opposite corner z: edge (z+1, z+2), which is edge index (z+1) % 3.
-            [z] => {
+            [true, false, false] | [false, true, false] | [false, false, true] => {
+                let z = w.iter().position(|&wk| wk <= 0.0).unwrap_or(0);
                 let o = self.neighbours[t as usize][(z + 1) % 3];
                 if o == NONE {
                     face
@@ -310,26 +310,35 @@ impl MeshCollider {
                         .unwrap_or(face)
                 }
             }
-            [a, b] => self.vertex_normal[tri[3 - a - b] as usize],
+            // At the corner whose weight is not zero.
+            [false, true, true] => self.vertex_normal[tri[0] as usize],
+            [true, false, true] => self.vertex_normal[tri[1] as usize],
+            [true, true, false] => self.vertex_normal[tri[2] as usize],
             _ => face,
         }
     }
 
-    /// Signed distance and outward direction from triangle `t` (at fraction `f`) to `p`, the
-    /// closest point's weights; unsigned on an open mesh.
-    fn probe(&self, t: u32, f: f64, p: &Vec3) -> (f64, Vec3, [f64; 3]) {
+    /// Unsigned distance from triangle `t` (at fraction `f`) to `p`, the closest point's
+    /// weights and the vector from it to `p`.
+    fn nearest_on(&self, t: u32, f: f64, p: &Vec3) -> (f64, [f64; 3], Vec3) {
         let [a, b, c] = self.corners(t, f);
         let w = closest_on_triangle(p, &a, &b, &c);
         let r = p - (w[0] * a + w[1] * b + w[2] * c);
-        let d = r.norm();
+        (r.norm(), w, r)
+    }
+
+    /// Signed distance (negative inside a closed mesh; unsigned on an open one) and outward
+    /// direction of a point at unsigned distance `d` and offset `r` from triangle `t`'s point
+    /// of weights `w`.
+    fn signed(&self, t: u32, d: f64, w: [f64; 3], r: &Vec3) -> (f64, Vec3) {
         let n = self.pseudo_normal(t, w);
         if self.closed {
             let inside = r.dot(&n) < 0.0;
             let dir = if d > 1e-12 && !inside { r / d } else { n };
-            (if inside { -d } else { d }, dir, w)
+            (if inside { -d } else { d }, dir)
         } else {
             let dir = if d > 1e-12 { r / d } else { n };
-            (d, dir, w)
+            (d, dir)
         }
     }
 
@@ -358,9 +367,10 @@ impl MeshCollider {
         // Cloth vertex against the nearest mesh triangle.
         for (i, cands) in self.cache.vertex.iter().enumerate() {
             let p = &x[i];
-            let mut best: Option<(f64, Vec3, u32, [f64; 3])> = None;
+            let mut best: Option<(f64, u32, [f64; 3], Vec3)> = None;
             // The last nearest first; then only triangles whose swept box is nearer than the
-            // best so far (the box holds the triangle at every fraction of the call).
+            // best so far (the box holds the triangle at every fraction of the call). Nearest
+            // by unsigned distance; the side only for the nearest.
             let hint = self.cache.nearest.get(i).copied().filter(|t| cands.contains(t));
             for &t in hint.iter().chain(cands.iter().filter(|&&t| Some(t) != hint)) {
                 if let Some(b) = &best {
@@ -368,15 +378,16 @@ impl MeshCollider {
                         continue;
                     }
                 }
-                let (d, dir, w) = self.probe(t, f, p);
-                if best.is_none_or(|b| d.abs() < b.0.abs()) {
-                    best = Some((d, dir, t, w));
+                let (d, w, r) = self.nearest_on(t, f, p);
+                if best.is_none_or(|b| d < b.0) {
+                    best = Some((d, t, w, r));
                 }
             }
             if let (Some(b), Some(slot)) = (&best, self.cache.nearest.get_mut(i)) {
-                *slot = b.2;
+                *slot = b.1;
             }
-            if let Some((d, dir, t, w)) = best {
+            if let Some((d, t, w, r)) = best {
+                let (d, dir) = self.signed(t, d, w, &r);
                 if d < margin {
                     out.push(Contact {
                         idx: [i as u32, 0, 0, 0],
