@@ -317,3 +317,49 @@ fn the_brisk_swing_with_self_collision_does_not_cross_itself() {
         "self-collision at least halves the crossings: {with} vs {without}"
     );
 }
+
+/// A refused step call leaves a cloth with collisions exactly as it was, self-collision's
+/// remembered pairs and sides included (the snapshot bytes are the same).
+#[test]
+fn a_refused_step_leaves_the_collision_state_as_it_was() {
+    let mut cloth = collision_towel(
+        21,
+        31,
+        0.02,
+        0.62,
+        TowelPose::Wavy,
+        0.005,
+        Integrator::SymplecticEuler,
+    )
+    .unwrap();
+    let floor = Plane {
+        point: Vec3::zeros(),
+        normal: Vec3::y(),
+        velocity: Vec3::zeros(),
+    };
+    cloth.add_collider(Collider::Plane(floor)).unwrap();
+    for _ in 0..120 {
+        cloth.step(1.0 / FPS).unwrap();
+    }
+    assert!(
+        !cloth.self_collision_pairs().0.is_empty(),
+        "the pile has pairs to remember"
+    );
+    // A pin thrown a kilometre away: the call is refused part-way (the step limit slows free
+    // vertices, not pins).
+    let corner = cloth.positions()[0];
+    cloth.set_pinned(&[0]).unwrap();
+    cloth
+        .set_pin_targets(&[0], &[corner + Vec3::new(1000.0, 0.0, 0.0)])
+        .unwrap();
+    let before = cloth.save_snapshot().unwrap();
+    let e = cloth.step_substeps(1.0 / FPS, 10).expect_err("refused");
+    assert_eq!(e.kind, fraccloth::ErrorKind::Unstable, "{}", e.message);
+    assert_eq!(
+        cloth.save_snapshot().unwrap(),
+        before,
+        "the refused call changed the cloth"
+    );
+    cloth.set_pin_targets(&[0], &[corner]).unwrap();
+    cloth.step(1.0 / FPS).expect("and it steps on");
+}

@@ -82,13 +82,16 @@ pub(super) struct StepScratch {
     pub implicit: ImplicitScratch,
 }
 
-/// State saved before a multi-substep call, restored if a substep fails.
+/// State saved before a multi-substep call, restored if a substep fails (and around the whole
+/// step of an extrapolated integrator).
 #[derive(Clone, Debug, Default)]
 pub(super) struct Rollback {
     pub(super) x: Vec<Vec3>,
     pub(super) v: Vec<Vec3>,
     history: Option<History>,
     strain_history: Option<History>,
+    /// Self-collision's remembered pairs and sides (state: a snapshot carries them).
+    self_collision: crate::collide::self_collision::SavedMemory,
     time: f64,
     steps: u64,
 }
@@ -121,6 +124,7 @@ impl Rollback {
             Some(h) => h.clone_from(&c.strain_history),
             None => self.strain_history = Some(c.strain_history.clone()),
         }
+        c.self_collision.save_memory(&mut self.self_collision);
         self.time = c.time;
         self.steps = c.steps;
         Ok(())
@@ -135,6 +139,7 @@ impl Rollback {
         if let Some(h) = &mut self.strain_history {
             std::mem::swap(&mut c.strain_history, h);
         }
+        c.self_collision.swap_memory(&mut self.self_collision);
         c.time = self.time;
         c.steps = self.steps;
     }

@@ -38,6 +38,14 @@ pub const EXCLUDED: f64 = 2.2;
 /// both).
 pub type Pair = (u32, u32, i8);
 
+/// What self-collision remembers across steps, saved by a rollback.
+#[derive(Clone, Debug, Default)]
+pub struct SavedMemory {
+    vertex_triangle: Vec<Pair>,
+    edge_edge: Vec<Pair>,
+    looked_at: Vec<Vec3>,
+}
+
 /// Self-collision's search and memory; see the module docs.
 #[derive(Clone, Debug, Default)]
 pub struct SelfCollision {
@@ -442,6 +450,22 @@ impl SelfCollision {
     #[cfg(test)]
     pub(crate) fn look_again(&mut self) {
         self.looked_at.clear();
+    }
+
+    /// Copies what self-collision remembers (the pairs with their sides, and where it last
+    /// looked) into `saved`, reusing its buffers.
+    pub(crate) fn save_memory(&self, saved: &mut SavedMemory) {
+        saved.vertex_triangle.clone_from(&self.vertex_triangle);
+        saved.edge_edge.clone_from(&self.edge_edge);
+        saved.looked_at.clone_from(&self.looked_at);
+    }
+
+    /// Swaps what self-collision remembers with `saved` (a rollback: the failed step's memory
+    /// goes to `saved`).
+    pub(crate) fn swap_memory(&mut self, saved: &mut SavedMemory) {
+        std::mem::swap(&mut self.vertex_triangle, &mut saved.vertex_triangle);
+        std::mem::swap(&mut self.edge_edge, &mut saved.edge_edge);
+        std::mem::swap(&mut self.looked_at, &mut saved.looked_at);
     }
 
     /// The remembered pairs (vertex-triangle, edge-edge).
