@@ -96,10 +96,10 @@ impl Cloth {
     /// the end of this step) and of the cloth with itself, their forces added to the forces
     /// before the force pass. Nothing without meshes or self-collision.
     pub(super) fn collisions(&mut self, fraction: Option<f64>) {
+        let (margin, skin) = self.mesh_reach();
         let s = &mut self.scratch;
         s.contacts.clear();
         let m = &self.config.model;
-        let (margin, skin) = (m.collision_margin, MESH_SKIN_MARGINS * m.collision_margin);
         let f = fraction.unwrap_or(1.0);
         for mesh in self.mesh_slots.iter_mut().flatten() {
             // A step outside a call (a snapshot's trial step) finds the boxes made here.

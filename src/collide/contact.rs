@@ -112,19 +112,21 @@ pub fn apply_friction(
     any
 }
 
-/// The contacts' part of the implicit system `A p`: `(h c_e + h^2 k) c_j (n . sum_l c_l p_l) n`
-/// added to `out[j]`, `c_e` the damping while approaching (at velocities `v`).
-pub fn add_system_product(
-    contacts: &[Contact],
-    k: f64,
-    c: f64,
-    h: f64,
-    v: &[Vec3],
-    p: &[Vec3],
-    out: &mut [Vec3],
-) {
-    for e in contacts {
-        let w = system_weight(e, k, c, h, v);
+/// Each contact's weight in the implicit system, `h c_e + h^2 k`, `c_e` the damping while
+/// approaching (at velocities `v`), into `out` (once a solve; the product reads it every
+/// iteration).
+pub fn system_weights(contacts: &[Contact], k: f64, c: f64, h: f64, v: &[Vec3], out: &mut Vec<f64>) {
+    out.clear();
+    out.extend(contacts.iter().map(|e| {
+        let damping = if e.approach(v) > 0.0 { c } else { 0.0 };
+        h * damping + h * h * k
+    }));
+}
+
+/// The contacts' part of the implicit system `A p`: `w_e c_j (n . sum_l c_l p_l) n` added to
+/// `out[j]`, `w_e` from [`system_weights`].
+pub fn add_system_product(contacts: &[Contact], weights: &[f64], p: &[Vec3], out: &mut [Vec3]) {
+    for (e, &w) in contacts.iter().zip(weights) {
         let s = w * e.dir.dot(&e.combine(p));
         for (i, cj) in e.terms() {
             out[i] += (cj * s) * e.dir;
@@ -132,23 +134,10 @@ pub fn add_system_product(
     }
 }
 
-/// `h c_e + h^2 k` of one contact.
-fn system_weight(e: &Contact, k: f64, c: f64, h: f64, v: &[Vec3]) -> f64 {
-    let damping = if e.approach(v) > 0.0 { c } else { 0.0 };
-    h * damping + h * h * k
-}
-
-/// The contacts' diagonal blocks `(h c_e + h^2 k) c_j^2 n n^T`, added to `blocks[j]`.
-pub fn add_system_diagonal(
-    contacts: &[Contact],
-    k: f64,
-    c: f64,
-    h: f64,
-    v: &[Vec3],
-    blocks: &mut [nalgebra::Matrix3<f64>],
-) {
-    for e in contacts {
-        let nn = e.dir * e.dir.transpose() * system_weight(e, k, c, h, v);
+/// The contacts' diagonal blocks `w_e c_j^2 n n^T`, added to `blocks[j]`.
+pub fn add_system_diagonal(contacts: &[Contact], weights: &[f64], blocks: &mut [nalgebra::Matrix3<f64>]) {
+    for (e, &w) in contacts.iter().zip(weights) {
+        let nn = e.dir * e.dir.transpose() * w;
         for (i, cj) in e.terms() {
             blocks[i] += cj * cj * nn;
         }
@@ -222,7 +211,9 @@ mod tests {
         let v = vec![Vec3::zeros(); 4];
         let p: Vec<Vec3> = (0..4).map(|i| Vec3::new(0.3, -0.1 * i as f64, 0.7)).collect();
         let mut out = vec![Vec3::zeros(); 4];
-        add_system_product(&[e], k, 0.0, h, &v, &p, &mut out);
+        let mut weights = Vec::new();
+        system_weights(&[e], k, 0.0, h, &v, &mut weights);
+        add_system_product(&[e], &weights, &p, &mut out);
         // f(x + eps p) - f(x - eps p): depth changes by -/+ eps n . u(p).
         let force_at = |s: f64| {
             let mut moved = e;
@@ -237,12 +228,12 @@ mod tests {
             assert!((jp - out[i]).norm() < 1e-12, "{i}");
         }
         let mut blocks = vec![nalgebra::Matrix3::zeros(); 4];
-        add_system_diagonal(&[e], k, 0.0, h, &v, &mut blocks);
+        add_system_diagonal(&[e], &weights, &mut blocks);
         let only0: Vec<Vec3> = (0..4)
             .map(|i| if i == 0 { p[0] } else { Vec3::zeros() })
             .collect();
         let mut out0 = vec![Vec3::zeros(); 4];
-        add_system_product(&[e], k, 0.0, h, &v, &only0, &mut out0);
+        add_system_product(&[e], &weights, &only0, &mut out0);
         assert!((blocks[0] * p[0] - out0[0]).norm() < 1e-15);
     }
 

@@ -33,6 +33,8 @@ pub struct ImplicitScratch {
     spring_blocks: Vec<SpringBlock>,
     spring_matrices: Vec<Matrix3<f64>>,
     spring_values: Vec<Vec3>,
+    /// Each contact element's weight in the system (`collide/contact.rs`).
+    contact_weights: Vec<f64>,
     cg: CgScratch,
 }
 
@@ -74,6 +76,7 @@ fn apply_system(
     inp: &ImplicitInput<'_>,
     lin: &Linearisation,
     blocks: &[SpringBlock],
+    contact_weights: &[f64],
     values: &mut [Vec3],
     p: &[Vec3],
     out: &mut [Vec3],
@@ -92,8 +95,7 @@ fn apply_system(
         }
         add_spring_values(inp.topology, first, values, -1.0, chunk);
     });
-    let (k, c) = (inp.contact_stiffness, inp.contact_damping);
-    contact::add_system_product(inp.contacts, k, c, h, inp.v, p, out);
+    contact::add_system_product(inp.contacts, contact_weights, p, out);
 }
 
 /// Solves for the new velocities of free particles into `v_new` (pinned entries keep `inp.v`).
@@ -114,6 +116,7 @@ pub fn implicit_euler(
         spring_blocks,
         spring_matrices,
         spring_values,
+        contact_weights,
         cg,
     } = scratch;
     rhs.resize(n, Vec3::zeros());
@@ -152,6 +155,8 @@ pub fn implicit_euler(
     });
     let (kc, cc) = (inp.contact_stiffness, inp.contact_damping);
     contact::add_rhs(inp.contacts, kc, h, inp.v, rhs);
+    contact::system_weights(inp.contacts, kc, cc, h, inp.v, contact_weights);
+    let contact_weights = &*contact_weights;
     // Block-Jacobi preconditioner: inverse of each 3x3 diagonal block of the system.
     let blocks = &*spring_blocks;
     parallel::chunks(par, spring_matrices, parallel::CHUNK, |first, chunk| {
@@ -170,7 +175,7 @@ pub fn implicit_euler(
         }
         add_spring_values(t, first, matrices, 1.0, chunk);
     });
-    contact::add_system_diagonal(inp.contacts, kc, cc, h, inp.v, precond);
+    contact::add_system_diagonal(inp.contacts, contact_weights, precond);
     parallel::chunks(par, precond, parallel::CHUNK, |first, chunk| {
         for (k, m) in chunk.iter_mut().enumerate() {
             *m = m
@@ -180,7 +185,7 @@ pub fn implicit_euler(
     });
     let lin_ref: &Linearisation = lin;
     let stats = cg::solve(
-        |p, out| apply_system(inp, lin_ref, blocks, spring_values, p, out),
+        |p, out| apply_system(inp, lin_ref, blocks, contact_weights, spring_values, p, out),
         rhs,
         precond,
         inp.pinned,
