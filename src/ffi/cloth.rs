@@ -318,6 +318,17 @@ pub(crate) unsafe fn copy_out<T>(
 }
 
 /// f64 to the ABI's float.
+/// Writes `value` to an optional output (nothing for NULL).
+///
+/// # Safety
+/// `out` NULL or writable.
+pub(crate) unsafe fn put<T>(out: *mut T, value: T) {
+    // SAFETY: NULL or writable (caller's promise).
+    if let Some(o) = unsafe { out.as_mut() } {
+        *o = value;
+    }
+}
+
 pub(crate) fn to_f32(x: f64) -> f32 {
     x as f32
 }
@@ -465,12 +476,8 @@ pub unsafe extern "C" fn fc_cloth_get_solver_stats(
         let stats = unsafe { handle(cloth) }?.solver_stats();
         // SAFETY: each output is NULL or writable, as the caller promises.
         unsafe {
-            if let Some(i) = iterations.as_mut() {
-                *i = stats.iterations;
-            }
-            if let Some(r) = residual.as_mut() {
-                *r = stats.residual;
-            }
+            put(iterations, stats.iterations);
+            put(residual, stats.residual);
         }
         Ok(())
     })
@@ -495,15 +502,9 @@ pub unsafe extern "C" fn fc_cloth_get_step_stats(
         let stats = unsafe { handle(cloth) }?.step_stats();
         // SAFETY: each output is NULL or writable, as the caller promises.
         unsafe {
-            if let Some(s) = substeps.as_mut() {
-                *s = stats.substeps;
-            }
-            if let Some(r) = retries.as_mut() {
-                *r = stats.retries;
-            }
-            if let Some(e) = estimate.as_mut() {
-                *e = stats.estimate;
-            }
+            put(substeps, stats.substeps);
+            put(retries, stats.retries);
+            put(estimate, stats.estimate);
         }
         Ok(())
     })

@@ -2,7 +2,7 @@
 
 use crate::math::Vec3;
 
-use super::cloth::{handle, handle_mut, slice_in, triples, FcCloth};
+use super::cloth::{handle, handle_mut, put, slice_in, triples, FcCloth};
 use super::status::{guard, FcStatus, FfiError};
 
 /// `3 * count` floats at `xyz` as vectors.
@@ -144,12 +144,8 @@ pub unsafe extern "C" fn fc_cloth_get_mesh_collider(
         })?;
         // SAFETY: each is NULL or writable (caller's promise).
         unsafe {
-            if !vertex_count.is_null() {
-                *vertex_count = mesh.vertex_count();
-            }
-            if !triangle_count.is_null() {
-                *triangle_count = mesh.triangles().len();
-            }
+            put(vertex_count, mesh.vertex_count());
+            put(triangle_count, mesh.triangles().len());
         }
         Ok(())
     })
