@@ -9,11 +9,15 @@
 mod auto_step;
 mod collisions;
 mod extrapolate;
+mod histories;
+mod pins;
 mod prepass;
 mod snapshot;
 mod step;
 
-use step::{Rollback, StepScratch};
+use histories::Histories;
+use pins::check_weight;
+use step::{Rollback, StepPlan, StepScratch};
 
 pub use auto_step::{safety, StepStats, AUTO, MAX_RETRIES, SAFETY, SAFETY_SYMPLECTIC};
 pub use snapshot::SNAPSHOT_VERSION;
@@ -146,10 +150,8 @@ pub struct Cloth {
     mesh_slots: Vec<Option<MeshCollider>>,
     /// Self-collision's search and remembered sides (`collide/self_collision.rs`).
     self_collision: SelfCollision,
-    history: History,
-    /// One scalar per spring for the rotation-invariant fractional springs
-    /// (`forces/strain.rs`), three springs to an entry; `Off` without them.
-    strain_history: History,
+    /// The half-derivative memories the model's terms and pair elements read.
+    histories: Histories,
     time: f64,
     steps: u64,
     scratch: StepScratch,
@@ -198,15 +200,7 @@ impl Cloth {
             friction: Vec::new(),
             mesh_slots: Vec::new(),
             self_collision: SelfCollision::new(&topology.triangles),
-            history: History::new(scheme, n)?,
-            strain_history: History::new(
-                if memories.springs {
-                    config.scheme
-                } else {
-                    Scheme::Off
-                },
-                forces::strain::entries(topology.springs.len()),
-            )?,
+            histories: Histories::new(&config.model, config.scheme, &topology)?,
             time: 0.0,
             steps: 0,
             scratch: StepScratch::default(),
@@ -299,13 +293,8 @@ impl Cloth {
     }
     /// The half-derivative history state.
     pub fn history(&self) -> &History {
-        &self.history
+        self.histories.get(forces::Memory::Particles)
     }
-    /// Pinned vertex indices, in the order they were given.
-    pub fn pinned(&self) -> &[u32] {
-        &self.pin_list
-    }
-
     fn check_index(&self, i: u32) -> Result<usize, Error> {
         let n = self.vertex_count();
         if (i as usize) < n {
@@ -315,103 +304,6 @@ impl Cloth {
                 "vertex index {i} out of range (cloth has {n} vertices)"
             )))
         }
-    }
-
-    /// Replaces the pinned set: the listed vertices are fully pinned (weight 1), every other
-    /// vertex is free. Pins hold their current positions until moved.
-    pub fn set_pinned(&mut self, indices: &[u32]) -> Result<(), Error> {
-        for &i in indices {
-            self.check_index(i)?;
-        }
-        self.clear_pins();
-        for &i in indices {
-            self.pin(i as usize, 1.0);
-        }
-        Ok(())
-    }
-
-    /// Replaces every vertex's pin weight (one per vertex, each in [0, 1]; 0 = free,
-    /// 1 = fully pinned). A vertex of weight w in (0, 1) is pulled the fraction w of the way
-    /// onto its target (and its velocity the fraction w onto the target's) at the end of
-    /// every step: a soft pin, as a DCC's pin weight or goal strength.
-    pub fn set_pin_weights(&mut self, weights: &[f64]) -> Result<(), Error> {
-        if weights.len() != self.vertex_count() {
-            return Err(Error::invalid(format!(
-                "expected {} pin weights, got {}",
-                self.vertex_count(),
-                weights.len()
-            )));
-        }
-        for (i, &w) in weights.iter().enumerate() {
-            check_weight(i, w)?;
-        }
-        self.clear_pins();
-        for (i, &w) in weights.iter().enumerate() {
-            self.pin(i, w);
-        }
-        Ok(())
-    }
-
-    /// Sets the pin weight of a group of vertices (e.g. a DCC vertex group) to `weight` in
-    /// [0, 1], leaving every other vertex as it is; 0 frees them.
-    pub fn pin_group(&mut self, indices: &[u32], weight: f64) -> Result<(), Error> {
-        for &i in indices {
-            check_weight(self.check_index(i)?, weight)?;
-        }
-        for &i in indices {
-            let i = i as usize;
-            if self.pin_weight[i] > 0.0 {
-                self.pin_weight[i] = 0.0;
-                self.pinned[i] = false;
-                self.pin_list.retain(|&p| p as usize != i);
-            }
-            self.pin(i, weight);
-        }
-        Ok(())
-    }
-
-    /// Pin weight of every vertex.
-    pub fn pin_weights(&self) -> &[f64] {
-        &self.pin_weight
-    }
-
-    fn clear_pins(&mut self) {
-        self.pinned.fill(false);
-        self.pin_weight.fill(0.0);
-        self.pin_list.clear();
-    }
-
-    /// Pins free vertex `i` with weight `w` (nothing for w = 0) at its current position.
-    fn pin(&mut self, i: usize, w: f64) {
-        if w > 0.0 && self.pin_weight[i] == 0.0 {
-            self.pin_weight[i] = w;
-            self.pinned[i] = w == 1.0;
-            self.pin_list.push(i as u32);
-            self.pin_target[i] = self.x[i];
-        }
-    }
-
-    /// Moves pinned vertices: at the end of the next step vertex `indices[k]` sits at
-    /// `targets[k]`. Every index must be pinned.
-    pub fn set_pin_targets(&mut self, indices: &[u32], targets: &[Vec3]) -> Result<(), Error> {
-        if indices.len() != targets.len() {
-            return Err(Error::invalid(format!(
-                "{} indices but {} targets",
-                indices.len(),
-                targets.len()
-            )));
-        }
-        for (&i, t) in indices.iter().zip(targets) {
-            let i = self.check_index(i)?;
-            if self.pin_weight[i] == 0.0 {
-                return Err(Error::invalid(format!("vertex {i} is not pinned")));
-            }
-            check_finite_vec("pin target", t)?;
-        }
-        for (&i, t) in indices.iter().zip(targets) {
-            self.pin_target[i as usize] = *t;
-        }
-        Ok(())
     }
 
     /// Teleports every vertex (velocities and history are kept); pins move with it.
@@ -624,7 +516,12 @@ impl Cloth {
         };
         let extrapolated = self.config.integrator.is_extrapolated();
         if substeps == 1 && !extrapolated {
-            return self.advance(dt, None);
+            return self.advance(StepPlan::new(
+                self.config.integrator,
+                dt,
+                None,
+                step::Stage::Whole,
+            ));
         }
         let h = dt / f64::from(substeps);
         let mut snap = std::mem::take(&mut self.rollback);
@@ -632,16 +529,13 @@ impl Cloth {
             self.rollback = snap;
             return Err(e);
         }
-        self.scratch.pin_start.clear();
-        self.scratch
-            .pin_start
-            .extend(self.pin_list.iter().map(|&i| self.x[i as usize]));
+        self.start_pin_paths();
         for k in 1..=substeps {
             let goal = (k < substeps).then_some(f64::from(k) / f64::from(substeps));
             let done = if extrapolated {
                 self.extrapolated_advance(h, f64::from(k - 1) / f64::from(substeps), goal)
             } else {
-                self.advance(h, goal)
+                self.advance(StepPlan::new(self.config.integrator, h, goal, step::Stage::Whole))
             };
             if let Err(mut e) = done {
                 snap.restore(self);
@@ -701,16 +595,6 @@ impl Cloth {
             e += 0.5 * k * d * d;
         }
         e
-    }
-}
-
-fn check_weight(i: usize, w: f64) -> Result<(), Error> {
-    if (0.0..=1.0).contains(&w) {
-        Ok(())
-    } else {
-        Err(Error::invalid(format!(
-            "pin weight of vertex {i} must be in [0, 1], got {w}"
-        )))
     }
 }
 

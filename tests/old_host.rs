@@ -49,7 +49,7 @@ fn a_host_built_against_an_older_header_runs_and_agrees() {
             .expect("checksum line")
             .to_string()
     };
-    assert_eq!(size(&new_out), fraccloth::ffi::desc_size::DESC_SIZE);
+    assert_eq!(size(&new_out), fraccloth::ffi::desc::DESC_SIZE);
     assert_eq!(
         size(&old_out),
         size(&new_out) - 32,

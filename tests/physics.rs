@@ -246,7 +246,7 @@ fn spring_damping_can_be_set_per_family() {
             half_derivative: &[],
             colliders: &[],
             prior_forces: &[],
-            strain_w0: 0.0,
+            weights: Default::default(),
         };
         total_forces(&input, &mut ForceScratch::default(), &mut f);
         f

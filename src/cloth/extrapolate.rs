@@ -17,6 +17,7 @@
 //! [`Integrator::ExtrapolatedSymplectic`]: crate::Integrator::ExtrapolatedSymplectic
 //! [`Integrator::ExtrapolatedImplicit`]: crate::Integrator::ExtrapolatedImplicit
 
+use super::step::{Stage, StepPlan};
 use super::Cloth;
 use crate::error::Error;
 use crate::integrate;
@@ -41,50 +42,22 @@ impl Cloth {
     ) -> Result<(), Error> {
         let steps = self.steps;
         probe.save(self)?;
+        let integrator = self.config.integrator;
         // The whole step, kept aside in `probe` (restoring swaps it there).
-        self.advance(h, f1)?;
+        self.advance(StepPlan::new(integrator, h, f1, Stage::Whole))?;
         probe.restore(self);
-        // Two half steps. At the middle a soft pin's goal is half-way along its straight path; a
-        // hard pin's is on the parabola through its last position (from its velocity, the last
-        // step's secant), its position and its goal: `5/8 x_n + 3/8 x_{n+1} + h/8 v_n`, third-order
-        // accurate where the straight line is second-order, which would leave the half steps'
-        // pin velocities with a first-order error that both runs share and no extrapolation
-        // removes.
-        let fmid = 0.5 * (f0 + f1.unwrap_or(1.0));
-        let s = &mut self.scratch;
-        s.mid_goal.clear();
-        for (k, &i) in self.pin_list.iter().enumerate() {
-            let i = i as usize;
-            let along = |f: f64| s.pin_start[k] + f * (self.pin_target[i] - s.pin_start[k]);
-            let end = f1.map_or(self.pin_target[i], along);
-            s.mid_goal.push(if self.pinned[i] {
-                0.625 * self.x[i] + 0.375 * end + (0.125 * h) * self.v[i]
-            } else {
-                along(fmid)
-            });
-        }
-        s.mid_goal_set = true;
-        let first = self.advance(0.5 * h, Some(fmid));
-        self.scratch.mid_goal_set = false;
-        first?;
-        self.advance(0.5 * h, f1)?;
+        // Two half steps, the first with the pins aimed at their mid goals (`pins.rs`).
+        let fmid = self.plan_mid_goals(h, f0, f1);
+        self.advance(StepPlan::new(integrator, 0.5 * h, Some(fmid), Stage::FirstHalf))?;
+        self.advance(StepPlan::new(integrator, 0.5 * h, f1, Stage::SecondHalf))?;
         for (x, whole) in self.x.iter_mut().zip(&probe.x) {
             *x = 2.0 * *x - whole;
         }
         for (v, whole) in self.v.iter_mut().zip(&probe.v) {
             *v = 2.0 * *v - whole;
         }
-        if !self.config.integrator.is_implicit() {
-            // Symplectic: a hard pin keeps the whole step's secant, the slope of its path half a
-            // step back, which is what the next step's mid goal and history sample read it as.
-            // (Extrapolating it too would feed the last velocity into the next through the mid
-            // goal, a recurrence whose error after a kink in the path never dies out.)
-            for &i in &self.pin_list {
-                let i = i as usize;
-                if self.pinned[i] {
-                    self.v[i] = probe.v[i];
-                }
-            }
+        if !integrator.is_implicit() {
+            self.keep_pin_secants(&probe.v);
         }
         self.steps = steps + 1;
         let max2 = self.config.max_speed * self.config.max_speed;

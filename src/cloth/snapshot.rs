@@ -29,12 +29,13 @@
 //! checksum and every value before touching the cloth: a truncated, corrupted or foreign snapshot
 //! is rejected with a message and the cloth is left exactly as it was.
 
-use super::{check_weight, checked_collider, Cloth};
+use super::step::{Stage, StepPlan};
+use super::{check_weight, checked_collider, Cloth, Histories};
 use crate::bytes::{ByteReader, ByteWriter};
 use crate::cloth::MAX_COORDINATE;
 use crate::error::{check_finite_vec, Error};
 use crate::forces::{Capsule, Collider, Plane, Sphere};
-use crate::history::{History, Scheme};
+use crate::history::Scheme;
 use crate::integrate::SolverSettings;
 
 const MAGIC: &[u8; 8] = b"FCSNAP\0\0";
@@ -93,7 +94,7 @@ fn history_fingerprint(c: &Cloth) -> u64 {
     }
     // A history per spring (rotation-invariant fractional springs) changes the state's layout;
     // without one the fingerprint is what it always was.
-    if !c.strain_history.is_off() {
+    if c.histories.layout() & 1 != 0 {
         h.word(u64::from(b'S'));
     }
     h.0
@@ -170,7 +171,7 @@ impl Cloth {
         w.u64(t.springs.len() as u64);
         w.u64(t.triangles.len() as u64);
         w.u64(topology_fingerprint(self));
-        w.u8(self.history.tag());
+        w.u8(self.history().tag());
         w.u64(history_fingerprint(self));
         w.f64(self.time);
         w.u64(self.steps);
@@ -196,8 +197,7 @@ impl Cloth {
                 }
             }
         }
-        self.history.write_state(w)?;
-        self.strain_history.write_state(w)?;
+        self.histories.write_state(w)?;
         self.write_collision_state(w);
         Ok(())
     }
@@ -249,7 +249,7 @@ impl Cloth {
                 counts[0], counts[1], counts[2], want[0], want[1], want[2]
             )));
         }
-        if r.u8()? != self.history.tag() || r.u64()? != history_fingerprint(self) {
+        if r.u8()? != self.history().tag() || r.u64()? != history_fingerprint(self) {
             return Err(Error::invalid(
                 "snapshot was saved with another history scheme or history settings",
             ));
@@ -288,20 +288,12 @@ impl Cloth {
                 k => return Err(Error::invalid(format!("snapshot: bad collider slot tag {k}"))),
             });
         }
-        {
-            use crate::history::HalfDerivative;
-            crate::memory::ensure_available(
-                2 * self.history.bytes_per_particle() as u64 * n as u64
-                    + 2 * self.strain_history.bytes_per_particle() as u64
-                        * crate::forces::strain::entries(self.topology.springs.len()) as u64
-                    + bytes.len() as u64,
-                "loading a snapshot",
-            )?;
-        }
-        let mut history: History = self.history.clone();
-        history.read_state(&mut r)?;
-        let mut strain_history: History = self.strain_history.clone();
-        strain_history.read_state(&mut r)?;
+        crate::memory::ensure_available(
+            2 * self.histories.bytes(&self.topology) + bytes.len() as u64,
+            "loading a snapshot",
+        )?;
+        let mut histories = self.histories.clone();
+        histories.read_state(&mut r)?;
         let collisions = if version >= 5 {
             self.read_collision_state(&mut r)?
         } else {
@@ -344,8 +336,7 @@ impl Cloth {
                 v[i].norm()
             )));
         }
-        history.check_state(time)?;
-        strain_history.check_state(time)?;
+        histories.check_state(time)?;
         for (i, &w) in weights.iter().enumerate() {
             check_weight(i, w)?;
         }
@@ -378,8 +369,7 @@ impl Cloth {
         next.pin_target = targets;
         next.collider_slots = collider_slots;
         next.rebuild_colliders();
-        next.history = history;
-        next.strain_history = strain_history;
+        next.histories = histories;
         next.set_collision_state(collisions);
         next.trial_step()?;
         *self = next;
@@ -401,17 +391,13 @@ impl Cloth {
             let mut t = c.clone();
             t.pin_target.clone_from(&t.x);
             t.config.accept_unconverged = true;
-            t.advance(h, None)
+            t.advance(StepPlan::new(t.config.integrator, h, None, Stage::Whole))
         };
         let Err(e) = trial(self) else {
             return Ok(());
         };
         let mut without = self.clone();
-        let memories = crate::forces::memories(&self.config.model);
-        let scheme = |on: bool| if on { self.config.scheme } else { Scheme::Off };
-        without.history = History::new(scheme(memories.particles), self.vertex_count())?;
-        let entries = crate::forces::strain::entries(self.topology.springs.len());
-        without.strain_history = History::new(scheme(memories.springs), entries)?;
+        without.histories = Histories::new(&self.config.model, self.config.scheme, &self.topology)?;
         let what = if trial(&without).is_ok() {
             "its half-derivative history holds values the cloth cannot step from"
         } else {

@@ -7,13 +7,56 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::{prepass, Cloth, FAR_STEP, MAX_COORDINATE};
+use super::pins::{PinPaths, PinSampling};
+use super::{prepass, Cloth, Histories, FAR_STEP, MAX_COORDINATE};
 use crate::error::Error;
-use crate::forces::{self, ForceInput, ForceScratch, SpringInputs, TILE};
-use crate::history::History;
+use crate::forces::{self, ElementScratch, ForceInput, ForceScratch, Memory, SpringInputs, Weights, TILE};
 use crate::integrate::{self, implicit_euler, ImplicitInput, ImplicitScratch, StepSoa};
 use crate::math::Vec3;
 use crate::parallel;
+
+/// What the driver decides for one step, built once by it (`Cloth::step_substeps`,
+/// `extrapolate.rs`, the snapshot's trial step) and read by the passes, instead of locals and
+/// flags (the role of Box2D's `b2StepContext` and rapier's `IntegrationParameters`).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct StepPlan {
+    /// Step size, s.
+    pub h: f64,
+    /// Where pins and mesh colliders are at the end of the step: this fraction of the way
+    /// through the call, or None for where the host put them.
+    pub fraction: Option<f64>,
+    /// Which part of the integrator's step this is.
+    pub stage: Stage,
+    /// Which velocity a hard pin gives the history.
+    pub sampling: PinSampling,
+}
+
+/// Which part of an integrator's step a step is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Stage {
+    /// A whole step (a first-order integrator's, or an extrapolated step's whole run).
+    Whole,
+    /// The first of an extrapolated step's two half steps: hard pins aim at their mid goals.
+    FirstHalf,
+    /// The second half step.
+    SecondHalf,
+}
+
+impl StepPlan {
+    pub(super) fn new(
+        integrator: integrate::Integrator,
+        h: f64,
+        fraction: Option<f64>,
+        stage: Stage,
+    ) -> Self {
+        StepPlan {
+            h,
+            fraction,
+            stage,
+            sampling: PinSampling::of(integrator, stage),
+        }
+    }
+}
 
 /// How a step goes from forces to the new state, chosen by [`Route::of`]:
 ///
@@ -54,23 +97,12 @@ pub(super) struct StepScratch {
     /// The state the step proposes; committed only if sound.
     pub x_new: Vec<Vec3>,
     pub v_new: Vec<Vec3>,
-    /// Where every pin is at the end of the step.
-    pub goal: Vec<Vec3>,
-    /// Pin positions at the start of a multi-substep call.
-    pub pin_start: Vec<Vec3>,
-    /// Fully pinned particles, ascending.
-    pub hard_pins: Vec<u32>,
-    /// Goals of the pins (in `pin_list` order) for the first half step of an extrapolated
-    /// step, used instead of `pin_goals`' when `mid_goal_set` (`extrapolate.rs`).
-    pub mid_goal: Vec<Vec3>,
-    pub mid_goal_set: bool,
-    /// Rotation-invariant fractional springs only (`forces/strain.rs`): each spring's rate of
-    /// elongation at the start of the step and the past part of its D^{1/2}, packed three
-    /// springs to an entry.
-    pub strain_rates: Vec<Vec3>,
-    pub strain_past: Vec<Vec3>,
-    /// Forces of the whole-cloth passes before the force pass (strain springs, the carried
-    /// water's turning forces), one per particle; empty without them.
+    /// The pins' goals and paths (`pins.rs`).
+    pub pins: PinPaths,
+    /// The pair elements' own passes: the rates their memories record (`forces::elements`).
+    pub elements: ElementScratch,
+    /// Forces of the whole-cloth passes before the force pass (pair elements with a pass of
+    /// their own, the carried water's turning forces), one per particle; empty without them.
     pub prior_forces: Vec<Vec3>,
     /// The collision pass's contact elements (mesh colliders, self-collision).
     pub contacts: Vec<crate::collide::Contact>,
@@ -88,8 +120,7 @@ pub(super) struct StepScratch {
 pub(super) struct Rollback {
     pub(super) x: Vec<Vec3>,
     pub(super) v: Vec<Vec3>,
-    history: Option<History>,
-    strain_history: Option<History>,
+    histories: Option<Histories>,
     /// Self-collision's remembered pairs and sides (state: a snapshot carries them).
     self_collision: crate::collide::self_collision::SavedMemory,
     time: f64,
@@ -100,14 +131,8 @@ impl Rollback {
     /// Copies the state, or fails with an out-of-memory error when the copy of a history
     /// that grew (the full history) cannot be allocated.
     pub(super) fn save(&mut self, c: &Cloth) -> Result<(), Error> {
-        use crate::history::HalfDerivative;
-        let need = c.history.bytes_per_particle() as u64 * c.x.len() as u64
-            + c.strain_history.bytes_per_particle() as u64
-                * forces::strain::entries(c.topology.springs.len()) as u64;
-        let have = self
-            .history
-            .as_ref()
-            .map_or(0, |h| h.bytes_per_particle() as u64 * c.x.len() as u64);
+        let need = c.histories.bytes(&c.topology);
+        let have = self.histories.as_ref().map_or(0, |h| h.bytes(&c.topology));
         if need > have {
             crate::memory::ensure_available(
                 2 * (need - have),
@@ -116,13 +141,9 @@ impl Rollback {
         }
         self.x.clone_from(&c.x);
         self.v.clone_from(&c.v);
-        match &mut self.history {
-            Some(h) => h.clone_from(&c.history),
-            None => self.history = Some(c.history.clone()),
-        }
-        match &mut self.strain_history {
-            Some(h) => h.clone_from(&c.strain_history),
-            None => self.strain_history = Some(c.strain_history.clone()),
+        match &mut self.histories {
+            Some(h) => h.clone_from(&c.histories),
+            None => self.histories = Some(c.histories.clone()),
         }
         c.self_collision.save_memory(&mut self.self_collision);
         self.time = c.time;
@@ -133,11 +154,8 @@ impl Rollback {
     pub(super) fn restore(&mut self, c: &mut Cloth) {
         std::mem::swap(&mut c.x, &mut self.x);
         std::mem::swap(&mut c.v, &mut self.v);
-        if let Some(h) = &mut self.history {
-            std::mem::swap(&mut c.history, h);
-        }
-        if let Some(h) = &mut self.strain_history {
-            std::mem::swap(&mut c.strain_history, h);
+        if let Some(h) = &mut self.histories {
+            std::mem::swap(&mut c.histories, h);
         }
         c.self_collision.swap_memory(&mut self.self_collision);
         c.time = self.time;
@@ -146,18 +164,18 @@ impl Rollback {
 }
 
 impl Cloth {
-    /// One step of size `h`. Pins go to `pin_start + fraction (target - pin_start)`, or to
-    /// their targets when `fraction` is None. Nothing is committed unless every pass succeeds.
-    pub(super) fn advance(&mut self, h: f64, fraction: Option<f64>) -> Result<(), Error> {
+    /// One step as `plan` says. Nothing is committed unless every pass succeeds.
+    pub(super) fn advance(&mut self, plan: StepPlan) -> Result<(), Error> {
+        let h = plan.h;
         self.prepare()?;
-        self.pin_goals(fraction);
-        let w0 = self.step_velocities(h);
-        let strain_w0 = self.strain_damping();
+        self.pin_goals(&plan);
+        let mut weights = self.step_velocities(&plan);
+        self.element_forces(&mut weights);
         self.water_turning();
-        self.collisions(fraction);
+        self.collisions(plan.fraction);
         let integrated_sound = match Route::of(self.config.integrator) {
-            Route::ExplicitTiles(step) => self.forces_and_explicit_step(h, strain_w0, step),
-            Route::Implicit => self.forces_and_implicit_step(h, w0, strain_w0)?,
+            Route::ExplicitTiles(step) => self.forces_and_explicit_step(h, weights, step),
+            Route::Implicit => self.forces_and_implicit_step(h, weights)?,
         };
         let friction = self.friction(h) | self.contact_friction(h);
         let limited = self.limit_collision_step() > 0;
@@ -169,8 +187,7 @@ impl Cloth {
 
     /// Sizes the step's buffers and lets the histories make room for the step.
     fn prepare(&mut self) -> Result<(), Error> {
-        self.history.reserve_step()?;
-        self.strain_history.reserve_step()?;
+        self.histories.reserve_step()?;
         let n = self.vertex_count();
         let s = &mut self.scratch;
         for buf in [
@@ -179,64 +196,30 @@ impl Cloth {
             &mut s.half,
             &mut s.x_new,
             &mut s.v_new,
-            &mut s.goal,
+            &mut s.pins.goal,
         ] {
             buf.resize(n, Vec3::zeros());
         }
         Ok(())
     }
 
-    /// Where every pin is at the end of the step: its target, or the `fraction` of the way
-    /// there from where a multi-substep call started.
-    fn pin_goals(&mut self, fraction: Option<f64>) {
-        let s = &mut self.scratch;
-        if s.mid_goal_set {
-            for (k, &i) in self.pin_list.iter().enumerate() {
-                s.goal[i as usize] = s.mid_goal[k];
-            }
-            return;
-        }
-        for (k, &i) in self.pin_list.iter().enumerate() {
-            let i = i as usize;
-            s.goal[i] = match fraction {
-                Some(f) => s.pin_start[k] + f * (self.pin_target[i] - s.pin_start[k]),
-                None => self.pin_target[i],
-            };
-        }
-    }
-
     /// One pass over the particles: the step's velocities (pins' from their goals), the
     /// velocity relative to the water, D^{1/2}x = w0 v + H of it (the history folds the last
     /// accepted step in here), and, for an untiled topology, the component arrays the spring
-    /// pass reads. Returns w0, the current-velocity weight of D^{1/2}.
-    fn step_velocities(&mut self, h: f64) -> f64 {
+    /// pass reads. Returns the memories' weights, the particles' w0 filled in.
+    fn step_velocities(&mut self, plan: &StepPlan) -> Weights {
+        let (h, sampling) = (plan.h, plan.sampling);
         let n = self.vertex_count();
         let s = &mut self.scratch;
         let par = parallel::worth_it(n);
-        let with_history = !self.history.is_off();
+        let history = self.histories.get_mut(Memory::Particles);
+        let with_history = !history.is_off();
         // The history folds the last accepted step in during this pass (SOE).
-        let past = with_history.then(|| self.history.begin_step());
+        let past = with_history.then(|| history.begin_step());
         let w0 = past.as_ref().map_or(0.0, |p| p.current_weight());
-        // Fully pinned particles, ascending, to find those of a tile by bisection.
-        s.hard_pins.clear();
-        s.hard_pins
-            .extend(self.pin_list.iter().filter(|&&i| self.pinned[i as usize]));
-        s.hard_pins.sort_unstable();
-        let hard_pins = &s.hard_pins;
+        let hard_pins = &s.pins.hard;
         let rate = forces::spring_rate(&self.config.model);
         let current = self.config.model.current;
-        // A hard pin's step velocity is its goal's secant, the velocity half a step ahead. The
-        // second-order integrators give the history (and this step's D^{1/2}) the slope of the
-        // pin's path at the start of the (half) step instead: the history keeps every sample, so
-        // a first-order error in them would never be extrapolated away. Its stored velocity is
-        // read as the last secant, half a step back (what extrapolated symplectic Euler leaves
-        // it; extrapolated implicit Euler extrapolates it and measured best so), giving the mean
-        // of it and this secant; in the first half step, whose secant reaches only a quarter
-        // step ahead, `(S_prev + 2 S_1) / 3`. The first-order integrators keep the secant.
-        let integrator = self.config.integrator;
-        let central_pins = integrator.is_extrapolated();
-        let start_pins = central_pins && !integrator.is_implicit();
-        let first_half = s.mid_goal_set;
         // A tile walk transposes its own spring inputs; only other topologies need them here.
         let arrays = self.topology.tiled.is_none();
         let (sx, sq) = s.force_pass.spring_arrays(if arrays { n } else { 0 });
@@ -248,7 +231,7 @@ impl Cloth {
             // SAFETY: every task borrows only its own chunk `r` of each array.
             unsafe { a.range(r) }
         }
-        let (x, v, goal) = (&self.x, &self.v, &s.goal);
+        let (x, v, goal) = (&self.x, &self.v, &s.pins.goal);
         let (v_step, v_rel, half) = (
             parallel::Disjoint::new(&mut s.v_step),
             parallel::Disjoint::new(&mut s.v_rel),
@@ -288,15 +271,7 @@ impl Cloth {
                 for &i in pins.iter().take_while(|&&i| (i as usize) < hi) {
                     let (p, k) = (i as usize, i as usize - first);
                     v_step[k] = (goal[p] - x[k]) / h;
-                    v_rel[k] = if start_pins && first_half {
-                        // The slope at the start from the last whole secant (a step back) and
-                        // this half step's: p'(0) = S_prev / 3 + 2 S_1 / 3 on a parabola.
-                        (v[k] + 2.0 * v_step[k]) / 3.0 - current
-                    } else if central_pins {
-                        0.5 * (v[k] + v_step[k]) - current
-                    } else {
-                        v_step[k] - current
-                    };
+                    v_rel[k] = sampling.rate(v[k], v_step[k]) - current;
                 }
                 if let Some(past) = &past {
                     // SAFETY: every particle once; tiles start on multiples of TILE and
@@ -326,37 +301,37 @@ impl Cloth {
             }
         });
         if with_history {
-            self.history.end_step();
+            self.histories.get_mut(Memory::Particles).end_step();
         }
-        w0
+        let mut weights = Weights::default();
+        weights.0[Memory::Particles.index()] = w0;
+        weights
     }
 
-    /// The rotation-invariant fractional springs' forces at the start of the step, from each
-    /// spring's rate of elongation and its history (nothing without them). Returns their w0.
-    fn strain_damping(&mut self) -> f64 {
-        if self.strain_history.is_off() {
-            self.scratch.prior_forces.clear();
-            return 0.0;
-        }
-        let s = &mut self.scratch;
-        forces::strain::elongation_rates(&self.topology, &self.x, &s.v_step, &mut s.strain_rates);
-        s.strain_past.resize(s.strain_rates.len(), Vec3::zeros());
-        let past = self.strain_history.begin_step();
-        let w0 = past.current_weight();
-        // SAFETY: one call covers every entry once.
-        unsafe { past.past_range(0, &mut s.strain_past) };
-        self.strain_history.end_step();
-        s.prior_forces.resize(self.x.len(), Vec3::zeros());
-        forces::strain::forces(
+    /// The pair elements with a pass of their own (`forces::elements`): each memory's rates
+    /// from the step's velocities, its past, and their forces, into the prior forces; fills in
+    /// those memories' weights.
+    fn element_forces(&mut self, weights: &mut Weights) {
+        let (s, histories) = (&mut self.scratch, &mut self.histories);
+        let memory_past = |memory: Memory, out: &mut [Vec3]| {
+            let history = histories.get_mut(memory);
+            let past = history.begin_step();
+            let w0 = past.current_weight();
+            // SAFETY: one call covers every entry once.
+            unsafe { past.past_range(0, out) };
+            history.end_step();
+            weights.0[memory.index()] = w0;
+            w0
+        };
+        forces::prior_forces(
             &self.config.model,
             &self.topology,
             &self.x,
-            w0,
-            &s.strain_rates,
-            &s.strain_past,
+            &s.v_step,
+            &mut s.elements,
+            memory_past,
             &mut s.prior_forces,
         );
-        w0
     }
 
     /// The carried water's forces as the normals turn (`dT/dx - (dM/dt) v`,
@@ -386,7 +361,7 @@ impl Cloth {
 
     /// The force pass with an explicit integrator stepping each tile in cache; returns whether
     /// every result it wrote was sound.
-    fn forces_and_explicit_step(&mut self, h: f64, strain_w0: f64, step: StepSoa) -> bool {
+    fn forces_and_explicit_step(&mut self, h: f64, weights: Weights, step: StepSoa) -> bool {
         let s = &mut self.scratch;
         let input = ForceInput {
             model: &self.config.model,
@@ -396,7 +371,7 @@ impl Cloth {
             half_derivative: &s.half,
             colliders: &self.colliders,
             prior_forces: &s.prior_forces,
-            strain_w0,
+            weights,
         };
         let (masses, areas) = (&self.topology.masses, &self.topology.areas);
         let projected = &s.projected;
@@ -449,7 +424,7 @@ impl Cloth {
     /// The force pass into one array, then linearised backward Euler solved by CG; refused
     /// when the solver stops above its tolerance (unless accepted). The result is checked by
     /// [`Self::check`], so this returns false (not checked here).
-    fn forces_and_implicit_step(&mut self, h: f64, w0: f64, strain_w0: f64) -> Result<bool, Error> {
+    fn forces_and_implicit_step(&mut self, h: f64, weights: Weights) -> Result<bool, Error> {
         let n = self.vertex_count();
         let s = &mut self.scratch;
         s.force_array.resize(n, Vec3::zeros());
@@ -461,7 +436,7 @@ impl Cloth {
             half_derivative: &s.half,
             colliders: &self.colliders,
             prior_forces: &s.prior_forces,
-            strain_w0,
+            weights,
         };
         forces::total_forces_with(
             &input,
@@ -469,13 +444,7 @@ impl Cloth {
             SpringInputs::Filled,
             &mut s.force_array,
         );
-        forces::linearise(
-            &input,
-            w0,
-            s.force_pass.normals(),
-            &s.projected,
-            &mut s.implicit.lin,
-        );
+        forces::linearise(&input, s.force_pass.normals(), &s.projected, &mut s.implicit.lin);
         let inp = ImplicitInput {
             h,
             x: &self.x,
@@ -519,26 +488,6 @@ impl Cloth {
         on
     }
 
-    /// Pinned particles onto their goals (moving with their step velocity); soft pins pulled
-    /// the fraction of their weight of the way there.
-    fn pins(&mut self, h: f64) {
-        let s = &mut self.scratch;
-        for &i in &self.pin_list {
-            let i = i as usize;
-            let w = self.pin_weight[i];
-            if self.pinned[i] {
-                s.x_new[i] = s.goal[i];
-                s.v_new[i] = s.v_step[i];
-            } else {
-                // Soft pin: the fraction w of the way onto the target and its velocity.
-                let v_goal = (s.goal[i] - self.x[i]) / h;
-                let (x_free, v_free) = (s.x_new[i], s.v_new[i]);
-                s.x_new[i] = x_free + w * (s.goal[i] - x_free);
-                s.v_new[i] = v_free + w * (v_goal - v_free);
-            }
-        }
-    }
-
     /// Refuses a proposed state that is not finite, too fast, or beyond the float range.
     /// `integrated_sound`: every particle the integrator wrote was checked and sound, so only
     /// what the pins changed is checked again.
@@ -553,14 +502,23 @@ impl Cloth {
         Ok(())
     }
 
-    /// Makes the proposed state the cloth's and records the step in the history.
+    /// Makes the proposed state the cloth's and records the step in every memory: the
+    /// particles' displacements by their velocities relative to the water, the others by the
+    /// rates their elements' passes wrote.
     fn commit(&mut self, h: f64) {
         let s = &mut self.scratch;
         std::mem::swap(&mut self.x, &mut s.x_new);
         std::mem::swap(&mut self.v, &mut s.v_new);
-        self.history.record(&mut s.v_rel, h);
-        if !self.strain_history.is_off() {
-            self.strain_history.record(&mut s.strain_rates, h);
+        for memory in Memory::ALL {
+            let history = self.histories.get_mut(memory);
+            if history.is_off() {
+                continue;
+            }
+            let rates = match memory {
+                Memory::Particles => &mut s.v_rel,
+                Memory::Springs => &mut s.elements.rates,
+            };
+            history.record(rates, h);
         }
         self.time += h;
         self.steps += 1;

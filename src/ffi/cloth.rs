@@ -123,7 +123,7 @@ pub(crate) unsafe fn create(
             return Err(FfiError::null("out_cloth"));
         }
         // SAFETY: the caller promises a valid description or NULL.
-        let desc = unsafe { super::desc_size::read_desc(desc) }?;
+        let desc = unsafe { super::desc_size::read_desc(desc, super::desc::fc_cloth_desc_default()) }?;
         let config = desc.config()?;
         let cloth = Cloth::new(topology(&desc)?, config)?;
         let raw = Box::into_raw(Box::new(FcCloth { cloth }));

@@ -13,7 +13,10 @@ use crate::math::Vec3;
 use crate::model::{Model, RegularDrag, SpringDamping};
 use crate::topology::GridSpec;
 
-use super::desc_size::{read_desc, write_desc, DESC_SIZE};
+use super::desc_size::{read_desc, write_desc};
+
+/// `sizeof(FcClothDesc)` in this library.
+pub const DESC_SIZE: usize = std::mem::size_of::<FcClothDesc>();
 use super::status::{guard, FcStatus, FfiError};
 
 /// Values of `FcClothDesc::history_scheme`: how D^{1/2}x is evaluated.
@@ -33,6 +36,7 @@ pub enum FcHistoryScheme {
 /// Values of `FcClothDesc::integrator`.
 #[allow(non_camel_case_types)]
 #[repr(C)]
+#[derive(Clone, Copy)]
 pub enum FcIntegrator {
     /// The paper's Eq. 7: `x += h v; v += h a`. Conditionally stable; see docs/stability.md.
     FC_INTEGRATOR_EXPLICIT_EULER = 0,
@@ -52,6 +56,7 @@ pub enum FcIntegrator {
 /// Values of `FcClothDesc::spring_damping_mode`.
 #[allow(non_camel_case_types)]
 #[repr(C)]
+#[derive(Clone, Copy)]
 pub enum FcSpringDamping {
     /// Purely elastic springs.
     FC_SPRING_DAMPING_NONE = 0,
@@ -206,6 +211,77 @@ pub struct FcClothDesc {
     pub self_collision_friction: f64,
 }
 
+/// Each ABI enumeration value beside the library's, once: [`FcClothDesc::config`] reads
+/// through these tables and [`FcClothDesc::from_model`] writes through them.
+const SPRING_DAMPINGS: [(FcSpringDamping, SpringDamping); 4] = [
+    (FcSpringDamping::FC_SPRING_DAMPING_NONE, SpringDamping::None),
+    (
+        FcSpringDamping::FC_SPRING_DAMPING_VELOCITY,
+        SpringDamping::Velocity,
+    ),
+    (
+        FcSpringDamping::FC_SPRING_DAMPING_FRACTIONAL,
+        SpringDamping::Fractional,
+    ),
+    (
+        FcSpringDamping::FC_SPRING_DAMPING_FRACTIONAL_STRAIN,
+        SpringDamping::FractionalStrain,
+    ),
+];
+
+const INTEGRATORS: [(FcIntegrator, Integrator); 5] = [
+    (
+        FcIntegrator::FC_INTEGRATOR_EXPLICIT_EULER,
+        Integrator::ExplicitEuler,
+    ),
+    (
+        FcIntegrator::FC_INTEGRATOR_SYMPLECTIC_EULER,
+        Integrator::SymplecticEuler,
+    ),
+    (
+        FcIntegrator::FC_INTEGRATOR_IMPLICIT_EULER,
+        Integrator::ImplicitEuler,
+    ),
+    (
+        FcIntegrator::FC_INTEGRATOR_EXTRAPOLATED_SYMPLECTIC,
+        Integrator::ExtrapolatedSymplectic,
+    ),
+    (
+        FcIntegrator::FC_INTEGRATOR_EXTRAPOLATED_IMPLICIT,
+        Integrator::ExtrapolatedImplicit,
+    ),
+];
+
+/// The library's value of the ABI value `raw` in `table`.
+fn decode<A: Copy + Into<u32>, B: Copy>(table: &[(A, B)], raw: u32) -> Option<B> {
+    table.iter().find(|(a, _)| (*a).into() == raw).map(|&(_, b)| b)
+}
+
+/// The ABI value of the library's value `value` in `table` (every value is in its table).
+fn encode<A: Copy + Into<u32>, B: Copy + PartialEq>(table: &[(A, B)], value: B) -> u32 {
+    table
+        .iter()
+        .find(|(_, b)| *b == value)
+        .map_or(u32::MAX, |&(a, _)| a.into())
+}
+
+impl From<FcSpringDamping> for u32 {
+    fn from(v: FcSpringDamping) -> u32 {
+        v as u32
+    }
+}
+
+impl From<FcIntegrator> for u32 {
+    fn from(v: FcIntegrator) -> u32 {
+        v as u32
+    }
+}
+
+const HISTORY_OFF: u32 = FcHistoryScheme::FC_HISTORY_OFF as u32;
+const HISTORY_TRUNCATED: u32 = FcHistoryScheme::FC_HISTORY_TRUNCATED as u32;
+const HISTORY_FULL: u32 = FcHistoryScheme::FC_HISTORY_FULL as u32;
+const HISTORY_SOE: u32 = FcHistoryScheme::FC_HISTORY_SOE as u32;
+
 fn v3(a: [f64; 3]) -> Vec3 {
     Vec3::new(a[0], a[1], a[2])
 }
@@ -216,16 +292,16 @@ impl FcClothDesc {
         let (mut tol, mut horizon, mut min_dt) =
             (DEFAULT_SOE_TOLERANCE, DEFAULT_SOE_HORIZON, DEFAULT_SOE_MIN_DT);
         let (scheme, u) = match config.scheme {
-            Scheme::Off => (FcHistoryScheme::FC_HISTORY_OFF as u32, 3),
-            Scheme::Truncated { u } => (FcHistoryScheme::FC_HISTORY_TRUNCATED as u32, u),
-            Scheme::Full => (FcHistoryScheme::FC_HISTORY_FULL as u32, 3),
+            Scheme::Off => (HISTORY_OFF, 3),
+            Scheme::Truncated { u } => (HISTORY_TRUNCATED, u),
+            Scheme::Full => (HISTORY_FULL, 3),
             Scheme::SumOfExponentials {
                 tolerance,
                 horizon: hz,
                 min_dt: md,
             } => {
                 (tol, horizon, min_dt) = (tolerance, hz, md);
-                (FcHistoryScheme::FC_HISTORY_SOE as u32, 3)
+                (HISTORY_SOE, 3)
             }
         };
         Self {
@@ -243,12 +319,7 @@ impl FcClothDesc {
             shear_stiffness: model.shear_stiffness,
             bend_stiffness: model.bend_stiffness,
             spring_damping: model.spring_damping,
-            spring_damping_mode: match model.spring_damping_mode {
-                SpringDamping::None => FcSpringDamping::FC_SPRING_DAMPING_NONE,
-                SpringDamping::Velocity => FcSpringDamping::FC_SPRING_DAMPING_VELOCITY,
-                SpringDamping::Fractional => FcSpringDamping::FC_SPRING_DAMPING_FRACTIONAL,
-                SpringDamping::FractionalStrain => FcSpringDamping::FC_SPRING_DAMPING_FRACTIONAL_STRAIN,
-            } as u32,
+            spring_damping_mode: encode(&SPRING_DAMPINGS, model.spring_damping_mode),
             viscous_drag: model.viscous_drag,
             history_drag: model.history_drag,
             normal_drag: model.normal_drag,
@@ -257,13 +328,7 @@ impl FcClothDesc {
             history_tolerance: tol,
             history_horizon: horizon,
             history_min_dt: min_dt,
-            integrator: match config.integrator {
-                Integrator::ExplicitEuler => FcIntegrator::FC_INTEGRATOR_EXPLICIT_EULER,
-                Integrator::SymplecticEuler => FcIntegrator::FC_INTEGRATOR_SYMPLECTIC_EULER,
-                Integrator::ImplicitEuler => FcIntegrator::FC_INTEGRATOR_IMPLICIT_EULER,
-                Integrator::ExtrapolatedSymplectic => FcIntegrator::FC_INTEGRATOR_EXTRAPOLATED_SYMPLECTIC,
-                Integrator::ExtrapolatedImplicit => FcIntegrator::FC_INTEGRATOR_EXTRAPOLATED_IMPLICIT,
-            } as u32,
+            integrator: encode(&INTEGRATORS, config.integrator),
             max_substep: config.max_substep,
             solver_tolerance: config.solver.tolerance,
             solver_max_iterations: config.solver.max_iterations,
@@ -313,23 +378,18 @@ impl FcClothDesc {
         if self.total_mass.is_nan() {
             return Err(FfiError::invalid("total_mass is NaN"));
         }
-        let spring_damping_mode = match self.spring_damping_mode {
-            0 => SpringDamping::None,
-            1 => SpringDamping::Velocity,
-            2 => SpringDamping::Fractional,
-            3 => SpringDamping::FractionalStrain,
-            x => {
-                return Err(FfiError::invalid(format!(
-                    "spring_damping_mode {x} is not an FcSpringDamping value"
-                )))
-            }
-        };
+        let spring_damping_mode = decode(&SPRING_DAMPINGS, self.spring_damping_mode).ok_or_else(|| {
+            FfiError::invalid(format!(
+                "spring_damping_mode {} is not an FcSpringDamping value",
+                self.spring_damping_mode
+            ))
+        })?;
         let scheme = match self.history_scheme {
-            0 => Scheme::Off,
-            1 if self.history_u >= 1 => Scheme::Truncated { u: self.history_u },
-            1 => return Err(FfiError::invalid("history_u must be >= 1")),
-            2 => Scheme::Full,
-            3 => Scheme::SumOfExponentials {
+            HISTORY_OFF => Scheme::Off,
+            HISTORY_TRUNCATED if self.history_u >= 1 => Scheme::Truncated { u: self.history_u },
+            HISTORY_TRUNCATED => return Err(FfiError::invalid("history_u must be >= 1")),
+            HISTORY_FULL => Scheme::Full,
+            HISTORY_SOE => Scheme::SumOfExponentials {
                 tolerance: self.history_tolerance,
                 horizon: self.history_horizon,
                 min_dt: self.history_min_dt,
@@ -340,18 +400,12 @@ impl FcClothDesc {
                 )))
             }
         };
-        let integrator = match self.integrator {
-            0 => Integrator::ExplicitEuler,
-            1 => Integrator::SymplecticEuler,
-            2 => Integrator::ImplicitEuler,
-            3 => Integrator::ExtrapolatedSymplectic,
-            4 => Integrator::ExtrapolatedImplicit,
-            x => {
-                return Err(FfiError::invalid(format!(
-                    "integrator {x} is not an FcIntegrator value"
-                )))
-            }
-        };
+        let integrator = decode(&INTEGRATORS, self.integrator).ok_or_else(|| {
+            FfiError::invalid(format!(
+                "integrator {} is not an FcIntegrator value",
+                self.integrator
+            ))
+        })?;
         Ok(ClothConfig {
             model: Model {
                 cloth_density: self.cloth_density,
@@ -454,28 +508,36 @@ pub unsafe extern "C" fn fc_cloth_desc_preset(preset: u32, out_desc: *mut FcClot
 
 /// The description of a preset (an `FcPreset` value) on the default grid.
 fn preset_desc(preset: u32) -> Result<FcClothDesc, FfiError> {
-    let scheme = if preset == 0 {
-        Scheme::PAPER
-    } else {
-        Scheme::DEFAULT
-    };
+    const PAPER: u32 = FcPreset::FC_PRESET_FRACTIONAL_PAPER as u32;
+    const VISCOUS_NORMAL: u32 = FcPreset::FC_PRESET_REGULAR_VISCOUS_NORMAL as u32;
+    const VISCOUS: u32 = FcPreset::FC_PRESET_REGULAR_VISCOUS as u32;
+    const NORMAL: u32 = FcPreset::FC_PRESET_REGULAR_NORMAL as u32;
+    const UNDERWATER: u32 = FcPreset::FC_PRESET_UNDERWATER as u32;
     let model = match preset {
-        0 => Model::fractional(),
-        1 => Model::regular(RegularDrag::ViscousAndNormal),
-        2 => Model::regular(RegularDrag::Viscous),
-        3 => Model::regular(RegularDrag::Normal),
-        4 => Model::underwater(),
+        PAPER => Model::fractional(),
+        VISCOUS_NORMAL => Model::regular(RegularDrag::ViscousAndNormal),
+        VISCOUS => Model::regular(RegularDrag::Viscous),
+        NORMAL => Model::regular(RegularDrag::Normal),
+        UNDERWATER => Model::underwater(),
         x => return Err(FfiError::invalid(format!("preset {x} is not an FcPreset value"))),
     };
     let config = ClothConfig {
-        scheme,
-        integrator: if preset == 4 {
+        scheme: if preset == PAPER {
+            Scheme::PAPER
+        } else {
+            Scheme::DEFAULT
+        },
+        integrator: if preset == UNDERWATER {
             Integrator::SymplecticEuler
         } else {
             Integrator::ExplicitEuler
         },
         // The underwater preset chooses its own step: one `fc_cloth_step` per frame works.
-        max_substep: if preset == 4 { crate::cloth::AUTO } else { 0.0 },
+        max_substep: if preset == UNDERWATER {
+            crate::cloth::AUTO
+        } else {
+            0.0
+        },
         ..ClothConfig::default()
     };
     Ok(FcClothDesc::from_model(&model, &config))
@@ -544,7 +606,7 @@ pub unsafe extern "C" fn fc_cloth_set_desc(cloth: *mut super::FcCloth, desc: *co
     guard(|| {
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { super::cloth::handle_mut(cloth) }?;
-        let desc = unsafe { read_desc(desc) }?;
+        let desc = unsafe { read_desc(desc, fc_cloth_desc_default()) }?;
         let mut config = desc.config()?;
         config.accept_unconverged = cloth.config().accept_unconverged;
         Ok(cloth.reconfigure(config)?)

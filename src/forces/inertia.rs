@@ -48,7 +48,7 @@ pub fn carries_water(m: &Model) -> bool {
 impl Inertia {
     /// The inertia of a particle of mass `mass` (kg) and area `area` (m^2) with unit normal
     /// `normal`, whose patch faces that normal with `projected` times its rest area
-    /// ([`patch_normals`]; 1 at rest), in the water of model `m`.
+    /// (`patch_normals`; 1 at rest), in the water of model `m`.
     #[inline]
     pub fn of(m: &Model, mass: f64, area: f64, normal: Vec3, projected: f64) -> Inertia {
         Inertia {

@@ -18,7 +18,6 @@ use nalgebra::Matrix3;
 use super::terms::{self, Context, Particle};
 use super::{body_acceleration, ForceInput};
 use crate::math::Vec3;
-use crate::model::SpringDamping;
 
 /// A spring's 3x3 block in the form every spring block has: `along dir dir^T + across I`
 /// (40 bytes instead of a matrix's 72; applying it is two dot-product-sized operations).
@@ -64,16 +63,10 @@ fn outer(a: &Vec3) -> Matrix3<f64> {
     a * a.transpose()
 }
 
-/// Fills `out` for the state in `input`; `w0` is the current-velocity weight of D^{1/2};
-/// `normals` are the vertex normals (needed only with terms that read them or the water's
+/// Fills `out` for the state in `input` (its `weights` are the current-rate weights of each
+/// memory's D^{1/2}); `normals` are the vertex normals (needed only with terms that read them or the water's
 /// inertia), `projected` the patches' projected-area ratios (with normal added mass only).
-pub fn linearise(
-    input: &ForceInput<'_>,
-    w0: f64,
-    normals: &[Vec3],
-    projected: &[f64],
-    out: &mut Linearisation,
-) {
+pub fn linearise(input: &ForceInput<'_>, normals: &[Vec3], projected: &[f64], out: &mut Linearisation) {
     let m = input.model;
     let ns = input.topology.springs.len();
     let n = input.x.len();
@@ -81,12 +74,9 @@ pub fn linearise(
     out.spring_damping.resize(ns, 0.0);
     out.damping.resize(n, Matrix3::zeros());
     out.stiffness.resize(n, Matrix3::zeros());
-    let cd = match m.spring_damping_mode {
-        SpringDamping::None => 0.0,
-        SpringDamping::Velocity => m.spring_damping,
-        SpringDamping::Fractional => m.spring_damping * w0,
-        SpringDamping::FractionalStrain => m.spring_damping * input.strain_w0,
-    };
+    // Every pair element's damping, in the springs' blocks (`elements.rs`).
+    let cd = super::spring_damping(m, &input.weights);
+    let w0 = input.weights.of(super::Memory::Particles);
     for (k, s) in input.topology.springs.iter().enumerate() {
         let ks = m.stiffness(s.kind);
         let l = input.x[s.i as usize] - input.x[s.j as usize];
@@ -138,7 +128,7 @@ pub fn linearise(
 mod tests {
     //! The springs' blocks against a central difference of the force pass, for each damping.
     use super::*;
-    use crate::forces::{strain, total_forces, ForceScratch};
+    use crate::forces::{prior_forces, total_forces, ElementScratch, ForceScratch, Weights};
     use crate::model::{Model, SpringDamping};
     use crate::topology::{GridSpec, Topology};
 
@@ -192,27 +182,23 @@ mod tests {
             }
         }
 
-        /// The force on every particle; D^{1/2}x = w0 v + past, and the strain springs' own
-        /// D^{1/2} of the elongation rate likewise with a past of zero.
+        /// The force on every particle; D^{1/2}x = w0 v + past, and every other memory's
+        /// D^{1/2} (the elements' own passes) likewise with a past of zero.
         fn forces(&self, x: &[Vec3], v: &[Vec3], past: &[Vec3]) -> Vec<Vec3> {
             let n = x.len();
             let half: Vec<Vec3> = v.iter().zip(past).map(|(v, p)| self.w0 * v + p).collect();
-            let mut strain_forces = Vec::new();
-            if self.model.spring_damping_mode == SpringDamping::FractionalStrain {
-                let mut rates = Vec::new();
-                strain::elongation_rates(&self.topology, x, v, &mut rates);
-                let past = vec![Vec3::zeros(); rates.len()];
-                strain_forces = vec![Vec3::zeros(); n];
-                strain::forces(
-                    &self.model,
-                    &self.topology,
-                    x,
-                    self.w0,
-                    &rates,
-                    &past,
-                    &mut strain_forces,
-                );
-            }
+            let mut prior = Vec::new();
+            let memory_past = |_, _: &mut [Vec3]| self.w0;
+            let mut scratch = ElementScratch::default();
+            prior_forces(
+                &self.model,
+                &self.topology,
+                x,
+                v,
+                &mut scratch,
+                memory_past,
+                &mut prior,
+            );
             let input = ForceInput {
                 model: &self.model,
                 topology: &self.topology,
@@ -220,8 +206,8 @@ mod tests {
                 v,
                 half_derivative: &half,
                 colliders: &[],
-                prior_forces: &strain_forces,
-                strain_w0: self.w0,
+                prior_forces: &prior,
+                weights: Weights([self.w0; 2]),
             };
             let mut f = vec![Vec3::zeros(); n];
             total_forces(&input, &mut ForceScratch::default(), &mut f);
@@ -243,10 +229,10 @@ mod tests {
                 half_derivative: &half,
                 colliders: &[],
                 prior_forces: &[],
-                strain_w0: self.w0,
+                weights: Weights([self.w0; 2]),
             };
             let mut out = Linearisation::default();
-            linearise(&input, self.w0, &[], &[], &mut out);
+            linearise(&input, &[], &[], &mut out);
             out
         }
     }

@@ -1,16 +1,16 @@
 //! Which half-derivative memories a model keeps, derived from what its terms read.
 //!
 //! A history is kept exactly when something reads it: a per-particle term whose [`Reads`]
-//! says `half_derivative` (the list in [`super::terms`]), springs damped on D^{1/2}x (Eq. 5),
-//! or springs damped on the half-derivative of their elongation (`strain.rs`). There is no
-//! second list to keep in step: a D^{1/2} term added to `TERMS` gets its history by what it
-//! declares.
+//! says `half_derivative` (the list in [`super::terms`]), or a pair element whose memory it is
+//! (the list in [`super::elements`]: springs damped on D^{1/2}x by Eq. 5, springs damped on
+//! the half-derivative of their elongation). There is no second list to keep in step: a
+//! D^{1/2} term or element added to either list gets its history by what it declares.
 //!
 //! [`Reads`]: super::terms::Reads
 
-use super::springs::{spring_rate, SpringRate};
+use super::elements::{remembers, Memory};
 use super::terms;
-use crate::model::{Model, SpringDamping};
+use crate::model::Model;
 
 /// The memories a model keeps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -21,18 +21,28 @@ pub struct Memories {
     pub springs: bool,
 }
 
+impl Memories {
+    /// Whether `memory` is kept.
+    pub fn keeps(&self, memory: Memory) -> bool {
+        match memory {
+            Memory::Particles => self.particles,
+            Memory::Springs => self.springs,
+        }
+    }
+}
+
 /// What `m` reads of the past. Colliders read none, so the answer does not depend on them.
 pub fn memories(m: &Model) -> Memories {
     Memories {
-        particles: terms::reads(m, true).half_derivative || spring_rate(m) == SpringRate::HalfDerivative,
-        springs: m.spring_damping_mode == SpringDamping::FractionalStrain && m.spring_damping != 0.0,
+        particles: terms::reads(m, true).half_derivative || remembers(m, Memory::Particles),
+        springs: remembers(m, Memory::Springs),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::RegularDrag;
+    use crate::model::{RegularDrag, SpringDamping};
 
     #[test]
     fn a_history_is_kept_exactly_when_a_term_reads_it() {

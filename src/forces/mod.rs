@@ -7,6 +7,7 @@
 //! | `body.rs` | Eq. 2 gravity and buoyancy |
 //! | `drag.rs` | Eq. 3 viscous, Eq. 4 history, and normal drag |
 //! | `contact.rs` | collider contacts and friction |
+//! | `elements.rs` | the list of pair elements (springs, strain springs): what each remembers, how its forces are summed, its damping block |
 //! | `strain.rs` | the rotation-invariant fractional spring: D^{1/2} of each spring's elongation |
 //! | `inertia.rs` | a particle's inertia: its mass and the water it carries (the mass matrix, its inverse, its energy) |
 //! | `memories.rs` | which half-derivative histories a model keeps, derived from what its terms read |
@@ -19,6 +20,7 @@ mod assemble;
 mod body;
 mod contact;
 mod drag;
+mod elements;
 mod inertia;
 mod inputs;
 mod jacobian;
@@ -26,19 +28,27 @@ mod memories;
 mod normals;
 mod pass;
 mod springs;
-pub mod strain;
+mod strain;
 pub(crate) mod terms;
 mod tiles;
 
-pub use assemble::add_spring_values;
+// The public face: the colliders, a particle's inertia and weight, what a model remembers,
+// and the forces of a state (`total_forces` on a `ForceInput`).
 pub use body::{body_acceleration, body_force};
-pub use contact::{apply_friction, friction_active, Capsule, Collider, Plane, Sphere};
-pub use inertia::{carries_water, effective_forces, patch_normals, turning_forces, Inertia, TurningScratch};
-pub use jacobian::{linearise, Linearisation, SpringBlock};
+pub use contact::{Capsule, Collider, Plane, Sphere};
+pub use elements::{Memory, Weights};
+pub use inertia::Inertia;
 pub use memories::{memories, Memories};
-pub use normals::{vertex_normals, vertex_normals_with};
-pub use pass::{
-    for_each_tile, total_forces, total_forces_with, ForceInput, ForceScratch, SpringInputs, TileTotals,
-};
+pub use normals::vertex_normals;
+pub use pass::{total_forces, ForceInput, ForceScratch};
 pub use springs::{spring_rate, SpringRate};
-pub use tiles::TILE;
+
+// The step's machinery, for the crate only.
+pub(crate) use assemble::add_spring_values;
+pub(crate) use contact::{apply_friction, friction_active};
+pub(crate) use elements::{prior_forces, spring_damping, ElementScratch};
+pub(crate) use inertia::{carries_water, effective_forces, patch_normals, turning_forces, TurningScratch};
+pub(crate) use jacobian::{linearise, Linearisation, SpringBlock};
+pub(crate) use normals::vertex_normals_with;
+pub(crate) use pass::{for_each_tile, total_forces_with, SpringInputs};
+pub(crate) use tiles::TILE;

@@ -33,12 +33,12 @@ pub struct ForceInput<'a> {
     /// Colliders present this step.
     pub colliders: &'a [Collider],
     /// Forces of the whole-cloth passes evaluated before this one (N, one per particle): the
-    /// rotation-invariant fractional springs (`strain.rs`) and the carried water's turning
-    /// forces ([`super::turning_forces`]); empty when the model has neither.
+    /// pair elements with a pass of their own (`elements.rs`) and the carried
+    /// water's turning forces (`inertia.rs`); empty when the model has neither.
     pub prior_forces: &'a [Vec3],
-    /// The current-rate weight w0 of those springs' D^{1/2} (what the implicit integrator
-    /// treats as their damping); 0 without them.
-    pub strain_w0: f64,
+    /// The current-rate weight w0 of each memory's D^{1/2} this step (what the implicit
+    /// integrator treats as damping).
+    pub weights: super::Weights,
 }
 
 /// Scratch buffers the force pass reuses (no allocation in a step).
@@ -55,7 +55,7 @@ impl ForceScratch {
     /// The component arrays the spring pass of an untiled topology reads, positions and damping
     /// rate (see [`spring_rate`]), sized for `n` particles: for a caller that fills them in a
     /// pass of its own ([`SpringInputs::Filled`]).
-    pub fn spring_arrays(&mut self, n: usize) -> (&mut Soa3, &mut Soa3) {
+    pub(crate) fn spring_arrays(&mut self, n: usize) -> (&mut Soa3, &mut Soa3) {
         let s = &mut self.spring_inputs;
         s.x.resize(n);
         s.q.resize(n);
@@ -63,7 +63,7 @@ impl ForceScratch {
     }
 
     /// Vertex normals of the last pass (empty when no term read them).
-    pub fn normals(&self) -> &[Vec3] {
+    pub(crate) fn normals(&self) -> &[Vec3] {
         &self.normals
     }
 }

@@ -42,10 +42,10 @@ pub fn elongation_rates(topology: &Topology, x: &[Vec3], v: &[Vec3], out: &mut V
     }
 }
 
-/// Writes the force of every spring's fractional damping on each particle into `out`
-/// (zeroed first): `-k_d (w0 rate + past) l_hat` on `i`, the opposite on `j`. `rates` and
-/// `past` are packed as by [`elongation_rates`].
-pub fn forces(
+/// Adds the force of every spring's fractional damping on each particle into `out`:
+/// `-k_d (w0 rate + past) l_hat` on `i`, the opposite on `j`. `rates` and `past` are packed
+/// as by [`elongation_rates`].
+pub fn add_forces(
     model: &Model,
     topology: &Topology,
     x: &[Vec3],
@@ -54,7 +54,6 @@ pub fn forces(
     past: &[Vec3],
     out: &mut [Vec3],
 ) {
-    out.fill(Vec3::zeros());
     for (k, s) in topology.springs.iter().enumerate() {
         let (i, j) = (s.i as usize, s.j as usize);
         let l = x[i] - x[j];
@@ -117,7 +116,7 @@ mod tests {
         };
         let past = vec![Vec3::new(0.01, 0.02, 0.03); rates.len()];
         let mut f = vec![Vec3::zeros(); x.len()];
-        forces(&model, &t, &x, 0.3, &rates, &past, &mut f);
+        add_forces(&model, &t, &x, 0.3, &rates, &past, &mut f);
         let total: Vec3 = f.iter().sum();
         assert!(total.norm() < 1e-12);
         // One spring alone: -k_d (w0 rate + past) l_hat on its first end.
@@ -126,7 +125,8 @@ mod tests {
         let half = 0.3 * rates[0][0] + 0.01;
         let mut single = t.clone();
         single.springs.truncate(1);
-        forces(&model, &single, &x, 0.3, &rates, &past, &mut f);
+        f.fill(Vec3::zeros());
+        add_forces(&model, &single, &x, 0.3, &rates, &past, &mut f);
         let want = -model.spring_damping_of(s.kind) * half * l / l.norm();
         assert!((f[s.i as usize] - want).norm() < 1e-15);
     }

@@ -603,7 +603,7 @@ mod tests {
                 half_derivative: q,
                 colliders: &[],
                 prior_forces: &[],
-                strain_w0: 0.0,
+                weights: Default::default(),
             };
             let mut f = vec![Vec3::zeros(); n];
             total_forces(&input, &mut ForceScratch::default(), &mut f);

@@ -110,7 +110,7 @@ impl Integrator {
 
 /// What an explicit step reads: the step size and, per particle of a tile, positions,
 /// velocities, forces (component arrays `[x, y, z]`, each of one length, as the force pass has
-/// them in cache: [`crate::forces::for_each_tile`]) and masses.
+/// them in cache: `forces::for_each_tile`) and masses.
 #[derive(Clone, Copy)]
 pub struct StepInput<'a> {
     pub h: f64,

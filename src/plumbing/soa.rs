@@ -27,14 +27,6 @@ impl Soa3 {
         }
     }
 
-    pub fn len(&self) -> usize {
-        self.c[0].len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// The three component arrays.
     pub fn slices(&self) -> [&[f64]; 3] {
         [&self.c[0], &self.c[1], &self.c[2]]
@@ -72,7 +64,7 @@ mod tests {
                 .collect();
             let mut s = Soa3::default();
             s.fill_from(par, &src);
-            assert_eq!(s.len(), n);
+            assert_eq!(s.slices()[0].len(), n);
             for (i, v) in src.iter().enumerate() {
                 assert_eq!([s.c[0][i], s.c[1][i], s.c[2][i]], [v.x, v.y, v.z]);
             }

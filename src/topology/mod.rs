@@ -44,7 +44,7 @@ pub struct Topology {
     /// One over the length of each vertex's patch normal at rest: `1 / |N_i|`, `N_i` the sum
     /// of its triangles' normals each twice its area (0 where that sum vanishes). A patch's
     /// area vector relative to its rest area is `N_i(x) * patch_scale[i]`
-    /// ([`crate::forces::patch_normals`]).
+    /// (`forces::patch_normals`).
     pub patch_scale: Vec<f64>,
     /// Grid size (columns, rows) when the cloth was built from a grid.
     pub grid: Option<(u32, u32)>,

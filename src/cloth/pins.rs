@@ -1,0 +1,266 @@
+//! Pins: the host's calls that pin and move vertices, where each pin is at the end of a step
+//! (its goal), the velocity a hard pin gives the history, and the pass that puts pins on their
+//! goals.
+//!
+//! A multi-substep call moves every pin in a straight line from where the call found it
+//! (`PinPaths::start`) to the host's target, a fraction of the way per substep; an extrapolated
+//! step's first half aims hard pins at a point on a parabola instead (`Cloth::plan_mid_goals`).
+
+use super::step::{Stage, StepPlan};
+use super::Cloth;
+use crate::error::{check_finite_vec, Error};
+use crate::integrate::Integrator;
+use crate::math::Vec3;
+
+/// The pins' buffers a step reuses.
+#[derive(Clone, Debug, Default)]
+pub(super) struct PinPaths {
+    /// Where every pin is at the end of the step (entries of free vertices unused).
+    pub goal: Vec<Vec3>,
+    /// Pin positions at the start of a multi-substep call, in `pin_list` order.
+    pub start: Vec<Vec3>,
+    /// Goals of the pins (in `pin_list` order) for the first half of an extrapolated step.
+    pub mid: Vec<Vec3>,
+    /// Fully pinned particles, ascending (to find those of a tile by bisection).
+    pub hard: Vec<u32>,
+}
+
+/// Which velocity a hard pin gives the history (and this step's D^{1/2}), from its stored
+/// velocity `v` and its step velocity, the secant to its goal, `v_step`.
+///
+/// A hard pin's step velocity is its goal's secant, the velocity half a step ahead. The
+/// second-order integrators give the history the slope of the pin's path at the start of the
+/// (half) step instead: the history keeps every sample, so a first-order error in them would
+/// never be extrapolated away. Its stored velocity is read as the last secant, half a step
+/// back (what extrapolated symplectic Euler leaves it; extrapolated implicit Euler
+/// extrapolates it and measured best so), giving the mean of it and this secant; in the first
+/// half step, whose secant reaches only a quarter step ahead, `(S_prev + 2 S_1) / 3`. The
+/// first-order integrators keep the secant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum PinSampling {
+    Secant,
+    Central,
+    StartSlope,
+}
+
+impl PinSampling {
+    pub(super) fn of(integrator: Integrator, stage: Stage) -> PinSampling {
+        if !integrator.is_extrapolated() {
+            PinSampling::Secant
+        } else if !integrator.is_implicit() && stage == Stage::FirstHalf {
+            PinSampling::StartSlope
+        } else {
+            PinSampling::Central
+        }
+    }
+
+    #[inline]
+    pub(super) fn rate(self, v: Vec3, v_step: Vec3) -> Vec3 {
+        match self {
+            PinSampling::Secant => v_step,
+            PinSampling::Central => 0.5 * (v + v_step),
+            // The slope at the start from the last whole secant (a step back) and this half
+            // step's: p'(0) = S_prev / 3 + 2 S_1 / 3 on a parabola.
+            PinSampling::StartSlope => (v + 2.0 * v_step) / 3.0,
+        }
+    }
+}
+
+pub(super) fn check_weight(i: usize, w: f64) -> Result<(), Error> {
+    if (0.0..=1.0).contains(&w) {
+        Ok(())
+    } else {
+        Err(Error::invalid(format!(
+            "pin weight of vertex {i} must be in [0, 1], got {w}"
+        )))
+    }
+}
+
+impl Cloth {
+    /// Pinned vertex indices, in the order they were given.
+    pub fn pinned(&self) -> &[u32] {
+        &self.pin_list
+    }
+
+    /// Replaces the pinned set: the listed vertices are fully pinned (weight 1), every other
+    /// vertex is free. Pins hold their current positions until moved.
+    pub fn set_pinned(&mut self, indices: &[u32]) -> Result<(), Error> {
+        for &i in indices {
+            self.check_index(i)?;
+        }
+        self.clear_pins();
+        for &i in indices {
+            self.pin(i as usize, 1.0);
+        }
+        Ok(())
+    }
+
+    /// Replaces every vertex's pin weight (one per vertex, each in [0, 1]; 0 = free,
+    /// 1 = fully pinned). A vertex of weight w in (0, 1) is pulled the fraction w of the way
+    /// onto its target (and its velocity the fraction w onto the target's) at the end of
+    /// every step: a soft pin, as a DCC's pin weight or goal strength.
+    pub fn set_pin_weights(&mut self, weights: &[f64]) -> Result<(), Error> {
+        if weights.len() != self.vertex_count() {
+            return Err(Error::invalid(format!(
+                "expected {} pin weights, got {}",
+                self.vertex_count(),
+                weights.len()
+            )));
+        }
+        for (i, &w) in weights.iter().enumerate() {
+            check_weight(i, w)?;
+        }
+        self.clear_pins();
+        for (i, &w) in weights.iter().enumerate() {
+            self.pin(i, w);
+        }
+        Ok(())
+    }
+
+    /// Sets the pin weight of a group of vertices (e.g. a DCC vertex group) to `weight` in
+    /// [0, 1], leaving every other vertex as it is; 0 frees them.
+    pub fn pin_group(&mut self, indices: &[u32], weight: f64) -> Result<(), Error> {
+        for &i in indices {
+            check_weight(self.check_index(i)?, weight)?;
+        }
+        for &i in indices {
+            let i = i as usize;
+            if self.pin_weight[i] > 0.0 {
+                self.pin_weight[i] = 0.0;
+                self.pinned[i] = false;
+                self.pin_list.retain(|&p| p as usize != i);
+            }
+            self.pin(i, weight);
+        }
+        Ok(())
+    }
+
+    /// Pin weight of every vertex.
+    pub fn pin_weights(&self) -> &[f64] {
+        &self.pin_weight
+    }
+
+    fn clear_pins(&mut self) {
+        self.pinned.fill(false);
+        self.pin_weight.fill(0.0);
+        self.pin_list.clear();
+    }
+
+    /// Pins free vertex `i` with weight `w` (nothing for w = 0) at its current position.
+    fn pin(&mut self, i: usize, w: f64) {
+        if w > 0.0 && self.pin_weight[i] == 0.0 {
+            self.pin_weight[i] = w;
+            self.pinned[i] = w == 1.0;
+            self.pin_list.push(i as u32);
+            self.pin_target[i] = self.x[i];
+        }
+    }
+
+    /// Moves pinned vertices: at the end of the next step vertex `indices[k]` sits at
+    /// `targets[k]`. Every index must be pinned.
+    pub fn set_pin_targets(&mut self, indices: &[u32], targets: &[Vec3]) -> Result<(), Error> {
+        if indices.len() != targets.len() {
+            return Err(Error::invalid(format!(
+                "{} indices but {} targets",
+                indices.len(),
+                targets.len()
+            )));
+        }
+        for (&i, t) in indices.iter().zip(targets) {
+            let i = self.check_index(i)?;
+            if self.pin_weight[i] == 0.0 {
+                return Err(Error::invalid(format!("vertex {i} is not pinned")));
+            }
+            check_finite_vec("pin target", t)?;
+        }
+        for (&i, t) in indices.iter().zip(targets) {
+            self.pin_target[i as usize] = *t;
+        }
+        Ok(())
+    }
+
+    /// Remembers where every pin is as a multi-substep call starts.
+    pub(super) fn start_pin_paths(&mut self) {
+        let start = &mut self.scratch.pins.start;
+        start.clear();
+        start.extend(self.pin_list.iter().map(|&i| self.x[i as usize]));
+    }
+
+    /// Where every pin is at the end of the step: its target, the plan's fraction of the way
+    /// there from where a multi-substep call started, or (an extrapolated step's first half)
+    /// its mid goal. Also lists the hard pins for the velocity pass.
+    pub(super) fn pin_goals(&mut self, plan: &StepPlan) {
+        let p = &mut self.scratch.pins;
+        for (k, &i) in self.pin_list.iter().enumerate() {
+            let i = i as usize;
+            p.goal[i] = match (plan.stage, plan.fraction) {
+                (Stage::FirstHalf, _) => p.mid[k],
+                (_, Some(f)) => p.start[k] + f * (self.pin_target[i] - p.start[k]),
+                (_, None) => self.pin_target[i],
+            };
+        }
+        p.hard.clear();
+        p.hard
+            .extend(self.pin_list.iter().filter(|&&i| self.pinned[i as usize]));
+        p.hard.sort_unstable();
+    }
+
+    /// The pins' goals at the middle of an extrapolated step of size `h` whose pins start at
+    /// fraction `f0` of the call's travel and end at `f1` (None: at their targets). A soft
+    /// pin's is half-way along its straight path; a hard pin's is on the parabola through its
+    /// last position (from its velocity, the last step's secant), its position and its goal:
+    /// `5/8 x_n + 3/8 x_{n+1} + h/8 v_n`, third-order accurate where the straight line is
+    /// second-order, which would leave the half steps' pin velocities with a first-order error
+    /// that both runs share and no extrapolation removes. Returns the middle's fraction.
+    pub(super) fn plan_mid_goals(&mut self, h: f64, f0: f64, f1: Option<f64>) -> f64 {
+        let fmid = 0.5 * (f0 + f1.unwrap_or(1.0));
+        let p = &mut self.scratch.pins;
+        p.mid.clear();
+        for (k, &i) in self.pin_list.iter().enumerate() {
+            let i = i as usize;
+            let along = |f: f64| p.start[k] + f * (self.pin_target[i] - p.start[k]);
+            let end = f1.map_or(self.pin_target[i], along);
+            p.mid.push(if self.pinned[i] {
+                0.625 * self.x[i] + 0.375 * end + (0.125 * h) * self.v[i]
+            } else {
+                along(fmid)
+            });
+        }
+        fmid
+    }
+
+    /// After an extrapolated symplectic step: a hard pin keeps the whole step's secant
+    /// (`whole_v`), the slope of its path half a step back, which is what the next step's mid
+    /// goal and history sample read it as. (Extrapolating it too would feed the last velocity
+    /// into the next through the mid goal, a recurrence whose error after a kink in the path
+    /// never dies out.)
+    pub(super) fn keep_pin_secants(&mut self, whole_v: &[Vec3]) {
+        for &i in &self.pin_list {
+            let i = i as usize;
+            if self.pinned[i] {
+                self.v[i] = whole_v[i];
+            }
+        }
+    }
+
+    /// Pinned particles onto their goals (moving with their step velocity); soft pins pulled
+    /// the fraction of their weight of the way there.
+    pub(super) fn pins(&mut self, h: f64) {
+        let s = &mut self.scratch;
+        let goal = &s.pins.goal;
+        for &i in &self.pin_list {
+            let i = i as usize;
+            let w = self.pin_weight[i];
+            if self.pinned[i] {
+                s.x_new[i] = goal[i];
+                s.v_new[i] = s.v_step[i];
+            } else {
+                // Soft pin: the fraction w of the way onto the target and its velocity.
+                let v_goal = (goal[i] - self.x[i]) / h;
+                let (x_free, v_free) = (s.x_new[i], s.v_new[i]);
+                s.x_new[i] = x_free + w * (goal[i] - x_free);
+                s.v_new[i] = v_free + w * (v_goal - v_free);
+            }
+        }
+    }
+}
