@@ -6,7 +6,9 @@
 //! quad mesh with its vertices in a scrambled order, so the force pass cannot walk it in tiles). `memoryless` is the fractional
 //! model with the history switched off (`Scheme::Off`): the same step without the fractional
 //! memory's work and bytes, to tell what the history costs at a size from what the rest does.
-//! `underwater` is the underwater preset (entrained water and form drag, no history).
+//! `underwater` is the underwater preset (normal added mass, form and skin drag, no history).
+//! `strain` is the fractional model with rotation-invariant fractional springs (a history per
+//! spring beside the particles').
 
 use fraccloth::history::Scheme;
 use fraccloth::scenes::Variant;
@@ -19,13 +21,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let regular = variant_arg == "regular";
     let memoryless = variant_arg == "memoryless";
     let underwater = variant_arg == "underwater";
+    let strain = variant_arg == "strain";
     if !matches!(
         variant_arg,
-        "fractional" | "regular" | "memoryless" | "underwater"
+        "fractional" | "regular" | "memoryless" | "underwater" | "strain"
     ) {
-        return Err(
-            format!("unknown variant {variant_arg}: fractional, regular, memoryless or underwater").into(),
-        );
+        return Err(format!(
+            "unknown variant {variant_arg}: fractional, regular, memoryless, underwater or strain"
+        )
+        .into());
     }
     let blocks: u64 = args.get(2).map_or(Ok(20), |s| s.parse())?;
     let (w, h) = match args.get(3) {
@@ -84,6 +88,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let mut model = variant.model(0.01);
     model.current = Vec3::new(0.0, 0.0, 0.2);
+    if strain {
+        model.spring_damping_mode = fraccloth::SpringDamping::FractionalStrain;
+    }
     let config = ClothConfig {
         model,
         scheme: if regular || memoryless {
