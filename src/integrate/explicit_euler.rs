@@ -4,7 +4,7 @@
 //! Chosen as the paper's reference; it is only conditionally stable (the damping
 //! must be large enough for the stiffest mode: h ω² < c), see `docs/`.
 
-use super::{step_soa_with, StepInput};
+use super::tile_step::{step_soa_with, StepInput};
 use crate::math::Vec3;
 
 crate::simd_dispatch! { pub fn explicit_euler_soa(s: &StepInput<'_>, x_new: &mut [Vec3], v_new: &mut [Vec3]) -> bool => explicit_euler_soa_kernel }

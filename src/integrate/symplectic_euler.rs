@@ -4,7 +4,7 @@
 //! makes the undamped part stable up to `h < 2/omega` instead of never; damping is still
 //! explicit.
 
-use super::{step_soa_with, StepInput};
+use super::tile_step::{step_soa_with, StepInput};
 use crate::math::Vec3;
 
 crate::simd_dispatch! { pub fn symplectic_euler_soa(s: &StepInput<'_>, x_new: &mut [Vec3], v_new: &mut [Vec3]) -> bool => symplectic_euler_soa_kernel }
