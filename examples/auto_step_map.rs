@@ -6,8 +6,8 @@
 //! `cargo run --release --example auto_step_map [SECONDS, default 4]`
 
 use fraccloth::history::Scheme;
-use fraccloth::scenes::{Drive, SceneKind, Variant};
 use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, Model, RegularDrag, Topology, Vec3};
+use fraccloth_tools::scenes::{Drive, SceneKind, Variant};
 
 /// A grid's topology, or the same vertices jittered and triangulated with random diagonals.
 fn topology(w: u32, h: u32, jittered: bool) -> Topology {
@@ -21,7 +21,7 @@ fn topology(w: u32, h: u32, jittered: bool) -> Topology {
     .build()
     .expect("a grid");
     if jittered {
-        fraccloth::scenes::jittered_mesh(&grid, w, 1.0, 12345).expect("a mesh")
+        fraccloth_tools::scenes::jittered_mesh(&grid, w, 1.0, 12345).expect("a mesh")
     } else {
         grid
     }
@@ -126,7 +126,7 @@ fn main() {
                 name.split(',').next(),
                 Some("paper (u = 3)" | "fractional SOE" | "regular")
             ) {
-                fraccloth::scenes::scale_drags(*model, spacing)
+                fraccloth_tools::scenes::scale_drags(*model, spacing)
             } else {
                 *model
             };

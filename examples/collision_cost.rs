@@ -13,8 +13,8 @@ use std::time::Instant;
 
 use fraccloth::collide::intersections::self_intersections;
 use fraccloth::collide::shapes::uv_sphere;
-use fraccloth::scenes::{Drive, SceneKind, SceneSpec, Variant};
 use fraccloth::{Integrator, Model, Vec3};
+use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
 
 const FPS: f64 = 30.0;
 

@@ -6,8 +6,8 @@
 use fraccloth::collide::intersections::{crossing_pairs, self_intersections};
 use fraccloth::collide::shapes::{bar, torus};
 use fraccloth::forces::{Collider, Plane};
-use fraccloth::scenes::{collision_towel, TowelPose};
 use fraccloth::{Cloth, Integrator, Vec3};
+use fraccloth_tools::scenes::{collision_towel, TowelPose};
 use plotters::prelude::*;
 
 const FPS: f64 = 30.0;

@@ -3,8 +3,8 @@
 //! it needed. `cargo run --release --example implicit_cost`
 
 use fraccloth::history::Scheme;
-use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
 use fraccloth::Integrator;
+use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
 
 fn main() {
     for ((w, h), threads) in [((61u32, 41u32), 1), ((201, 201), 1), ((201, 201), 2)] {

@@ -11,11 +11,11 @@
 //! (Eq. 5) against the rotation-invariant element in the paper's model and the underwater preset.
 
 use fraccloth::history::Scheme;
-use fraccloth::look::{measure, Descriptors};
 use fraccloth::model::{SpringDamping, Water};
-use fraccloth::scenes::{stable_dt, top_offset, SceneKind, Variant, CLOTH_MASS, CLOTH_WIDTH};
 use fraccloth::topology::grid_index;
 use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, Model, Vec3};
+use fraccloth_tools::look::{measure, Descriptors};
+use fraccloth_tools::scenes::{stable_dt, top_offset, SceneKind, Variant, CLOTH_MASS, CLOTH_WIDTH};
 
 const W: u32 = 31;
 const H: u32 = 21;

@@ -23,9 +23,9 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 use fraccloth::history::Scheme;
-use fraccloth::oscillator::Oscillator;
-use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
 use fraccloth::{HalfDerivative, Integrator, RegularDrag, Vec3};
+use fraccloth_tools::oscillator::Oscillator;
+use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
 use nalgebra::Complex;
 use plotters::coord::Shift;
 use plotters::prelude::*;

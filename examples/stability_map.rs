@@ -16,9 +16,9 @@ use std::error::Error;
 use std::fmt::Write as _;
 
 use fraccloth::history::Scheme;
-use fraccloth::oscillator::Oscillator;
-use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
 use fraccloth::{Cloth, Integrator};
+use fraccloth_tools::oscillator::Oscillator;
+use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

@@ -8,9 +8,9 @@
 
 use std::time::Instant;
 
-use fraccloth::look::{measure, Descriptors};
-use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
 use fraccloth::{Integrator, Vec3};
+use fraccloth_tools::look::{measure, Descriptors};
+use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
 use plotters::prelude::*;
 
 #[derive(Clone, Copy)]

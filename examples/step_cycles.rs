@@ -11,9 +11,9 @@
 //! spring beside the particles').
 
 use fraccloth::history::Scheme;
-use fraccloth::scenes::Variant;
 use fraccloth::topology::{grid_index, MeshMass, MeshSpec};
 use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, RegularDrag, Vec3};
+use fraccloth_tools::scenes::Variant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();

@@ -27,9 +27,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use fraccloth::history::Scheme;
-use fraccloth::scenes::Variant;
 use fraccloth::topology::grid_index;
 use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, RegularDrag, Vec3};
+use fraccloth_tools::scenes::Variant;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

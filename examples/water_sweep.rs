@@ -11,9 +11,9 @@
 //! `skin=` (N s/m^3), `damping=` (spring damping), `mode=velocity|fractional|strain|none` (what the
 //! springs damp), `history=` (history drag per area, N s^1/2/m^3; the SOE history is kept).
 
-use fraccloth::look::measure;
-use fraccloth::scenes::{Drive, SceneKind, SceneSpec, Variant};
 use fraccloth::{Integrator, Model, Vec3};
+use fraccloth_tools::look::measure;
+use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
 
 fn main() {
     let args: Vec<(String, String)> = std::env::args()
@@ -118,7 +118,7 @@ fn main() {
         if spec.drive.amplitude == 0.0 {
             let root = scene.top_row()[w as usize / 2] as usize;
             let tip = (h as usize - 1) * w as usize + w as usize / 2;
-            let s = fraccloth::look::measure_stream(&topo.rest_positions, &frames, &times, root, tip);
+            let s = fraccloth_tools::look::measure_stream(&topo.rest_positions, &frames, &times, root, tip);
             let d = scene.cloth.positions()[tip] - topo.rest_positions[tip];
             println!(
                 "still | {s:?} | tip moved ({:.4}, {:.4}, {:.4}) m | {status}",

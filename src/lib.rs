@@ -6,7 +6,10 @@
 //! particle displacement. The half-derivative carries the memory of the fluid.
 //!
 //! The physics core (everything but [`ffi`]) knows nothing of C; the C ABI in
-//! [`ffi`] is a thin checked shell over [`Cloth`]. Units are SI throughout.
+//! [`ffi`] is a thin checked shell over [`Cloth`]. Units are SI throughout. What only the baker,
+//! the tests and the examples use (the look meter, the built-in scenes, the fractional
+//! oscillator, the cache readers) is the `fraccloth-tools` crate (`tools/`), not this one, so the
+//! C library is built from the physics alone.
 //!
 //! ```
 //! use fraccloth::{Cloth, ClothConfig, GridSpec, Vec3};
@@ -37,11 +40,8 @@ pub mod ffi;
 pub mod forces;
 pub mod history;
 pub mod integrate;
-pub mod look;
 pub mod model;
-pub mod oscillator;
 mod plumbing;
-pub mod scenes;
 #[cfg(test)]
 mod testing;
 pub mod topology;

@@ -175,7 +175,7 @@ impl Model {
     /// The fractional cloth of the paper (Eq. 2-5): fractional springs, viscous and history drag.
     ///
     /// The paper gives no numbers; these were tuned so a 61 x 41 towel of 2 cm spacing
-    /// sinks slowly and forms travelling bumps when swung (see `scenes.rs`).
+    /// sinks slowly and forms travelling bumps when swung (see `tools/src/scenes.rs`).
     pub fn fractional() -> Self {
         Self {
             cloth_density: 1100.0,

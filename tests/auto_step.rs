@@ -5,8 +5,8 @@
 
 use fraccloth::ffi::FcStatus::*;
 use fraccloth::ffi::*;
-use fraccloth::scenes::{Drive, SceneKind, SceneSpec, Variant};
 use fraccloth::Integrator;
+use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
 
 #[test]
 fn the_underwater_preset_steps_once_per_frame() {

@@ -5,7 +5,7 @@ mod common;
 
 use common::{compile_c, run, scratch_dir};
 use fraccloth::ffi::*;
-use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
+use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
 
 fn field<'a>(out: &'a str, key: &str) -> Vec<&'a str> {
     out.lines()

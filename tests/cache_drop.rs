@@ -2,8 +2,9 @@
 //! file whose header counts exactly the frames written whole. (The baker's own refused bake:
 //! `cli/tests/refused_bake.rs`.)
 
-use fraccloth::export::{read_cache, CacheFormat, CacheWriter};
+use fraccloth::export::{CacheFormat, CacheWriter};
 use fraccloth::Vec3;
+use fraccloth_tools::read::read_cache;
 
 #[test]
 fn a_dropped_cache_counts_exactly_its_frames() {

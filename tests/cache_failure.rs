@@ -71,8 +71,8 @@ fn a_cache_that_fails_part_way_keeps_its_whole_frames_and_says_so() {
         assert_eq!(count, 2, "{name}: the header counts the frames that are there");
         // And it reads back as a valid cache.
         let back = match format {
-            0 => fraccloth::export::parse_pc2(&bytes),
-            _ => fraccloth::export::parse_mdd(&bytes),
+            0 => fraccloth_tools::read::parse_pc2(&bytes),
+            _ => fraccloth_tools::read::parse_mdd(&bytes),
         };
         assert_eq!(back.unwrap().frames.len(), 2);
     }

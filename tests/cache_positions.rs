@@ -2,9 +2,9 @@
 
 use std::ffi::CString;
 
-use fraccloth::export::read_cache;
 use fraccloth::ffi::FcStatus::{FC_ERROR_INVALID_ARGUMENT, FC_OK};
 use fraccloth::ffi::*;
+use fraccloth_tools::read::read_cache;
 
 #[test]
 fn host_positions_are_written_as_given_and_bad_ones_refused() {

@@ -7,8 +7,8 @@
 use fraccloth::collide::intersections::{self_intersections, vertices_inside};
 use fraccloth::collide::shapes::{bar, torus};
 use fraccloth::forces::{Collider, Plane};
-use fraccloth::scenes::{collision_towel, TowelPose};
 use fraccloth::{Cloth, Integrator, Model, Vec3};
+use fraccloth_tools::scenes::{collision_towel, TowelPose};
 
 const FPS: f64 = 30.0;
 
@@ -279,7 +279,7 @@ fn a_snapshot_resumes_a_bake_with_collisions_bitwise() {
 /// target (no crossing at any frame) is not met here; docs/collisions.md gives the figures.
 #[test]
 fn the_brisk_swing_with_self_collision_does_not_cross_itself() {
-    use fraccloth::scenes::{Drive, SceneKind, SceneSpec, Variant};
+    use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
     let run = |thickness: f64| {
         let drive = Drive {
             amplitude: 0.08,

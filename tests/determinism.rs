@@ -10,9 +10,9 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use fraccloth::history::Scheme;
-use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
 use fraccloth::topology::grid_index;
 use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, RegularDrag, Vec3};
+use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
 
 fn fnv(cloth: &Cloth) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;

@@ -6,9 +6,9 @@ use common::reference::talbot;
 use fraccloth::ffi::FcStatus::*;
 use fraccloth::ffi::*;
 use fraccloth::history::Scheme;
-use fraccloth::oscillator::Oscillator;
-use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
 use fraccloth::{Cloth, Integrator};
+use fraccloth_tools::oscillator::Oscillator;
+use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
 use nalgebra::Complex;
 
 const SOE: Scheme = Scheme::SumOfExponentials {
@@ -128,7 +128,7 @@ fn implicit_runs_stiff_swing_at_frame_rate_where_explicit_fails() {
 }
 
 /// 10 s of the stiff swing at frame rate: energy bounded, nothing flies away.
-fn stiff_swing_stays_bounded(mut implicit: fraccloth::scenes::Scene, integrator: Integrator) {
+fn stiff_swing_stays_bounded(mut implicit: fraccloth_tools::scenes::Scene, integrator: Integrator) {
     // Energy relative to the start, largest magnitude in the first and in the second 5 s.
     let e0 = implicit.cloth.energy();
     let (mut first, mut second) = (0.0f64, 0.0f64);

@@ -6,8 +6,8 @@
 
 use std::f64::consts::PI;
 
-use fraccloth::look::{measure, Look};
 use fraccloth::{GridSpec, Vec3};
+use fraccloth_tools::look::{measure, Look};
 
 const L: f64 = 0.4; // column length, m
 const FPS: f64 = 30.0;

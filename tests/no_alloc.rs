@@ -11,8 +11,8 @@ use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use fraccloth::history::Scheme;
-use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
 use fraccloth::{Integrator, RegularDrag};
+use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
 
 struct Counting;
 

@@ -2,8 +2,8 @@
 
 use fraccloth::forces::body_force;
 use fraccloth::history::Scheme;
-use fraccloth::scenes::{sphere_at, SceneKind, SceneSpec, Variant};
 use fraccloth::{Cloth, ClothConfig, GridSpec, Model, RegularDrag, SpringDamping, Vec3};
+use fraccloth_tools::scenes::{sphere_at, SceneKind, SceneSpec, Variant};
 
 fn free_particles(model: Model) -> Cloth {
     // 2 x 2 grid with every spring switched off: four independent particles.
@@ -75,7 +75,7 @@ fn pinned_vertices_sit_exactly_on_their_targets_after_every_step() {
     for _ in 0..400 {
         scene.step().unwrap();
         let t = scene.cloth.time();
-        let off = fraccloth::scenes::top_offset(SceneKind::Swing, Variant::Fractional, t);
+        let off = fraccloth_tools::scenes::top_offset(SceneKind::Swing, Variant::Fractional, t);
         for (k, &i) in top.iter().enumerate() {
             assert_eq!(scene.cloth.positions()[i as usize], rest[k] + off, "t = {t}");
         }

@@ -11,11 +11,12 @@ fn read(p: &str) -> String {
 #[test]
 fn the_version_is_defined_once_and_every_package_carries_it() {
     let v = env!("CARGO_PKG_VERSION");
-    let cli = read("cli/Cargo.toml");
-    assert!(
-        cli.contains(&format!("version = \"{v}\"")),
-        "cli/Cargo.toml is not at {v}"
-    );
+    for package in ["cli/Cargo.toml", "tools/Cargo.toml"] {
+        assert!(
+            read(package).contains(&format!("version = \"{v}\"")),
+            "{package} is not at {v}"
+        );
+    }
     let py = read("bindings/python/pyproject.toml");
     assert!(
         py.contains(&format!("version = \"{v}\"")),
@@ -68,6 +69,7 @@ fn the_license_texts_are_there_and_named_the_same_everywhere() {
     for p in [
         "Cargo.toml",
         "cli/Cargo.toml",
+        "tools/Cargo.toml",
         "bindings/python/pyproject.toml",
         "bindings/blender/fraccloth_blender/__init__.py",
     ] {

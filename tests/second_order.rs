@@ -191,8 +191,8 @@ fn rms(a: &[fraccloth::Vec3], b: &[fraccloth::Vec3]) -> f64 {
 /// order.
 fn swung_differences(integrator: fraccloth::Integrator, smooth: bool) -> (f64, f64) {
     use fraccloth::history::Scheme;
-    use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
     use fraccloth::{Cloth, ClothConfig, Vec3};
+    use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
     let run = |dt: f64| -> Vec<Vec3> {
         let spec = SceneSpec {
             width: 21,
@@ -277,8 +277,8 @@ fn extrapolated_symplectic_euler_converges_at_second_order_on_the_underwater_swi
     // pins' velocity error after the kink must die out (measured ratios 4.01, 4.00; a mid goal
     // read from the extrapolated velocity instead kept it alive: 1.85).
     use fraccloth::history::Scheme;
-    use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
     use fraccloth::Vec3;
+    use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
     let run = |dt: f64| -> Vec<Vec3> {
         let spec = SceneSpec {
             width: 31,

@@ -4,8 +4,8 @@
 
 use fraccloth::history::Scheme;
 use fraccloth::model::SpringDamping;
-use fraccloth::oscillator::{axis, Oscillator};
 use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, Model, Vec3};
+use fraccloth_tools::oscillator::{axis, Oscillator};
 
 /// The fractional oscillator `m x'' + c D^{1/2}x + k x = F` built from one diagonal spring
 /// whose damping is `mode` (the other springs neither pull nor damp): particle 3 moves on the

@@ -4,9 +4,9 @@
 //! (> `parallel::MIN_PARALLEL` particles) for the passes to be split among threads.
 
 use fraccloth::history::Scheme;
-use fraccloth::scenes::Variant;
 use fraccloth::topology::grid_index;
 use fraccloth::{forces::Sphere, Cloth, ClothConfig, GridSpec, Integrator, RegularDrag, Vec3};
+use fraccloth_tools::scenes::Variant;
 
 const W: u32 = 131;
 const H: u32 = 129;

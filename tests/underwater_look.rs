@@ -4,9 +4,9 @@
 //! and travel speed within 15 % between 31 x 21 and 61 x 41. (121 x 81, measured by the
 //! baker, is in docs/underwater.md; it takes too long for CI.)
 
-use fraccloth::look::{measure, Look};
-use fraccloth::scenes::{stable_dt, SceneKind, SceneSpec, Variant, CLOTH_WIDTH};
 use fraccloth::{Integrator, Vec3};
+use fraccloth_tools::look::{measure, Look};
+use fraccloth_tools::scenes::{stable_dt, SceneKind, SceneSpec, Variant, CLOTH_WIDTH};
 
 fn bake(width: u32, height: u32) -> Look {
     let spacing = CLOTH_WIDTH / f64::from(width - 1);

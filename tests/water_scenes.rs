@@ -4,9 +4,9 @@
 //! and motion in the cloth's own plane dying out. Numbers of record: `docs/underwater.md`
 //! (`cargo run --release --example water_sweep`).
 
-use fraccloth::look::{measure, measure_stream, Descriptors};
-use fraccloth::scenes::{Drive, Scene, SceneKind, SceneSpec, Variant};
 use fraccloth::{Integrator, Model, Vec3};
+use fraccloth_tools::look::{measure, measure_stream, Descriptors};
+use fraccloth_tools::scenes::{Drive, Scene, SceneKind, SceneSpec, Variant};
 
 fn spec(kind: SceneKind, drive: Drive, integrator: Integrator, dt: f64) -> SceneSpec {
     SceneSpec {

@@ -2,7 +2,7 @@
 //! mesh that Blender, Maya or 3ds Max can load (Mesh Cache modifier), with preview pictures: a
 //! contact sheet (PNG) and an animated GIF. `--compare` bakes one scene with the paper's three
 //! regular models, its fractional preset, the fractional model with the accurate history and
-//! the underwater preset side by side, and measures the look of each (`fraccloth::look`).
+//! the underwater preset side by side, and measures the look of each (`fraccloth_tools::look`).
 //!
 //! With no arguments it bakes the underwater `swing` scene (61 x 41, 12 s) into `out/`.
 //! `fraccloth look CACHE --rest REST.obj` measures the look of any point cache.
@@ -19,12 +19,12 @@ use std::time::Instant;
 use clap::{Parser, Subcommand};
 
 mod render;
-use fraccloth::export::{read_cache, read_obj};
 use fraccloth::export::{write_obj, CacheFormat, CacheWriter};
 use fraccloth::history::Scheme;
-use fraccloth::look::{measure, measure_stream, Look};
-use fraccloth::scenes::{stable_dt, Drive, Scene, SceneKind, SceneSpec, Variant, DEFAULT_DT};
 use fraccloth::{HalfDerivative, Integrator, RegularDrag, Vec3};
+use fraccloth_tools::look::{measure, measure_stream, Look};
+use fraccloth_tools::read::{read_cache, read_obj};
+use fraccloth_tools::scenes::{stable_dt, Drive, Scene, SceneKind, SceneSpec, Variant, DEFAULT_DT};
 use indicatif::{ProgressBar, ProgressStyle};
 use render::{contact_sheet, render_frame, save_png, side_view, space_time, Camera, GifWriter, Scene3d};
 use tiny_skia::Pixmap;

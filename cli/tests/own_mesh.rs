@@ -1,8 +1,8 @@
 //! `fraccloth --mesh model.obj`: a studio's own mesh baked with the underwater preset, pinned
 //! by an OBJ group, a list of vertices or the top rows; the caches keep the OBJ's vertex order.
 
-use fraccloth::export::read_cache;
 use fraccloth::Vec3;
+use fraccloth_tools::read::read_cache;
 
 /// A 13 x 9 quad mesh of 3 cm spacing hanging in the x-y plane, its top row of faces in the
 /// group `hem`, written with its rows bottom-up (so the order is not the built-in grid's).

@@ -1,7 +1,7 @@
 //! A bake the baker stops on a refused step says so, exits non-zero, and leaves caches whose
 //! headers count exactly the frames they hold.
 
-use fraccloth::export::read_cache;
+use fraccloth_tools::read::read_cache;
 
 #[test]
 fn a_refused_bake_leaves_honest_caches() {

@@ -8,7 +8,7 @@
 use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
 use super::label::{draw_text, text_width};
-use fraccloth::look::Look;
+use fraccloth_tools::look::Look;
 
 const INK: [u8; 3] = [30, 30, 30];
 const BACKGROUND: Color = Color::WHITE;

@@ -2,14 +2,14 @@
 //! colliders in the picture.
 
 use crate::render::{render_frame, Camera, Scene3d};
-use fraccloth::scenes::{SceneKind, SceneSpec, Variant};
+use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
 use tiny_skia::Pixmap;
 
-fn camera(scene: &fraccloth::scenes::Scene, w: u32, h: u32) -> Camera {
+fn camera(scene: &fraccloth_tools::scenes::Scene, w: u32, h: u32) -> Camera {
     Camera::for_rest_shape(&scene.cloth.topology().rest_positions, w, h)
 }
 
-fn draw(scene: &fraccloth::scenes::Scene, cam: &Camera) -> Pixmap {
+fn draw(scene: &fraccloth_tools::scenes::Scene, cam: &Camera) -> Pixmap {
     let mut pix = Pixmap::new(cam.width, cam.height).unwrap();
     let spheres = Scene3d::spheres_of(scene.cloth.colliders().iter().copied());
     render_frame(

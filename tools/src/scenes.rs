@@ -28,14 +28,14 @@
 //! scaled by the area a particle represents; spring constants of a square lattice
 //! are independent of the spacing.
 
-use crate::cloth::{Cloth, ClothConfig};
-use crate::error::Error;
-use crate::forces::Sphere;
-use crate::history::Scheme;
-use crate::integrate::Integrator;
-use crate::math::Vec3;
-use crate::model::{Model, RegularDrag};
-use crate::topology::{grid_index, GridSpec};
+use fraccloth::cloth::{Cloth, ClothConfig};
+use fraccloth::error::Error;
+use fraccloth::forces::Sphere;
+use fraccloth::history::Scheme;
+use fraccloth::integrate::Integrator;
+use fraccloth::math::Vec3;
+use fraccloth::model::{Model, RegularDrag};
+use fraccloth::topology::{grid_index, GridSpec};
 
 /// Cloth width, m.
 pub const CLOTH_WIDTH: f64 = 0.6;
@@ -266,7 +266,7 @@ pub struct SceneSpec {
     /// variant's.
     pub model: Option<Model>,
     /// The cloth's `max_substep`: 0 steps `dt` at once (the paper's scenes), negative
-    /// ([`crate::cloth::AUTO`]) lets the cloth split each `dt` as it needs.
+    /// ([`fraccloth::cloth::AUTO`]) lets the cloth split each `dt` as it needs.
     pub max_substep: f64,
     /// Build the cloth as an irregular triangle mesh ([`jittered_mesh`]) instead of the grid:
     /// the same vertices in the same order, moved and triangulated at random.
@@ -277,11 +277,11 @@ pub struct SceneSpec {
 /// its plane and triangulated with random diagonals, as a DCC's irregular mesh; masses and
 /// areas lumped from the faces at `areal_density` (kg/m^2). The same `seed` gives the same mesh.
 pub fn jittered_mesh(
-    grid: &crate::Topology,
+    grid: &fraccloth::Topology,
     width: u32,
     areal_density: f64,
     seed: u64,
-) -> Result<crate::Topology, Error> {
+) -> Result<fraccloth::Topology, Error> {
     let (w, h) = (width, (grid.vertex_count() as u32) / width.max(1));
     let spacing = grid
         .rest_positions
@@ -320,11 +320,11 @@ pub fn jittered_mesh(
             }
         }
     }
-    crate::topology::MeshSpec {
+    fraccloth::topology::MeshSpec {
         positions: &positions,
         indices: &indices,
         face_size: 3,
-        mass: crate::topology::MeshMass::ArealDensity(areal_density),
+        mass: fraccloth::topology::MeshMass::ArealDensity(areal_density),
     }
     .build()
 }
@@ -391,7 +391,12 @@ impl SceneSpec {
     /// The scene on any topology (a host's own mesh), pinned at `pins` (vertex indices), with
     /// the model of the variant at the mesh's `spacing` (m; its drag coefficients are given
     /// per 1 cm spacing, `scale_drags`) unless the spec has its own. The drive moves the pins.
-    pub fn build_on(&self, topology: crate::Topology, pins: &[u32], spacing: f64) -> Result<Scene, Error> {
+    pub fn build_on(
+        &self,
+        topology: fraccloth::Topology,
+        pins: &[u32],
+        spacing: f64,
+    ) -> Result<Scene, Error> {
         let mut model = self.variant.model(spacing);
         if self.kind == SceneKind::Kelp {
             model.cloth_density = KELP_DENSITY;
@@ -543,7 +548,7 @@ pub fn collision_towel(
         model,
         scheme: Scheme::DEFAULT,
         integrator,
-        max_substep: crate::cloth::AUTO,
+        max_substep: fraccloth::cloth::AUTO,
         ..ClothConfig::default()
     };
     let mut cloth = Cloth::new(grid, config)?;

@@ -7,13 +7,13 @@
 
 use nalgebra::Complex;
 
-use crate::cloth::{Cloth, ClothConfig};
-use crate::error::Error;
-use crate::history::Scheme;
-use crate::integrate::Integrator;
-use crate::math::Vec3;
-use crate::model::{Model, SpringDamping};
-use crate::topology::GridSpec;
+use fraccloth::cloth::{Cloth, ClothConfig};
+use fraccloth::error::Error;
+use fraccloth::history::Scheme;
+use fraccloth::integrate::Integrator;
+use fraccloth::math::Vec3;
+use fraccloth::model::{Model, SpringDamping};
+use fraccloth::topology::GridSpec;
 
 /// Parameters of `m x'' + c D^{1/2}x + k x = F`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -3,8 +3,8 @@
 //! root (a pinned point) and tip (the free edge's middle) are known.
 
 use super::harmonic::dominant_frequency;
-use crate::error::Error;
-use crate::math::Vec3;
+use fraccloth::error::Error;
+use fraccloth::math::Vec3;
 
 /// Flutter below this (m, rms) is stillness: no frequency is reported.
 pub const STILL: f64 = 1e-4;

@@ -21,8 +21,8 @@ use nalgebra::{Complex, Matrix2, Matrix3, SymmetricEigen, Vector2};
 
 use super::descriptors::{describe, ColumnMotion, Descriptors};
 use super::harmonic::{complex_amplitude, dominant_frequency};
-use crate::error::Error;
-use crate::math::Vec3;
+use fraccloth::error::Error;
+use fraccloth::math::Vec3;
 
 /// A measured look: the drive, the column and its descriptors.
 #[derive(Clone, Debug, PartialEq)]

@@ -6,7 +6,7 @@
 use std::io;
 use std::path::Path;
 
-use crate::math::Vec3;
+use fraccloth::math::Vec3;
 
 /// Frames read from a point cache.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -253,7 +253,7 @@ pub fn read_obj(path: &Path) -> io::Result<ObjMesh> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::export::{write_obj, MddWriter, Pc2Writer};
+    use fraccloth::export::{write_obj, MddWriter, Pc2Writer};
 
     #[test]
     fn caches_and_meshes_read_back_what_was_written() {
