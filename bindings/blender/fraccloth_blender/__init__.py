@@ -194,6 +194,10 @@ class FracclothSettings(bpy.types.PropertyGroup):
                                            description="How collider objects are seen: their own mesh every frame, or a fitted sphere, capsule or plane (faster)")
     self_collision: bpy.props.FloatProperty(name="Self-collision", description="Distance the cloth keeps from itself, m (0 = off); a few mm for a cloth of 1-2 cm spacing", default=0.0, min=0.0, soft_max=0.02, precision=4)
     self_friction: bpy.props.FloatProperty(name="Self friction", description="How much the cloth grips itself where it touches (0 = slippery)", default=0.0, min=0.0, soft_max=1.0)
+    use_scene_range: bpy.props.BoolProperty(name="Scene frame range", default=True,
+                                            description="Bake the scene's frame range; off: the range below")
+    frame_start: bpy.props.IntProperty(name="Start", description="First frame of the bake (the cloth's rest state)", default=1, min=0)
+    frame_end: bpy.props.IntProperty(name="End", description="Last frame of the bake", default=250, min=0)
     cache_format: bpy.props.EnumProperty(name="Format", items=FORMAT_ITEMS, default="PC2")
     cache_path: bpy.props.StringProperty(name="Cache file", subtype="FILE_PATH", default="",
                                          description="Where the cache goes; empty: a 'fraccloth' folder next to the .blend, named after the object")
@@ -219,6 +223,45 @@ def _evaluated(obj, triangles=False):
         ev.to_mesh_clear()
     m = np.array(ev.matrix_world, dtype=np.float64)
     return co.reshape(-1, 3) @ m[:3, :3].T + m[:3, 3], tris
+
+
+def frame_range(scene, s):
+    """(first, last) frame of a bake with settings `s`: the scene's range, or the settings' own."""
+    if s.use_scene_range:
+        return scene.frame_start, scene.frame_end
+    if s.frame_end < s.frame_start:
+        raise ValueError(f"the bake's frame range ends ({s.frame_end}) before it starts ({s.frame_start})")
+    return s.frame_start, s.frame_end
+
+
+def unit_scale(scene):
+    """Metres per Blender unit (Scene > Units > Unit Scale): the library works in metres."""
+    return float(scene.unit_settings.scale_length)
+
+
+def _in_metres(spec, u):
+    """A collider spec (`collider_specs_for`) in metres: lengths times `u` metres per unit."""
+    kind = spec[0]
+    if kind == "mesh":
+        return (kind, spec[1] * u, spec[2])
+    if kind == "plane":
+        return (kind, tuple(u * c for c in spec[1]), spec[2])
+    if kind == "capsule":
+        return (kind, tuple(u * c for c in spec[1]), tuple(u * c for c in spec[2]), u * spec[3])
+    return (kind, tuple(u * c for c in spec[1]), u * spec[2])
+
+
+def colliders_of(context, obj):
+    """The objects `obj` collides with: mesh objects with Blender's own Collision physics on
+    (the setting Blender's cloth reads), and mesh objects selected beside it."""
+    chosen = []
+    for o in context.scene.objects:
+        if o is obj or o.type != "MESH":
+            continue
+        physics = any(m.type == "COLLISION" for m in o.modifiers)
+        if physics or o.select_get():
+            chosen.append(o)
+    return chosen
 
 
 def _mesh_spec(o):
@@ -316,9 +359,10 @@ def pin_weights(obj, name):
     return np.clip(w, 0.0, 1.0)
 
 
-def describe(s):
-    """The library's description (`FcClothDesc`) for the settings `s`; grid size and time step
-    are not in it."""
+def describe(s, scene=None):
+    """The library's description (`FcClothDesc`) for the settings `s` in `scene` (its gravity,
+    off when the scene's gravity is off, in metres; Earth's without a scene); grid size and time
+    step are not in it."""
     import fraccloth
 
     desc = fraccloth.default_desc()
@@ -327,7 +371,10 @@ def describe(s):
     desc.cloth_density = s.cloth_density
     desc.water_density = s.water_density
     for k in range(3):
-        desc.gravity[k] = (0.0, 0.0, -9.81)[k]
+        if scene is None:
+            desc.gravity[k] = (0.0, 0.0, -9.81)[k]
+        else:
+            desc.gravity[k] = scene.gravity[k] * unit_scale(scene) if scene.use_gravity else 0.0
         desc.current[k] = s.current[k]
     desc.stretch_stiffness = s.stretch_stiffness
     desc.shear_stiffness = s.shear_stiffness
@@ -379,10 +426,11 @@ def build_cloth(context, obj, others):
     if any(abs(c - 1.0) > 1e-6 for c in obj.matrix_world.to_scale()):
         raise ValueError(f"{obj.name}: apply its scale first (Ctrl+A > Scale)")
     _, faces = mesh_arrays(obj)
-    pos = world_positions(obj)
+    u = unit_scale(context.scene)
+    pos = world_positions(obj) * u
     if len(pos) != len(obj.data.vertices):
         raise ValueError(f"{obj.name}: its modifiers change the vertex count; apply or remove them")
-    desc = describe(s)
+    desc = describe(s, context.scene)
     if s.auto_step:
         # The library chooses each frame's substeps from the cloth as it is (and retries a
         # refused frame with more): FC_MAX_SUBSTEP_AUTO.
@@ -397,6 +445,7 @@ def build_cloth(context, obj, others):
         cloth.set_pin_weights(w)
     ids = []
     for spec in collider_specs_for(s, others):
+        spec = _in_metres(spec, u)
         if spec[0] == "mesh":
             cid = cloth.add_mesh_collider(spec[1].astype(np.float32), spec[2])
         elif spec[0] == "plane":
@@ -415,7 +464,8 @@ def build_cloth(context, obj, others):
 
 
 def simulate(context, obj, others):
-    """Yields (frame, cloth, local positions) for every frame of the scene's range. The cloth
+    """Yields (frame, cloth, local positions) for every frame of the bake's range (`frame_range`),
+    in metres inside the library (Blender units times the scene's unit scale). The cloth
     moves in world space; the first frame is the rest state, each next one a frame's worth of
     steps later. Before each frame's steps the pinned vertices' evaluated world positions at that
     frame become the pin targets (approached in a straight line over the substeps; a weight
@@ -436,16 +486,19 @@ def simulate(context, obj, others):
 
 def _simulate(context, obj, others):
     scene = context.scene
-    scene.frame_set(scene.frame_start)
-    cloth, (frame_dt, substeps), pinned, ids = build_cloth(context, obj, others)
     s = obj.fraccloth
-    previous = collider_specs_for(s, others)
-    for f in range(scene.frame_start, scene.frame_end + 1):
-        if f > scene.frame_start:
+    first, last = frame_range(scene, s)
+    u = unit_scale(scene)
+    scene.frame_set(first)
+    cloth, (frame_dt, substeps), pinned, ids = build_cloth(context, obj, others)
+    specs = lambda: [_in_metres(spec, u) for spec in collider_specs_for(s, others)]  # noqa: E731
+    previous = specs()
+    for f in range(first, last + 1):
+        if f > first:
             scene.frame_set(f)
             if len(pinned):
-                cloth.set_pin_targets(pinned, world_positions(obj)[pinned].astype(np.float32))
-            now = collider_specs_for(s, others)
+                cloth.set_pin_targets(pinned, (world_positions(obj)[pinned] * u).astype(np.float32))
+            now = specs()
             for cid, old, new in zip(ids, previous, now):
                 if new[0] == "mesh":
                     if len(new[1]) != len(old[1]):
@@ -465,7 +518,7 @@ def _simulate(context, obj, others):
                 cloth.step(frame_dt)
             else:
                 cloth.step_substeps(frame_dt, substeps)
-        yield f, cloth, to_local(obj, cloth.positions_f64()).astype(np.float32)
+        yield f, cloth, to_local(obj, cloth.positions_f64() / u).astype(np.float32)
 
 
 def cache_path(obj):
@@ -495,7 +548,8 @@ class BakeJob:
         self.path = path if path.endswith(ext) else path + ext
         os.makedirs(os.path.dirname(self.path) or ".", exist_ok=True)
         self.format = fraccloth.CACHE_PC2 if s.cache_format == "PC2" else fraccloth.CACHE_MDD
-        self.frames = scene.frame_end - scene.frame_start + 1
+        self.first, last = frame_range(scene, s)
+        self.frames = last - self.first + 1
         self.fps = scene.render.fps / scene.render.fps_base
         self.done = 0
         self.cache = None
@@ -506,7 +560,7 @@ class BakeJob:
         self.partial = self.path + ".baking"
         # Check the setup before anything is written: the cloth is built here (and again by the
         # simulation); a bad setup raises now.
-        scene.frame_set(scene.frame_start)
+        scene.frame_set(self.first)
         try:
             build_cloth(context, obj, others)
         except Exception:
@@ -520,7 +574,7 @@ class BakeJob:
         scene = self.context.scene
         f, cloth, local = next(self.frames_left)
         if self.cache is None:
-            self.cache = fraccloth.Cache(self.partial, self.format, cloth, float(scene.frame_start), self.fps, self.frames)
+            self.cache = fraccloth.Cache(self.partial, self.format, cloth, float(self.first), self.fps, self.frames)
         self.cache.write_positions(local)
         self.done += 1
         if self.done < self.frames:
@@ -540,7 +594,7 @@ class BakeJob:
         mod.filepath = self.path
         mod.time_mode = "FRAME"
         mod.play_mode = "SCENE"
-        mod.frame_start = float(scene.frame_start)
+        mod.frame_start = float(self.first)
         mod.interpolation = "NONE"
         return True
 
@@ -572,8 +626,7 @@ class FRACCLOTH_OT_bake(bpy.types.Operator):
 
     def _start(self, context):
         obj = context.active_object
-        others = [o for o in context.selected_objects if o is not obj]
-        return BakeJob(context, obj, others)
+        return BakeJob(context, obj, colliders_of(context, obj))
 
     def _fail(self, job, error):
         if job is not None:
@@ -643,6 +696,38 @@ class FRACCLOTH_OT_bake(bpy.types.Operator):
         return {"RUNNING_MODAL"}
 
 
+def free_bake(obj):
+    """Removes `obj`'s baked cache: its fraccloth Mesh Cache modifier and the file it plays.
+    Returns the paths removed."""
+    removed = []
+    for m in list(obj.modifiers):
+        if m.type == "MESH_CACHE" and m.name == "fraccloth":
+            path = bpy.path.abspath(m.filepath)
+            obj.modifiers.remove(m)
+            if path and os.path.exists(path):
+                os.remove(path)
+                removed.append(path)
+    return removed
+
+
+class FRACCLOTH_OT_free_bake(bpy.types.Operator):
+    """Remove the active mesh's underwater bake: its cache modifier and cache file"""
+
+    bl_idname = "fraccloth.free_bake"
+    bl_label = "Free bake"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        o = context.active_object
+        return o is not None and any(m.type == "MESH_CACHE" and m.name == "fraccloth" for m in o.modifiers)
+
+    def execute(self, context):
+        removed = free_bake(context.active_object)
+        self.report({"INFO"}, f"fraccloth: bake freed ({', '.join(removed) or 'no file on disk'})")
+        return {"FINISHED"}
+
+
 class FRACCLOTH_PT_panel(bpy.types.Panel):
     bl_label = "fraccloth (underwater cloth)"
     bl_space_type = "PROPERTIES"
@@ -665,7 +750,7 @@ class FRACCLOTH_PT_panel(bpy.types.Panel):
                        "viscous_drag", "normal_drag", "current")),
             ("Colliders", ("collider_shape", "friction", "collision_margin", "self_collision", "self_friction")),
             ("Solver", ("history", "integrator", "auto_step", "time_step")),
-            ("Cache", ("cache_format", "cache_path")),
+            ("Cache", ("use_scene_range", "frame_start", "frame_end", "cache_format", "cache_path")),
         ):
             box = layout.box()
             box.label(text=title)
@@ -674,10 +759,16 @@ class FRACCLOTH_PT_panel(bpy.types.Panel):
                 row.prop(s, name)
                 if name == "time_step":
                     row.enabled = not s.auto_step
-        layout.operator(FRACCLOTH_OT_bake.bl_idname)
+                if name in ("frame_start", "frame_end"):
+                    row.enabled = not s.use_scene_range
+            if title == "Colliders":
+                box.label(text="Colliders: mesh objects with Collision physics, and meshes selected with the cloth")
+        row = layout.row()
+        row.operator(FRACCLOTH_OT_bake.bl_idname)
+        row.operator(FRACCLOTH_OT_free_bake.bl_idname)
 
 
-_classes = (FracclothSettings, FRACCLOTH_OT_bake, FRACCLOTH_PT_panel)
+_classes = (FracclothSettings, FRACCLOTH_OT_bake, FRACCLOTH_OT_free_bake, FRACCLOTH_PT_panel)
 
 
 def register():

@@ -29,7 +29,8 @@ def addon():
     addon_utils.disable("fraccloth_blender")
 
 
-def make_scene(tmp_path, fmt):
+def make_scene(tmp_path, fmt, k=1.0):
+    """The test scene; `k` Blender units to the metre (every length `k` times larger)."""
     # Start empty (read_factory_settings here would also disable the add-on).
     for o in list(bpy.data.objects):
         bpy.data.objects.remove(o)
@@ -40,17 +41,17 @@ def make_scene(tmp_path, fmt):
     scene.render.fps = 24
     # A 0.3 m square cloth of 13 x 9 vertices, lying in the x-y plane 20 cm up, moved and
     # turned so the local frame is not the world frame.
-    bpy.ops.mesh.primitive_grid_add(x_subdivisions=12, y_subdivisions=8, size=0.3, location=(0.1, -0.2, 0.2),
-                                    rotation=(0.0, 0.0, 0.3))
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=12, y_subdivisions=8, size=0.3 * k,
+                                    location=(0.1 * k, -0.2 * k, 0.2 * k), rotation=(0.0, 0.0, 0.3))
     cloth = bpy.context.active_object
     group = cloth.vertex_groups.new(name="pins")
     ys = [v.co.y for v in cloth.data.vertices]
     edge = [v.index for v in cloth.data.vertices if v.co.y > max(ys) - 1e-6]
     group.add(edge, 1.0, "REPLACE")
     # A ball under the middle of the cloth and a floor.
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.05, location=(0.1, -0.2, 0.1))
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.05 * k, location=(0.1 * k, -0.2 * k, 0.1 * k))
     ball = bpy.context.active_object
-    bpy.ops.mesh.primitive_plane_add(size=2.0, location=(0.0, 0.0, -0.1))
+    bpy.ops.mesh.primitive_plane_add(size=2.0 * k, location=(0.0, 0.0, -0.1 * k))
     floor = bpy.context.active_object
     for o in (ball, floor):
         o.select_set(True)
@@ -394,3 +395,96 @@ def test_a_new_cloth_starts_on_the_librarys_underwater_towel_and_edits_say_custo
     s.damping_mode, s.spring_damping, s.history = "FRACTIONAL", 0.35, "OFF"
     with pytest.raises(RuntimeError, match="needs a History"):
         bpy.ops.fraccloth.bake()
+
+
+def test_free_bake_removes_the_modifier_and_its_file(addon, tmp_path):
+    cloth, _ = make_scene(tmp_path, "PC2")
+    assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+    path = Path(cloth.modifiers["fraccloth"].filepath)
+    assert path.exists()
+    assert bpy.ops.fraccloth.free_bake() == {"FINISHED"}
+    assert cloth.modifiers.get("fraccloth") is None
+    assert not path.exists()
+    # Nothing left to free: the button is greyed out.
+    assert not bpy.ops.fraccloth.free_bake.poll()
+
+
+def test_a_frame_range_of_its_own(addon, tmp_path):
+    """Off the scene's range, the bake covers its own frames: the cache starts at its first
+    frame (the rest state) and plays the library's positions at its last."""
+    cloth, others = make_scene(tmp_path, "PC2")
+    s = cloth.fraccloth
+    s.use_scene_range, s.frame_start, s.frame_end = False, 5, 12
+    rest = np.array([v.co[:] for v in cloth.data.vertices], dtype=np.float32)
+    assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+    mod = cloth.modifiers["fraccloth"]
+    assert mod.frame_start == 5.0
+    expected = {f: local for f, _, local in addon.simulate(bpy.context, cloth, others)}
+    assert sorted(expected) == list(range(5, 13))
+    assert np.array_equal(evaluated(cloth, 5), expected[5])
+    assert np.allclose(expected[5], rest, atol=1e-6)
+    assert np.array_equal(evaluated(cloth, 12), expected[12])
+    assert np.abs(expected[12] - rest).max() > 0.002
+    s.frame_start, s.frame_end = 12, 5
+    with pytest.raises(RuntimeError, match="ends .* before it starts"):
+        bpy.ops.fraccloth.bake()
+
+
+def test_the_scenes_gravity_is_the_clothes(addon, tmp_path):
+    """With the scene's gravity off, a free cloth in still water has neither weight nor
+    buoyancy: it stays where it is."""
+    cloth, _ = make_scene(tmp_path, "PC2")
+    s = cloth.fraccloth
+    s.pin_group, s.current = "", (0.0, 0.0, 0.0)
+    bpy.context.scene.use_gravity = False
+    try:
+        rest = world(cloth, 1)
+        assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+        assert np.abs(world(cloth, 24) - rest).max() < 1e-5
+    finally:
+        bpy.context.scene.use_gravity = True
+
+
+def test_the_unit_scale_gives_the_same_motion_in_metres(addon, tmp_path):
+    """The same scene built twice as large in Blender units with a unit scale of 0.5 m (and its
+    gravity given in those units) bakes the same motion in metres."""
+    scene = bpy.context.scene
+    cloth, _ = make_scene(tmp_path / "one", "PC2")
+    assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+    metres = world(cloth, 24)
+    try:
+        scene.unit_settings.scale_length = 0.5
+        scene.gravity = (0.0, 0.0, -9.81 / 0.5)
+        cloth, _ = make_scene(tmp_path / "two", "PC2", k=2.0)
+        assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+        scaled = world(cloth, 24) * 0.5
+    finally:
+        scene.unit_settings.scale_length = 1.0
+        scene.gravity = (0.0, 0.0, -9.81)
+    assert np.abs(metres - world(cloth, 1) * 0.5).max() > 0.01  # it moved
+    assert np.abs(scaled - metres).max() < 1e-4, np.abs(scaled - metres).max()
+
+
+def test_an_object_with_collision_physics_collides_unselected(addon, tmp_path):
+    """Colliders are chosen as Blender's cloth chooses them: a mesh with Collision physics
+    pushes the cloth without being selected."""
+    cloth, others = make_scene(tmp_path, "PC2")
+    ball, floor = others
+    for o in others:
+        o.select_set(False)
+    ball.modifiers.new("Collision", "COLLISION")
+    assert addon.colliders_of(bpy.context, cloth) == [ball]
+    ball.location = (0.1, -0.2, -0.15)
+    ball.keyframe_insert("location", frame=1)
+    ball.location = (0.1, -0.2, 0.35)
+    ball.keyframe_insert("location", frame=24)
+    assert bpy.ops.fraccloth.bake() == {"FINISHED"}
+    margin, radius = 0.01, 0.05
+    closest = np.inf
+    for frame in range(1, 25):
+        x = world(cloth, frame)
+        bpy.context.scene.frame_set(frame)
+        d = np.linalg.norm(x - np.array(ball.matrix_world.translation), axis=1)
+        assert d.min() >= radius - margin - 1e-4, f"frame {frame}"
+        closest = min(closest, d.min())
+    assert closest < radius + margin, closest
