@@ -211,6 +211,25 @@ for _name, (_res, _args) in _SIGNATURES.items():
     _fn.argtypes = _args
 
 
+def _typed(fn, name):
+    """`fn` with ctypes' conversion errors (`ctypes.ArgumentError`, which names neither the call
+    nor the value) raised as a `TypeError` that names the call."""
+
+    def call(*args):
+        try:
+            return fn(*args)
+        except ctypes.ArgumentError as e:
+            raise TypeError(f"fraccloth: {name} got an argument it cannot take ({e}): "
+                            "numbers where the documentation says a number, arrays where it says an array") from None
+
+    call.__name__ = name
+    return call
+
+
+for _name in _SIGNATURES:
+    setattr(library, _name, _typed(getattr(library, _name), _name))
+
+
 def _check_layout() -> None:
     """The description struct as this package lays it out against the loaded library: the
     library accepts its size (the struct_size rule) and fills the fields at both ends where

@@ -324,3 +324,13 @@ def test_a_description_prints_its_fields():
     text = repr(desc)
     assert text.startswith("FcClothDesc(") and "added_mass=10.0" in text and "gravity=(0.0, -9.81, 0.0)" in text
     assert str(desc) == text and text.count("=") == len(fraccloth.FcClothDesc._fields_)
+
+
+def test_a_wrong_argument_type_is_a_type_error_that_names_the_call():
+    """ctypes' own conversion error does not escape: a caller sees a TypeError naming the call."""
+    cloth = fraccloth.Cloth.grid()
+    for bad in (lambda: cloth.step("a frame"), lambda: cloth.step_substeps(1 / 30, "four")):
+        with pytest.raises(TypeError, match="fraccloth: fc_cloth_step") as info:
+            bad()
+        assert not isinstance(info.value, ctypes.ArgumentError)
+    cloth.step(1e-4)  # still usable
