@@ -1,8 +1,9 @@
 //! Steps the 61 x 41 throughput cloth in blocks of 1000 steps and prints the fastest block in
 //! ns per particle-step: the least noisy figure on a shared machine, for comparing two builds
 //! while optimising (the benchmark of record is `examples/throughput.rs`, which reports medians).
-//! `cargo run --release --example step_cycles -- [fractional|regular|memoryless|underwater] [blocks] [WxH] [shuffled]`
-//! (default 61x41; blocks of 1000 steps, fewer for big cloths; `shuffled` builds the grid as a
+//! `cargo run --release --example step_cycles -- [fractional|regular|memoryless|underwater|strain] [blocks] [WxH] [shuffled|jittered]`
+//! (default 61x41; blocks of 1000 steps, fewer for big cloths; `jittered` builds it as the
+//! scenes' irregular triangle mesh, the grid's vertices in its order with random diagonals; `shuffled` builds the grid as a
 //! quad mesh with its vertices in a scrambled order, so the force pass cannot walk it in tiles). `memoryless` is the fractional
 //! model with the history switched off (`Scheme::Off`): the same step without the fractional
 //! memory's work and bytes, to tell what the history costs at a size from what the rest does.
@@ -40,6 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         None => (61, 41),
     };
     let shuffled = args.get(4).is_some_and(|a| a == "shuffled");
+    let jittered = args.get(4).is_some_and(|a| a == "jittered");
     let steps_per_block = (2_500_000 / (w as u64 * h as u64)).clamp(1, 1000);
     // The same mass per particle at every size, so the same dt is stable.
     let total_mass = 0.24 * (w * h) as f64 / (61.0 * 41.0);
@@ -76,6 +78,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             mass: MeshMass::Total(total_mass),
         }
         .build()?
+    } else if jittered {
+        // The grid's vertices, in its order, moved and triangulated with random diagonals.
+        fraccloth_tools::scenes::jittered_mesh(&grid, w, total_mass / (0.01 * 0.01 * ((w - 1) * (h - 1)) as f64), 7)?
     } else {
         grid
     };
