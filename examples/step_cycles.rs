@@ -80,7 +80,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .build()?
     } else if jittered {
         // The grid's vertices, in its order, moved and triangulated with random diagonals.
-        fraccloth_tools::scenes::jittered_mesh(&grid, w, total_mass / (0.01 * 0.01 * ((w - 1) * (h - 1)) as f64), 7)?
+        fraccloth_tools::scenes::jittered_mesh(
+            &grid,
+            w,
+            total_mass / (0.01 * 0.01 * ((w - 1) * (h - 1)) as f64),
+            7,
+        )?
     } else {
         grid
     };

@@ -563,8 +563,6 @@ mod tests {
         let q_wide: Vec<Vec3> = (0..wide.vertex_count())
             .map(|_| Vec3::new(rnd(), rnd(), rnd()))
             .collect();
-        // Gaps of six springs in every family at four places: 40 runs, too many for the gather
-        // path, so the window-of-sums path runs.
         // The grid `t` with only the springs `keep` accepts.
         let keeping = |keep: &dyn Fn(&crate::topology::Spring) -> bool| {
             let springs = t.springs.iter().filter(|s| keep(s)).copied().collect();
@@ -576,14 +574,43 @@ mod tests {
                 t.grid,
             )
         };
+        // Gaps of six springs in every family at four places: padded, each family and offset
+        // one run again, gathered.
         let holes = keeping(&|s| !(1..=4).any(|k| (2000 * k..2000 * k + 6).contains(&s.i)));
-        // One gap in the horizontal stretch family only, inside a tile: 9 runs, gathered, with
-        // two runs of one family each covering part of a tile.
+        assert_eq!(holes.tile_runs.runs.len(), t.tile_runs.runs.len());
+        // One gap in the horizontal stretch family only, inside a tile: padded over, so a
+        // tile's run has padding slots in its middle.
         let gap = keeping(&|s| !(s.j == s.i + 1 && (3000..3006).contains(&s.i)));
-        assert_eq!(gap.tile_runs.runs.len(), t.tile_runs.runs.len() + 1);
+        assert_eq!(gap.tile_runs.runs.len(), t.tile_runs.runs.len());
+        assert!(gap.tile_runs.pads.len() >= 6);
+        // Six more offsets (bend springs reaching 3 to 8 columns along a row): 14 runs, too many
+        // for the gather path, so the window-of-sums path runs.
+        let mut more = t.springs.clone();
+        let w = t.grid.map_or(0, |g| g.0);
+        for k in 3..=8u32 {
+            for i in 0..n as u32 {
+                if i % w + k < w {
+                    let rest = (t.rest_positions[(i + k) as usize] - t.rest_positions[i as usize]).norm();
+                    more.push(crate::topology::Spring {
+                        i,
+                        j: i + k,
+                        rest,
+                        kind: crate::topology::SpringKind::Bend,
+                    });
+                }
+            }
+        }
+        let many = Topology::new(
+            t.rest_positions.clone(),
+            t.masses.clone(),
+            more,
+            t.triangles.clone(),
+            t.grid,
+        );
+        assert_eq!(many.tile_runs.runs.len(), t.tile_runs.runs.len() + 6);
         let gathered = |t: &Topology| t.tiled.is_some_and(|l| l.gather_runs > 0);
-        assert!(gathered(&gap));
-        assert!(holes.tiled.is_some() && !gathered(&holes));
+        assert!(gathered(&gap) && gathered(&holes));
+        assert!(many.tiled.is_some() && !gathered(&many));
         assert!(gathered(&t) && gathered(&varied) && gathered(&wide));
         for (topology, x, q) in [
             (&t, &x, &q),
@@ -592,6 +619,7 @@ mod tests {
             (&wide, &x_wide, &q_wide),
             (&holes, &x, &q),
             (&gap, &x, &q),
+            (&many, &x, &q),
         ] {
             let n = topology.vertex_count();
             let want = reference(&m, topology, x, q);

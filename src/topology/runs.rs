@@ -60,8 +60,15 @@ pub fn order_into_runs(springs: &mut [Spring]) -> Vec<SpringRun> {
     runs
 }
 
-/// Largest gap (missing springs) between two runs of one family that [`TileRuns`] pads over.
+/// Largest gap (missing springs) between two runs of one family and offset that [`TileRuns`]
+/// pads over when joining them all would pad too much (see [`MAX_PADDED`]).
 const MAX_GAP: u32 = 4;
+
+/// [`TileRuns`] joins every run of one family and offset into one, padding the gaps, when that
+/// leaves at most this many slots per spring: an irregular mesh (random diagonals) then walks in
+/// as few runs as a grid (`docs/benchmarks.md`: 2.3x the grid's cost per particle-step before,
+/// about 1.5x after), while a mesh whose runs lie far apart is not padded without bound.
+const MAX_PADDED: usize = 3;
 
 /// The runs again, with runs of the same family and offset that are separated by a few missing
 /// springs joined into one by padding slots (a grid's rows break every horizontal, shear and
@@ -89,15 +96,26 @@ pub struct TileRuns {
 }
 
 impl TileRuns {
-    /// Pads `runs` (from `order_into_runs` on `springs`) for `n` vertices.
+    /// Pads `runs` (from `order_into_runs` on `springs`) for `n` vertices: every run of a family
+    /// and offset joined into one when the padding stays within [`MAX_PADDED`] slots a spring,
+    /// else only over gaps of at most [`MAX_GAP`].
     pub fn new(n: usize, springs: &[Spring], runs: &[SpringRun]) -> Self {
+        let joined = Self::padded(n, springs, runs, u32::MAX);
+        if joined.rest.len() <= MAX_PADDED * springs.len().max(1) {
+            return joined;
+        }
+        Self::padded(n, springs, runs, MAX_GAP)
+    }
+
+    /// `runs` joined over gaps of at most `max_gap` missing springs.
+    fn padded(n: usize, springs: &[Spring], runs: &[SpringRun], max_gap: u32) -> Self {
         let mut t = Self::default();
         for r in runs {
             let kind = springs[r.first_spring as usize].kind as u8;
             let gap = t.runs.last().and_then(|last| {
                 let end = last.first_vertex + last.len;
                 let same = t.kinds[last.first_spring as usize] == kind && last.offset == r.offset;
-                (same && r.first_vertex >= end && r.first_vertex - end <= MAX_GAP)
+                (same && r.first_vertex >= end && r.first_vertex - end <= max_gap)
                     .then(|| r.first_vertex - end)
             });
             match (gap, t.runs.last_mut()) {
@@ -163,6 +181,32 @@ impl TileRuns {
 #[cfg(test)]
 mod tests {
     use crate::topology::{GridSpec, Topology};
+
+    /// Runs of one family and offset are joined into one when the padding stays bounded, and
+    /// only over short gaps when joining would pad more than `MAX_PADDED` slots a spring.
+    #[test]
+    fn runs_are_joined_when_the_padding_stays_bounded() {
+        let t = grid_7x5();
+        let keep = |keep: &dyn Fn(&crate::topology::Spring) -> bool| {
+            let springs: Vec<_> = t.springs.iter().filter(|s| keep(s)).copied().collect();
+            Topology::new(
+                t.rest_positions.clone(),
+                t.masses.clone(),
+                springs,
+                t.triangles.clone(),
+                t.grid,
+            )
+        };
+        // A gap of three rows in every family: joined (padding within bounds).
+        let gapped = keep(&|s| !(7..28).contains(&s.i));
+        assert_eq!(gapped.tile_runs.runs.len(), t.tile_runs.runs.len());
+        assert!(!gapped.tile_runs.pads.is_empty());
+        // Only the first and last stretch spring along x: joining would pad 27 slots for two
+        // springs, so they stay two runs.
+        let sparse = keep(&|s| s.j == s.i + 1 && (s.i == 0 || s.i == 32));
+        assert_eq!(sparse.tile_runs.runs.len(), 2);
+        assert!(sparse.tile_runs.pads.is_empty());
+    }
 
     fn grid_7x5() -> Topology {
         GridSpec {
