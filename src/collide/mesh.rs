@@ -403,6 +403,10 @@ impl MeshCollider {
         }
         // Mesh vertex against cloth triangle.
         for (t, cands) in self.cache.triangle.iter().enumerate() {
+            // Most cloth triangles have no mesh vertex near: nothing to read for them.
+            if cands.is_empty() {
+                continue;
+            }
             let tri = cloth_triangles[t];
             let [a, b, c] = tri.map(|i| x[i as usize]);
             let near = Aabb::of([&a, &b, &c]).inflated(margin);
