@@ -202,11 +202,29 @@ pub fn turning_forces(
     projected: &mut [f64],
     out: &mut [Vec3],
 ) {
-    let (areas, triangles, vertex_triangles) = (&t.areas, &t.triangles, &t.vertex_triangles);
     let ma = m.water.added_mass;
     if ma == 0.0 {
         return;
     }
+    // Four passes, faces and vertices in turn; each element is computed alone (by the
+    // functions below), so a large cloth spreads them over the pool with the same bits.
+    if crate::parallel::worth_it(x.len()) {
+        turning_parallel(ma, t, x, v, scratch, projected, out);
+    } else {
+        turning_serial(ma, t, x, v, scratch, projected, out);
+    }
+}
+
+fn turning_serial(
+    ma: f64,
+    t: &Topology,
+    x: &[Vec3],
+    v: &[Vec3],
+    scratch: &mut TurningScratch,
+    projected: &mut [f64],
+    out: &mut [Vec3],
+) {
+    let (areas, triangles, vertex_triangles) = (&t.areas, &t.triangles, &t.vertex_triangles);
     let TurningScratch {
         faces,
         rates,
@@ -215,49 +233,146 @@ pub fn turning_forces(
     } = scratch;
     faces.clear();
     rates.clear();
-    for t in triangles {
-        let [a, b, c] = t.map(|i| i as usize);
-        let (e1, e2) = (x[b] - x[a], x[c] - x[a]);
-        faces.push(e1.cross(&e2));
-        rates.push((v[b] - v[a]).cross(&e2) + e1.cross(&(v[c] - v[a])));
+    for tri in triangles {
+        let (f, r) = face_and_rate(x, v, tri);
+        faces.push(f);
+        rates.push(r);
     }
     patches.clear();
     for (i, o) in out.iter_mut().enumerate() {
-        let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
-        for &t in vertex_triangles.row(i) {
-            big_n += faces[t as usize];
-            big_ndot += rates[t as usize];
-        }
-        let scale = t.patch_scale[i];
-        let (a, adot) = (scale * big_n, scale * big_ndot);
-        projected[i] = a.norm();
         let k = ma * areas[i];
-        let av = a.dot(&v[i]);
-        *o -= k * (av * adot + adot.dot(&v[i]) * a);
-        // w_i, kept in `patches` (its area vector is no longer needed).
-        patches.push((k * av * scale) * v[i]);
+        let w = patch_turning(
+            faces,
+            rates,
+            vertex_triangles.row(i),
+            t.patch_scale[i],
+            k,
+            &v[i],
+            o,
+            &mut projected[i],
+        );
+        patches.push(w);
     }
     // W of every face and its gradients at its corners once, then each vertex gathers its
     // faces' (no scatter).
     gradients.clear();
-    gradients.extend(triangles.iter().map(|t| {
-        let w: Vec3 = t.iter().map(|&i| patches[i as usize]).sum();
-        let [a, b, c] = t.map(|i| i as usize);
-        let (e1, e2) = (x[b] - x[a], x[c] - x[a]);
-        [e2.cross(&w), w.cross(&e1)]
-    }));
+    gradients.extend(triangles.iter().map(|tri| face_gradients(x, patches, tri)));
     for (i, o) in out.iter_mut().enumerate() {
-        for &t in vertex_triangles.row(i) {
-            let [_, b, c] = triangles[t as usize];
-            let [gb, gc] = gradients[t as usize];
-            *o += if i == b as usize {
-                gb
-            } else if i == c as usize {
-                gc
-            } else {
-                -(gb + gc)
-            };
-        }
+        gather_gradients(triangles, gradients, vertex_triangles.row(i), i, o);
+    }
+}
+
+fn turning_parallel(
+    ma: f64,
+    t: &Topology,
+    x: &[Vec3],
+    v: &[Vec3],
+    scratch: &mut TurningScratch,
+    projected: &mut [f64],
+    out: &mut [Vec3],
+) {
+    use rayon::prelude::*;
+    let (areas, triangles, vertex_triangles) = (&t.areas, &t.triangles, &t.vertex_triangles);
+    let TurningScratch {
+        faces,
+        rates,
+        patches,
+        gradients,
+    } = scratch;
+    faces.resize(triangles.len(), Vec3::zeros());
+    rates.resize(triangles.len(), Vec3::zeros());
+    (faces.par_iter_mut(), rates.par_iter_mut(), triangles.par_iter())
+        .into_par_iter()
+        .for_each(|(f, r, tri)| (*f, *r) = face_and_rate(x, v, tri));
+    let (faces, rates) = (&*faces, &*rates);
+    patches.resize(x.len(), Vec3::zeros());
+    (
+        patches.par_iter_mut(),
+        out.par_iter_mut(),
+        projected.par_iter_mut(),
+    )
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(i, (w, o, p))| {
+            let k = ma * areas[i];
+            *w = patch_turning(
+                faces,
+                rates,
+                vertex_triangles.row(i),
+                t.patch_scale[i],
+                k,
+                &v[i],
+                o,
+                p,
+            );
+        });
+    let patches = &*patches;
+    gradients.resize(triangles.len(), [Vec3::zeros(); 2]);
+    (gradients.par_iter_mut(), triangles.par_iter())
+        .into_par_iter()
+        .for_each(|(g, tri)| *g = face_gradients(x, patches, tri));
+    let gradients = &*gradients;
+    out.par_iter_mut()
+        .enumerate()
+        .for_each(|(i, o)| gather_gradients(triangles, gradients, vertex_triangles.row(i), i, o));
+}
+
+/// A face's area vector `e1 x e2` and its rate of change.
+#[inline(always)]
+fn face_and_rate(x: &[Vec3], v: &[Vec3], t: &[u32; 3]) -> (Vec3, Vec3) {
+    let [a, b, c] = t.map(|i| i as usize);
+    let (e1, e2) = (x[b] - x[a], x[c] - x[a]);
+    (e1.cross(&e2), (v[b] - v[a]).cross(&e2) + e1.cross(&(v[c] - v[a])))
+}
+
+/// At one vertex (its faces `row`, `k = m_a A`): subtracts the force of the patch's turning from
+/// `o`, writes the projected-area ratio, and returns the vertex's `w`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn patch_turning(
+    faces: &[Vec3],
+    rates: &[Vec3],
+    row: &[u32],
+    scale: f64,
+    k: f64,
+    v: &Vec3,
+    o: &mut Vec3,
+    projected: &mut f64,
+) -> Vec3 {
+    let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
+    for &t in row {
+        big_n += faces[t as usize];
+        big_ndot += rates[t as usize];
+    }
+    let (a, adot) = (scale * big_n, scale * big_ndot);
+    *projected = a.norm();
+    let av = a.dot(v);
+    *o -= k * (av * adot + adot.dot(v) * a);
+    (k * av * scale) * v
+}
+
+/// The gradients of `W . c` at a face's corners b and c (`W` the sum of its corners' `w`).
+#[inline(always)]
+fn face_gradients(x: &[Vec3], w: &[Vec3], t: &[u32; 3]) -> [Vec3; 2] {
+    let sum: Vec3 = t.iter().map(|&i| w[i as usize]).sum();
+    let [a, b, c] = t.map(|i| i as usize);
+    let (e1, e2) = (x[b] - x[a], x[c] - x[a]);
+    [e2.cross(&sum), sum.cross(&e1)]
+}
+
+/// Adds to vertex `i`'s force the gradients of its faces (`row`) at it.
+#[inline(always)]
+fn gather_gradients(triangles: &[[u32; 3]], gradients: &[[Vec3; 2]], row: &[u32], i: usize, o: &mut Vec3) {
+    for &t in row {
+        let [_, b, c] = triangles[t as usize];
+        let [gb, gc] = gradients[t as usize];
+        *o += if i == b as usize {
+            gb
+        } else if i == c as usize {
+            gc
+        } else {
+            -(gb + gc)
+        };
     }
 }
 
