@@ -97,8 +97,8 @@ pub struct TileRuns {
 
 impl TileRuns {
     /// Pads `runs` (from `order_into_runs` on `springs`) for `n` vertices: every run of a family
-    /// and offset joined into one when the padding stays within [`MAX_PADDED`] slots a spring,
-    /// else only over gaps of at most [`MAX_GAP`].
+    /// and offset joined into one when the padding stays within `MAX_PADDED` slots a spring,
+    /// else only over gaps of at most `MAX_GAP`.
     pub fn new(n: usize, springs: &[Spring], runs: &[SpringRun]) -> Self {
         let joined = Self::padded(n, springs, runs, u32::MAX);
         if joined.rest.len() <= MAX_PADDED * springs.len().max(1) {
