@@ -28,10 +28,10 @@
 //! the estimate allows; a frame whose substep is refused is rolled back to its start (the call
 //! is atomic) and retried with twice the substeps, at most [`MAX_RETRIES`] times.
 
-use crate::forces::Inertia;
+use crate::forces::{damping_rate, DampingRate, Inertia};
 use crate::integrate::Integrator;
 use crate::math::Vec3;
-use crate::model::{Model, SpringDamping};
+use crate::model::Model;
 
 use super::Cloth;
 
@@ -92,10 +92,10 @@ fn explicit_bound(m: &Model) -> f64 {
         if k <= 0.0 || c <= 0.0 {
             continue;
         }
-        let b = match m.spring_damping_mode {
-            SpringDamping::Velocity => c / k,
-            SpringDamping::Fractional | SpringDamping::FractionalStrain => (c / (GAMMA_3_2 * k)).powi(2),
-            SpringDamping::None => f64::INFINITY,
+        let b = match damping_rate(m) {
+            DampingRate::Velocity => c / k,
+            DampingRate::HalfDerivative => (c / (GAMMA_3_2 * k)).powi(2),
+            DampingRate::None => f64::INFINITY,
         };
         bound = bound.min(b);
     }
@@ -160,12 +160,7 @@ impl Cloth {
     /// Whether the springs or drags damp on D^{1/2} (their damping depends on the step).
     fn fractional_damping(&self) -> bool {
         let m = &self.config.model;
-        matches!(
-            m.spring_damping_mode,
-            SpringDamping::Fractional | SpringDamping::FractionalStrain
-        ) && m.spring_damping > 0.0
-            || m.history_drag > 0.0
-            || m.water.history_drag > 0.0
+        damping_rate(m) == DampingRate::HalfDerivative || m.history_drag > 0.0 || m.water.history_drag > 0.0
     }
 
     /// The smallest bound over the particles and pins (module docs); `h` the step at which the
@@ -186,6 +181,7 @@ impl Cloth {
         };
         let oscillator = if explicit { 0.5 } else { 1.0 };
         let (ma, rho_w, cd) = (m.water.added_mass, m.water_density, m.water.form_drag);
+        let rate = damping_rate(m);
         for i in 0..self.x.len() {
             if self.pinned[i] {
                 continue;
@@ -196,12 +192,10 @@ impl Cloth {
             for &e in t.vertex_springs.row(i) {
                 let s = &t.springs[(e / 2) as usize];
                 k += m.stiffness(s.kind);
-                c += match m.spring_damping_mode {
-                    SpringDamping::Velocity => m.spring_damping_of(s.kind),
-                    SpringDamping::Fractional | SpringDamping::FractionalStrain => {
-                        w0 * m.spring_damping_of(s.kind)
-                    }
-                    SpringDamping::None => 0.0,
+                c += match rate {
+                    DampingRate::Velocity => m.spring_damping_of(s.kind),
+                    DampingRate::HalfDerivative => w0 * m.spring_damping_of(s.kind),
+                    DampingRate::None => 0.0,
                 };
                 shortest = shortest.min(s.rest);
             }
@@ -277,7 +271,7 @@ mod tests {
         let mut m = Model::regular(crate::model::RegularDrag::Normal);
         m.spring_damping = 0.0;
         assert_eq!(explicit_bound(&m), f64::INFINITY);
-        m.spring_damping_mode = SpringDamping::None;
+        m.spring_damping_mode = crate::model::SpringDamping::None;
         assert_eq!(explicit_bound(&m), f64::INFINITY);
     }
 

@@ -138,6 +138,31 @@ pub fn spring_damping(m: &Model, w: &Weights) -> f64 {
     PAIR_ELEMENTS.iter().map(|e| (e.damping)(m, w)).sum()
 }
 
+/// What model `m`'s springs damp: nothing, their ends' velocities, or a half-derivative (its
+/// current-rate weight `w0` then scales the damping: what the automatic step's bound reads).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DampingRate {
+    None,
+    Velocity,
+    HalfDerivative,
+}
+
+/// How `m`'s springs are damped, from the elements that damp them: an element with a memory
+/// damps on a half-derivative.
+pub fn damping_rate(m: &Model) -> DampingRate {
+    let unit = Weights([1.0; 2]);
+    PAIR_ELEMENTS
+        .iter()
+        .find(|e| (e.on)(m) && (e.damping)(m, &unit) > 0.0)
+        .map_or(DampingRate::None, |e| {
+            if (e.memory)(m).is_some() {
+                DampingRate::HalfDerivative
+            } else {
+                DampingRate::Velocity
+            }
+        })
+}
+
 /// Whether any element of model `m` remembers `memory`.
 pub fn remembers(m: &Model, memory: Memory) -> bool {
     PAIR_ELEMENTS
@@ -213,6 +238,24 @@ mod tests {
                 .collect();
             assert!(damping.len() <= 1, "{mode:?}: {damping:?}");
         }
+    }
+
+    #[test]
+    fn the_damping_rate_is_the_damping_elements() {
+        let mut m = Model::regular(RegularDrag::Normal);
+        m.spring_damping = 1.0;
+        for (mode, want) in [
+            (SpringDamping::None, DampingRate::None),
+            (SpringDamping::Velocity, DampingRate::Velocity),
+            (SpringDamping::Fractional, DampingRate::HalfDerivative),
+            (SpringDamping::FractionalStrain, DampingRate::HalfDerivative),
+        ] {
+            m.spring_damping_mode = mode;
+            assert_eq!(damping_rate(&m), want, "{mode:?}");
+        }
+        m.spring_damping = 0.0;
+        m.spring_damping_mode = SpringDamping::Velocity;
+        assert_eq!(damping_rate(&m), DampingRate::None);
     }
 
     #[test]

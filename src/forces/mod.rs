@@ -36,7 +36,7 @@ mod tiles;
 // and the forces of a state (`total_forces` on a `ForceInput`).
 pub use body::{body_acceleration, body_force};
 pub use contact::{Capsule, Collider, Plane, Sphere};
-pub use elements::{Memory, Weights};
+pub use elements::{damping_rate, DampingRate, Memory, Weights};
 pub use inertia::Inertia;
 pub use memories::{memories, Memories};
 pub use normals::vertex_normals;
