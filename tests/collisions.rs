@@ -24,11 +24,16 @@ fn worst_intersections(cloth: &mut Cloth, frames: usize, mut each: impl FnMut(&m
     worst
 }
 
+/// The 21 x 31 towel of 2 cm held wavy above the floor, with self-collision at `thickness`.
+fn wavy_towel(thickness: f64, integrator: Integrator) -> fraccloth::Cloth {
+    collision_towel(21, 31, 0.02, 0.62, TowelPose::Wavy, thickness, integrator).unwrap()
+}
+
 /// The drop: a 21 x 31 towel of 2 cm spacing hanging with a wave from 0.62 m falls onto a floor
 /// and piles up in folds over 5 s. Returns the most crossing triangle pairs at any frame, the
 /// pile's top at the end and the self-collision pairs in reach then.
 fn drop(thickness: f64, integrator: Integrator) -> (usize, f64, usize) {
-    let mut cloth = collision_towel(21, 31, 0.02, 0.62, TowelPose::Wavy, thickness, integrator).unwrap();
+    let mut cloth = wavy_towel(thickness, integrator);
     let floor = Plane {
         point: Vec3::zeros(),
         normal: Vec3::y(),
@@ -231,18 +236,7 @@ fn a_snapshot_resumes_a_bake_with_collisions_bitwise() {
             .collect::<Vec<_>>(),
         floor.1,
     );
-    let make = || {
-        collision_towel(
-            21,
-            31,
-            0.02,
-            0.62,
-            TowelPose::Wavy,
-            0.005,
-            Integrator::SymplecticEuler,
-        )
-        .unwrap()
-    };
+    let make = || wavy_towel(0.005, Integrator::SymplecticEuler);
     let pose = |f: usize| -> Vec<Vec3> {
         tx.iter()
             .map(|p| p + Vec3::new(0.001 * f as f64, 0.0, 0.0))
@@ -322,16 +316,7 @@ fn the_brisk_swing_with_self_collision_does_not_cross_itself() {
 /// remembered pairs and sides included (the snapshot bytes are the same).
 #[test]
 fn a_refused_step_leaves_the_collision_state_as_it_was() {
-    let mut cloth = collision_towel(
-        21,
-        31,
-        0.02,
-        0.62,
-        TowelPose::Wavy,
-        0.005,
-        Integrator::SymplecticEuler,
-    )
-    .unwrap();
+    let mut cloth = wavy_towel(0.005, Integrator::SymplecticEuler);
     let floor = Plane {
         point: Vec3::zeros(),
         normal: Vec3::y(),
