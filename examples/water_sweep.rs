@@ -7,7 +7,7 @@
 //! Keys (defaults in brackets): `freq=0.25,0.5,1,2` (Hz), `amp=0.04` (m), `size=61x41`,
 //! `current=X,Y,Z` (m/s; with `amp=0`, how far the tip leans and flutters), `integrator=symplectic|implicit|explicit|symplectic2|implicit2` [symplectic], `dt` [2 ms
 //! explicit, 1/30 s implicit], `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
-//! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag),
+//! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag), `scale=` (its smoothing length, m),
 //! `skin=` (N s/m^3), `damping=` (spring damping), `mode=velocity|fractional|strain|none` (what the
 //! springs damp), `history=` (history drag per area, N s^1/2/m^3; the SOE history is kept).
 
@@ -40,6 +40,7 @@ fn main() {
     w_.added_mass = num("added", w_.added_mass);
     w_.entrained_mass = num("entrained", w_.entrained_mass);
     w_.form_drag = num("cd", w_.form_drag);
+    w_.form_drag_scale = num("scale", w_.form_drag_scale);
     w_.skin_drag = num("skin", w_.skin_drag);
     model.spring_damping = num("damping", model.spring_damping);
     model.water.history_drag = num("history", model.water.history_drag);
@@ -55,11 +56,12 @@ fn main() {
     let seconds = num("seconds", 12.0);
     let fps = 30.0;
     println!(
-        "# {w}x{h} {} added {} entrained {} C_d {} skin {} damping {}",
+        "# {w}x{h} {} added {} entrained {} C_d {} over {} m, skin {} damping {}",
         integrator.key(),
         model.water.added_mass,
         model.water.entrained_mass,
         model.water.form_drag,
+        model.water.form_drag_scale,
         model.water.skin_drag,
         model.spring_damping
     );

@@ -15,7 +15,7 @@
 #include <stdint.h>
 
 #define FC_VERSION_MAJOR 0
-#define FC_VERSION_MINOR 7
+#define FC_VERSION_MINOR 8
 #define FC_VERSION_PATCH 0
 /* Equals fc_version() of the library this header belongs to. */
 #define FC_VERSION (FC_VERSION_MAJOR * 1000000 + FC_VERSION_MINOR * 1000 + FC_VERSION_PATCH)
@@ -404,6 +404,13 @@ typedef struct {
    * Coulomb friction coefficient of the cloth against itself (>= 0). Default 0.
    */
   double self_collision_friction;
+  /**
+   * Length over which the form drag smooths the normal velocity before it acts, m (>= 0;
+   * 0 = each particle's own). Ripples much shorter than it shed little drag, so a brisk
+   * swing keeps its short bumps while the sheet's motion at large is damped in full.
+   * Default 0 (`FC_PRESET_UNDERWATER`: see docs/underwater.md).
+   */
+  double form_drag_scale;
 } FcClothDesc;
 
 #ifdef __cplusplus

@@ -95,6 +95,11 @@ pub struct Water {
     /// Form-drag coefficient C_d (dimensionless) of the velocity normal to the cloth relative
     /// to the water: `-1/2 rho_w C_d area |v_n| v_n n`.
     pub form_drag: f64,
+    /// Length over which the form drag smooths the normal velocity before it acts, m (0: the
+    /// drag of each particle's own normal velocity). Ripples much shorter than this carry the
+    /// water beside them along and shed little; the sheet's motion at large meets the full
+    /// drag (`forces/wide_drag.rs`). The rms radius of the smoothing, the same on any mesh.
+    pub form_drag_scale: f64,
     /// Skin (tangential) drag on the velocity along the cloth relative to the water, N s/m^3:
     /// `-skin_drag area (v_rel - (v_rel . n) n)`.
     pub skin_drag: f64,
@@ -165,6 +170,7 @@ impl Model {
         check_non_negative("added_mass_coefficient", w.added_mass_coefficient)?;
         check_non_negative("entrained_mass", w.entrained_mass)?;
         check_non_negative("form_drag", w.form_drag)?;
+        check_non_negative("form_drag_scale", w.form_drag_scale)?;
         check_non_negative("skin_drag", w.skin_drag)?;
         check_non_negative("viscous_drag_per_area", w.viscous_drag)?;
         check_non_negative("history_drag_per_area", w.history_drag)?;
@@ -228,14 +234,16 @@ impl Model {
     /// - normal added mass [`UNDERWATER_ADDED_MASS`] (the water a face carries when it moves
     ///   face first; none along the cloth), with the turning forces that keep its energy
     ///   (`forces/inertia.rs`);
-    /// - form drag on the normal velocity, C_d = [`UNDERWATER_FORM_DRAG`];
+    /// - form drag on the normal velocity, C_d = [`UNDERWATER_FORM_DRAG`], smoothed over
+    ///   [`UNDERWATER_FORM_DRAG_SCALE`] (short ripples shed little; the sheet at large meets
+    ///   the full drag);
     /// - skin drag on the tangential velocity, [`UNDERWATER_SKIN_DRAG`] (laminar skin friction
     ///   on both faces, linearised at 0.3 m/s on a 0.4 m cloth): a current along the cloth
     ///   drags it, and motion in its plane dies out.
     ///
-    /// Swung 4 cm at 0.25 to 2 Hz the towel hangs at least 0.9 of its length and shows bumps
-    /// travelling down (about 4 half-waves at 0.5 Hz, 0.15 m/s), the same within 7 % from 2 cm
-    /// to 0.5 cm spacing.
+    /// Swung 4 cm at 0.25 to 2 Hz the towel hangs (0.89 of its length at 2 Hz) and shows bumps
+    /// travelling down, more and shorter the brisker the swing (about 3.5 half-waves at
+    /// 0.5 Hz, 0.16 m/s; 6 at 2 Hz), the same within 14 % from 2 cm to 0.5 cm spacing.
     pub fn underwater() -> Self {
         Self {
             spring_damping: UNDERWATER_SPRING_DAMPING,
@@ -246,6 +254,7 @@ impl Model {
             water: Water {
                 added_mass: UNDERWATER_ADDED_MASS,
                 form_drag: UNDERWATER_FORM_DRAG,
+                form_drag_scale: UNDERWATER_FORM_DRAG_SCALE,
                 skin_drag: UNDERWATER_SKIN_DRAG,
                 ..Water::default()
             },
@@ -257,13 +266,18 @@ impl Model {
 /// Normal added mass of the underwater preset, kg/m^2. Potential flow gives
 /// `rho_w lambda / pi` for a sheet rippled at wavelength lambda (about 80 kg/m^2 for the
 /// 0.25 m bumps the preset shows at 0.5 Hz) and up to `rho_w pi W / 4` for a whole sheet of
-/// width W moving rigidly. The preset carries far less: the most that keeps a towel swung 4 cm
-/// at 2 Hz hanging at 0.9 of its length (15 kg/m^2 hangs 0.885; more gives more and deeper
-/// bumps and a shorter hang), which is also what gives the look it was tuned for at 0.5 Hz
-/// (`docs/underwater.md`).
-pub const UNDERWATER_ADDED_MASS: f64 = 10.0;
+/// width W moving rigidly. The preset carries far less: more gives more and deeper bumps and
+/// a shorter hang, and 8 keeps a towel swung 4 cm at 2 Hz hanging at 0.89 of its length
+/// with 6 half-waves (10 with the drag smoothed over 1 cm hangs 0.352 m; `docs/underwater.md`).
+pub const UNDERWATER_ADDED_MASS: f64 = 8.0;
 /// Form-drag coefficient of the underwater preset (a flat plate face on: 1-2).
 pub const UNDERWATER_FORM_DRAG: f64 = 1.0;
+/// Length over which the underwater preset's form drag smooths the normal velocity, m
+/// ([`Water::form_drag_scale`]). Fitted, of the order of the ripples' amplitude: ripples a
+/// few centimetres long shed little, so bumps keep growing in number with the drive's
+/// frequency (without it the visible half-waves fell from 4.6 at 1 Hz to 3.8 at 2 Hz: a
+/// quadratic drag takes the same share of a wave's energy each cycle at any frequency).
+pub const UNDERWATER_FORM_DRAG_SCALE: f64 = 0.012;
 /// Skin drag of the underwater preset, N s/m^3: laminar skin friction on both faces,
 /// `2 * 0.664 rho_w sqrt(nu / L) U^1.5` (`C_f = 1.328 / sqrt(Re)` per face, water
 /// `nu = 1e-6 m^2/s`), is 0.345 N/m^2 at U = 0.3 m/s over L = 0.4 m; over U, 1.15 N s/m^3.

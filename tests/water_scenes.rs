@@ -57,8 +57,14 @@ fn the_towel_hangs_and_its_bumps_shorten_from_a_quarter_to_two_hertz() {
             d.mid_ratio,
             d.hang_depth
         );
-        // Nothing rolls up under the pins: the towel hangs.
-        assert!(d.hang_depth >= 0.9 * rest_length, "{f} Hz: hang {}", d.hang_depth);
+        // Nothing rolls up under the pins: the towel hangs (at 2 Hz its six half-waves of
+        // ripple shorten it to 0.89 of its length: docs/underwater.md).
+        let hang = if f < 2.0 { 0.9 } else { 0.88 };
+        assert!(
+            d.hang_depth >= hang * rest_length,
+            "{f} Hz: hang {}",
+            d.hang_depth
+        );
         assert!(
             d.zigzag.is_some_and(|z| z <= 3.0),
             "{f} Hz: zigzag {:?}",
@@ -66,8 +72,8 @@ fn the_towel_hangs_and_its_bumps_shorten_from_a_quarter_to_two_hertz() {
         );
         rows.push((f, d.half_waves, c / f, d));
     }
-    // The bumps shorten at every step up in frequency; up to 1 Hz there are more of them
-    // (at 2 Hz the drag stops the motion in the top third, so fewer are visible).
+    // The bumps shorten and grow in number at every step up in frequency (the form drag
+    // smoothed over 1.2 cm lets short ripples through: without it 2 Hz showed fewer than 1 Hz).
     for w in rows.windows(2) {
         assert!(
             w[1].2 < w[0].2,
@@ -79,7 +85,7 @@ fn the_towel_hangs_and_its_bumps_shorten_from_a_quarter_to_two_hertz() {
         );
     }
     assert!(
-        rows[0].1 < rows[1].1 && rows[1].1 < rows[2].1,
+        rows.windows(2).all(|w| w[0].1 < w[1].1),
         "half-waves {:?}",
         rows.iter().map(|r| r.1).collect::<Vec<_>>()
     );

@@ -107,6 +107,8 @@ pub(super) struct StepScratch {
     /// The collision pass's contact elements (mesh colliders, self-collision).
     pub contacts: Vec<crate::collide::Contact>,
     pub turning: forces::TurningScratch,
+    /// The wide form drag's buffers and rest weights.
+    pub wide_drag: forces::WideDragScratch,
     /// Each patch's projected-area ratio ([`forces::patch_normals`]), with normal added mass
     /// only (else empty).
     pub projected: Vec<f64>,
@@ -172,6 +174,7 @@ impl Cloth {
         let mut weights = self.step_velocities(&plan);
         self.element_forces(&mut weights);
         self.water_turning();
+        self.wide_form_drag();
         self.collisions(plan.fraction);
         let integrated_sound = match Route::of(self.config.integrator) {
             Route::ExplicitTiles(step) => self.forces_and_explicit_step(h, weights, step),
@@ -357,6 +360,21 @@ impl Cloth {
             &mut s.projected,
             &mut s.prior_forces,
         );
+    }
+
+    /// Form drag on the smoothed normal velocity ([`forces::add_wide_form_drag`]), added to
+    /// the forces before the pass; nothing unless the model gives it a length.
+    fn wide_form_drag(&mut self) {
+        let m = &self.config.model;
+        if !forces::wide_drag(m) {
+            return;
+        }
+        let (s, t) = (&mut self.scratch, &self.topology);
+        if s.prior_forces.is_empty() {
+            s.prior_forces.resize(self.x.len(), Vec3::zeros());
+        }
+        let normals = s.force_pass.normals_ahead(&self.x, t);
+        forces::add_wide_form_drag(m, t, normals, &s.v_rel, &mut s.wide_drag, &mut s.prior_forces);
     }
 
     /// The force pass with an explicit integrator stepping each tile in cache; returns whether

@@ -209,6 +209,11 @@ pub struct FcClothDesc {
     pub self_collision_thickness: f64,
     /// Coulomb friction coefficient of the cloth against itself (>= 0). Default 0.
     pub self_collision_friction: f64,
+    /// Length over which the form drag smooths the normal velocity before it acts, m (>= 0;
+    /// 0 = each particle's own). Ripples much shorter than it shed little drag, so a brisk
+    /// swing keeps its short bumps while the sheet's motion at large is damped in full.
+    /// Default 0 (`FC_PRESET_UNDERWATER`: see docs/underwater.md).
+    pub form_drag_scale: f64,
 }
 
 /// Each ABI enumeration value beside the library's, once: [`FcClothDesc::config`] reads
@@ -349,6 +354,7 @@ impl FcClothDesc {
             shear_damping_scale: model.spring_damping_scale[1],
             bend_damping_scale: model.spring_damping_scale[2],
             added_mass_coefficient: model.water.added_mass_coefficient,
+            form_drag_scale: model.water.form_drag_scale,
         }
     }
 
@@ -435,6 +441,7 @@ impl FcClothDesc {
                     added_mass_coefficient: self.added_mass_coefficient,
                     entrained_mass: self.entrained_mass,
                     form_drag: self.form_drag,
+                    form_drag_scale: self.form_drag_scale,
                     skin_drag: self.skin_drag,
                     viscous_drag: self.viscous_drag_per_area,
                     history_drag: self.history_drag_per_area,

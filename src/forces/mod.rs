@@ -31,6 +31,7 @@ mod springs;
 mod strain;
 pub(crate) mod terms;
 mod tiles;
+mod wide_drag;
 
 // The public face: the colliders, a particle's inertia and weight, what a model remembers,
 // and the forces of a state (`total_forces` on a `ForceInput`).
@@ -42,6 +43,7 @@ pub use memories::{memories, Memories};
 pub use normals::vertex_normals;
 pub use pass::{total_forces, ForceInput, ForceScratch};
 pub use springs::{spring_rate, SpringRate};
+pub use wide_drag::{add_wide_form_drag, wide as wide_drag, WideDragScratch};
 
 // The step's machinery, for the crate only.
 pub(crate) use assemble::add_spring_values;

@@ -45,6 +45,9 @@ pub struct ForceInput<'a> {
 #[derive(Clone, Debug, Default)]
 pub struct ForceScratch {
     normals: Vec<Vec3>,
+    /// Whether `normals` are already those of the coming pass's positions
+    /// ([`ForceScratch::normals_ahead`]); the pass consumes the flag.
+    normals_ready: bool,
     faces: Vec<Vec3>,
     springs: Soa3,
     spring_inputs: springs::SpringScratch,
@@ -64,6 +67,14 @@ impl ForceScratch {
 
     /// Vertex normals of the last pass (empty when no term read them).
     pub(crate) fn normals(&self) -> &[Vec3] {
+        &self.normals
+    }
+
+    /// The vertex normals at `x`, computed now for a whole-cloth pass before the force pass,
+    /// which then reads them instead of computing them again (once a step).
+    pub(crate) fn normals_ahead(&mut self, x: &[Vec3], topology: &crate::topology::Topology) -> &[Vec3] {
+        compute_normals(x, topology, self);
+        self.normals_ready = true;
         &self.normals
     }
 }
@@ -122,9 +133,10 @@ where
 {
     let m = input.model;
     let reads = terms::reads(m, !input.colliders.is_empty());
-    if reads.normals {
-        update_normals(input, scratch);
+    if reads.normals && !std::mem::take(&mut scratch.normals_ready) {
+        compute_normals(input.x, input.topology, scratch);
     }
+    scratch.normals_ready = false;
     let normals = reads.normals.then_some(&scratch.normals[..]);
     let context = Context {
         model: m,
@@ -180,13 +192,13 @@ where
     spring_sums(input, spring_inputs, springs, windows, inputs, sources, finish);
 }
 
-/// Computes the vertex normals into `scratch`.
-fn update_normals(input: &ForceInput<'_>, scratch: &mut ForceScratch) {
-    let (t, n) = (input.topology, input.x.len());
+/// Computes the vertex normals at `x` into `scratch`.
+fn compute_normals(x: &[Vec3], t: &crate::topology::Topology, scratch: &mut ForceScratch) {
+    let n = x.len();
     scratch.normals.resize(n, Vec3::zeros());
     scratch.faces.resize(t.triangles.len(), Vec3::zeros());
     normals::vertex_normals_with(
-        input.x,
+        x,
         &t.triangles,
         &t.vertex_triangles,
         parallel::worth_it(n),

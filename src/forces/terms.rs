@@ -205,6 +205,11 @@ const FORM_DRAG: Term = Term {
     on: |m, _| m.water.form_drag != 0.0,
     reads: Reads::NORMALS,
     add: |c, t, f| {
+        // With a length the drag is the whole-cloth pass's (`wide_drag.rs`); this block of the
+        // Jacobian stays, the local drag's, an upper bound of the smoothed one's.
+        if super::wide_drag::wide(c.model) {
+            return;
+        }
         if let Some(n) = t.normals {
             drag::add_form(c.model, t.v, n, t.areas, f);
         }

@@ -49,6 +49,7 @@ DESC_FIELDS = [
     ('added_mass_coefficient', ctypes.c_double, "Added mass for normal motion as a coefficient C_a (dimensionless, >= 0): adds `C_a * water_density * W` kg/m^2 to `added_mass`, W the cloth's width (the smaller extent of its rest shape in its own plane). pi/4 is a rigid plate's added mass for face-first motion (potential flow); `lambda / (pi W)` that of ripples of wavelength lambda. Default 0."),
     ('self_collision_thickness', ctypes.c_double, 'Self-collision: the distance the cloth keeps from itself, m (0 = off, the default). Points nearer than 2.2 times this at rest (neighbours) are not tested: a few millimetres for a cloth of 1-2 cm spacing. No vertex moves more than half of it in one substep (a faster one is slowed to that). See docs/collisions.md.'),
     ('self_collision_friction', ctypes.c_double, 'Coulomb friction coefficient of the cloth against itself (>= 0). Default 0.'),
+    ('form_drag_scale', ctypes.c_double, "Length over which the form drag smooths the normal velocity before it acts, m (>= 0; 0 = each particle's own). Ripples much shorter than it shed little drag, so a brisk swing keeps its short bumps while the sheet's motion at large is damped in full. Default 0 (`FC_PRESET_UNDERWATER`: see docs/underwater.md)."),
 ]
 
 # Every FC_* enum value of the header.
