@@ -10,7 +10,8 @@ Physics > fraccloth panel (Properties editor, Physics tab). "Bake underwater clo
   object (one dimension near zero) is an infinite plane through its origin along its local Z
   axis, a long one (longest dimension over twice the next) a capsule along that axis, any other
   a sphere of half its largest dimension around its origin (objects that are not meshes are
-  always fitted). "Collider friction" applies to them all;
+  always fitted). "Collider friction" applies to them all, except a collider whose own panel
+  says "As a collider: Own friction" (its friction then);
 - "Self-collision" (a thickness in m, 0 = off) keeps the cloth from passing through itself;
 - the scene's frame range is baked at the scene's frame rate, each frame split into steps of
   "Time step"; the result is written to a PC2 (or MDD) point cache by the fraccloth library and
@@ -189,7 +190,9 @@ class FracclothSettings(bpy.types.PropertyGroup):
     integrator: bpy.props.EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="SYMPLECTIC", update=_edited)
     auto_step: bpy.props.BoolProperty(name="Automatic time step", description="The library splits each frame into as few steps as the cloth needs (from its springs, weight, water, colliders and pins) and retries a frame that fails with more", default=True)
     time_step: bpy.props.FloatProperty(name="Time step", description="Longest step when not automatic, s", default=5e-4, min=1e-6, max=0.1, precision=5)
-    friction: bpy.props.FloatProperty(name="Collider friction", description="How much the colliders grip the cloth (0 = slippery, 1 = grippy)", default=0.0, min=0.0, soft_max=1.0)
+    friction: bpy.props.FloatProperty(name="Collider friction", description="How much the colliders grip the cloth (0 = slippery, 1 = grippy); a collider with its own friction (its panel's \"As a collider\") uses that", default=0.0, min=0.0, soft_max=1.0)
+    collider_own_friction: bpy.props.BoolProperty(name="Own friction", description="When this object is a collider of a fraccloth cloth, it grips the cloth with its own friction below instead of the cloth's Collider friction", default=False)
+    collider_friction: bpy.props.FloatProperty(name="Friction", description="How much this object grips a fraccloth cloth that collides with it (0 = slippery, 1 = grippy)", default=0.5, min=0.0, soft_max=1.0)
     collision_margin: bpy.props.FloatProperty(name="Collision margin", description="Distance from a collider at which the cloth is pushed away, m", default=0.01, min=0.0, soft_max=0.05)
     collider_shape: bpy.props.EnumProperty(name="Collider shape", items=COLLIDER_ITEMS, default="MESH",
                                            description="How collider objects are seen: their own mesh every frame, or a fitted sphere, capsule or plane (faster)")
@@ -272,16 +275,30 @@ def _mesh_spec(o):
     return ("mesh", co, tris)
 
 
+def collider_objects(s, others):
+    """The objects of `others` that become colliders under the settings `s`, in the order of
+    `collider_specs_for`'s specs: meshes (with faces, for "Collider shape" Mesh)."""
+    if s.collider_shape != "MESH":
+        return [o for o in others if o.type == "MESH"]
+    return [o for o in others if o.type == "MESH" and len(o.data.polygons) > 0]
+
+
+def collider_friction_of(s, o):
+    """The friction collider `o` grips the cloth of settings `s` with: its own ("As a collider:
+    Own friction") or the cloth's "Collider friction"."""
+    own = getattr(o, "fraccloth", None)
+    if own is not None and own.collider_own_friction:
+        return own.collider_friction
+    return s.friction
+
+
 def collider_specs_for(s, others):
     """The colliders at the current frame as the settings `s` see them: each mesh object as its
-    evaluated mesh ("Collider shape" Mesh), or fitted shapes (`_world_specs`)."""
+    evaluated mesh ("Collider shape" Mesh), or fitted shapes (`_world_specs`), one per object of
+    `collider_objects`."""
     if s.collider_shape != "MESH":
         return _world_specs(others)
-    specs = []
-    for o in others:
-        if o.type == "MESH" and len(o.data.polygons) > 0:
-            specs.append(_mesh_spec(o))
-    return specs
+    return [_mesh_spec(o) for o in collider_objects(s, others)]
 
 
 def _world_specs(others):
@@ -446,7 +463,7 @@ def build_cloth(context, obj, others):
     if w.any():
         cloth.set_pin_weights(w)
     ids = []
-    for spec in collider_specs_for(s, others):
+    for o, spec in zip(collider_objects(s, others), collider_specs_for(s, others)):
         spec = _in_metres(spec, u)
         if spec[0] == "mesh":
             cid = cloth.add_mesh_collider(spec[1].astype(np.float32), spec[2])
@@ -456,7 +473,7 @@ def build_cloth(context, obj, others):
             cid = cloth.add_capsule(spec[1], spec[2], spec[3])
         else:
             cid = cloth.add_sphere(spec[1], spec[2])
-        cloth.set_collider_friction(cid, s.friction)
+        cloth.set_collider_friction(cid, collider_friction_of(s, o))
         ids.append(cid)
     fps = context.scene.render.fps / context.scene.render.fps_base
     frame_dt = 1.0 / fps
@@ -765,6 +782,12 @@ class FRACCLOTH_PT_panel(bpy.types.Panel):
                     row.enabled = not s.use_scene_range
             if title == "Colliders":
                 box.label(text="Colliders: mesh objects with Collision physics, and meshes selected with the cloth")
+        box = layout.box()
+        box.label(text="As a collider of another fraccloth cloth")
+        box.prop(s, "collider_own_friction")
+        row = box.row()
+        row.prop(s, "collider_friction")
+        row.enabled = s.collider_own_friction
         row = layout.row()
         row.operator(FRACCLOTH_OT_bake.bl_idname)
         row.operator(FRACCLOTH_OT_free_bake.bl_idname)

@@ -479,3 +479,33 @@ def test_an_object_with_collision_physics_collides_unselected(addon, tmp_path):
     ball.modifiers.new("Collision", "COLLISION")
     assert addon.colliders_of(bpy.context, cloth) == [ball]
     rising_ball_pushes(cloth, ball)
+
+
+def test_a_collider_with_its_own_friction_grips_with_it(addon, tmp_path, monkeypatch):
+    """Per-object collision settings: a collider's own friction ("As a collider: Own friction")
+    replaces the cloth's Collider friction for that collider only."""
+    import fraccloth
+
+    cloth, others = make_scene(tmp_path, "PC2")
+    ball, floor = others
+    s = cloth.fraccloth
+    s.friction = 0.1
+    ball.fraccloth.collider_own_friction = True
+    ball.fraccloth.collider_friction = 0.7
+    assert addon.collider_friction_of(s, ball) == pytest.approx(0.7)
+    assert addon.collider_friction_of(s, floor) == pytest.approx(0.1)
+    calls = []
+    real = fraccloth.Cloth.set_collider_friction
+
+    def spy(self, cid, friction):
+        calls.append(friction)
+        return real(self, cid, friction)
+
+    monkeypatch.setattr(fraccloth.Cloth, "set_collider_friction", spy)
+    for shape in ("MESH", "FITTED"):
+        s.collider_shape = shape
+        calls.clear()
+        objects = addon.collider_objects(s, others)
+        addon.build_cloth(bpy.context, cloth, others)
+        want = [0.7 if o is ball else 0.1 for o in objects]
+        assert calls == pytest.approx(want), shape
