@@ -42,15 +42,21 @@ struct Stencil {
 }
 
 impl Stencil {
+    /// `out = rows . u`; each row alone, so a large cloth spreads them over the pool with the
+    /// same bits.
     fn apply(&self, u: &[f64], out: &mut [f64]) {
-        for (i, o) in out.iter_mut().enumerate() {
-            let (a, b) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
-            *o = self.cols[a..b]
-                .iter()
-                .zip(&self.weights[a..b])
-                .map(|(&j, w)| w * u[j as usize])
-                .sum();
-        }
+        let parallel = crate::parallel::worth_it(out.len());
+        crate::parallel::chunks(parallel, out, crate::parallel::CHUNK, |first, chunk| {
+            for (k, o) in chunk.iter_mut().enumerate() {
+                let i = first + k;
+                let (a, b) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
+                *o = self.cols[a..b]
+                    .iter()
+                    .zip(&self.weights[a..b])
+                    .map(|(&j, w)| w * u[j as usize])
+                    .sum();
+            }
+        });
     }
 
     /// The transposed rows, each in ascending column order.
