@@ -153,6 +153,48 @@ fn a_bar_thinner_than_the_spacing_catches_the_towel() {
     );
 }
 
+/// The bar again, 2 mm across, between two rows of the towel (1 cm from each) and with a margin
+/// of 3 mm: no cloth vertex comes within reach of the bar and no bar vertex is near the towel
+/// (its ends are 20 cm beyond its sides), so only the contacts of the bar's edges with the
+/// towel's edges can catch it.
+#[test]
+fn a_bar_between_two_rows_catches_the_towel_by_its_edges() {
+    let model = Model {
+        collision_margin: 0.003,
+        ..Model::underwater()
+    };
+    let mut cloth = fraccloth_tools::scenes::collision_towel_with(
+        21,
+        21,
+        0.02,
+        0.0,
+        TowelPose::Hanging,
+        model,
+        Integrator::SymplecticEuler,
+    )
+    .unwrap();
+    let top: Vec<u32> = (0..21).collect();
+    cloth.set_pinned(&top).unwrap();
+    let (bx, bt) = bar(Vec3::new(-0.4, -0.31, 0.0), Vec3::new(0.4, -0.31, 0.0), 0.001, 1);
+    let at = |z: f64| -> Vec<Vec3> { bx.iter().map(|p| p + Vec3::new(0.0, 0.0, z)).collect() };
+    let id = cloth.add_mesh_collider(&at(0.1), &bt, None).unwrap();
+    let mut z = 0.1;
+    for _ in 0..60 {
+        z -= 0.1 / FPS;
+        cloth.set_mesh_collider(id, &at(z), None).unwrap();
+        cloth.step(1.0 / FPS).unwrap();
+    }
+    let bottom = &cloth.positions()[20 * 21..];
+    let behind = bottom.iter().filter(|p| p.z < z + 0.001).count();
+    let mean_z = bottom.iter().map(|p| p.z).sum::<f64>() / bottom.len() as f64;
+    println!("bar between rows at z = {z:.3}; bottom row mean z {mean_z:.3}; {behind} behind it");
+    assert_eq!(behind, 0, "no vertex of the bottom row slipped past the bar");
+    assert!(
+        mean_z < z + 0.03,
+        "the towel was carried by the bar: {mean_z} vs bar {z}"
+    );
+}
+
 /// The drop again with implicit Euler at the automatic step: the contacts' Jacobian blocks
 /// are in its system, and the pile does not cross itself either.
 #[test]

@@ -16,19 +16,32 @@
 //! - *mesh vertex against cloth triangle*: a mesh vertex within the margin of a cloth triangle
 //!   pushes the triangle's three vertices by their barycentric weights, so a collider thinner
 //!   than the cloth's spacing (a bar, a fin, a finger tip) cannot slip between cloth vertices.
+//! - *mesh edge against cloth edge*: where the nearest points of a mesh edge and a cloth edge
+//!   lie inside both (not at an end) and within the margin, and neither cloth vertex touches
+//!   the mesh already, the cloth edge's two vertices are pushed by their weights: a thin
+//!   collider whose vertices are all far from the cloth (a bar longer than the towel, crossing
+//!   it between two rows) cannot slip between cloth vertices either. Only the mesh's *active*
+//!   edges take part (a border, or a fold sharper than [`ACTIVE_EDGE_DEGREES`] between its two
+//!   faces, at the mesh's target each call): across a smooth surface the faces are as near as
+//!   the edges, and the vertex contacts hold the cloth.
 //!
 //! **Search.** Each call the swept boxes of the mesh's triangles and vertices (start to target)
-//! are refitted into two [`Bvh`]s. Each cloth vertex (and triangle) keeps the candidates found
+//! are refitted into three [`Bvh`]s (with its edges). Each cloth vertex (triangle, edge) keeps
+//! the candidates found
 //! within `margin + skin` of where it was when it last looked, and looks again once it has
 //! moved more than `skin / 2` (a Verlet list): most substeps test only a few exact distances.
 
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
-use super::geometry::closest_on_triangle;
+use super::geometry::{closest_on_segments, closest_on_triangle};
 use crate::error::Error;
 use crate::math::Vec3;
 
 const NONE: u32 = u32::MAX;
+
+/// A mesh edge whose two faces turn by more than this (degrees), or with one face, is active
+/// (takes part in edge contacts).
+pub const ACTIVE_EDGE_DEGREES: f64 = 20.0;
 
 /// Most vertices (and triangles) a mesh collider may have.
 pub const MAX_MESH_COLLIDER_VERTICES: usize = 1 << 26;
@@ -52,6 +65,10 @@ pub struct MeshCollider {
     vert_boxes: Vec<Aabb>,
     tri_bvh: Bvh,
     vert_bvh: Bvh,
+    /// Each active edge once, its ends in ascending order (at the last refresh).
+    edges: Vec<[u32; 2]>,
+    edge_boxes: Vec<Aabb>,
+    edge_bvh: Bvh,
     /// Whether the boxes and normals are those of `start` and `target` at `reach`.
     fresh_at: f64,
     /// Coulomb friction coefficient.
@@ -66,8 +83,15 @@ struct Candidates {
     vertex_at: Vec<Vec3>,
     triangle: Vec<Vec<u32>>,
     triangle_at: Vec<Vec3>,
+    /// The cloth's edges (each once) and each one's candidate mesh edges.
+    cloth_edges: Vec<[u32; 2]>,
+    edge: Vec<Vec<u32>>,
+    edge_at: Vec<Vec3>,
     /// Each cloth vertex's nearest triangle at the last substep (tested first).
     nearest: Vec<u32>,
+    /// Whether each cloth vertex touches the mesh at this substep (its edges then need no
+    /// edge contact).
+    touching: Vec<bool>,
     /// Every list must be looked up again (the mesh moved, or the cloth changed).
     stale: bool,
 }
@@ -146,6 +170,9 @@ impl MeshCollider {
             vert_boxes: Vec::new(),
             tri_bvh: Bvh::default(),
             vert_bvh: Bvh::default(),
+            edges: Vec::new(),
+            edge_boxes: Vec::new(),
+            edge_bvh: Bvh::default(),
             fresh_at: f64::NAN,
             friction: 0.0,
             cache: Candidates::default(),
@@ -265,6 +292,18 @@ impl MeshCollider {
             .zip(&self.target)
             .map(|(s, t)| Aabb::of([s, t]).inflated(reach))
             .collect();
+        self.active_edges();
+        self.edge_boxes = self
+            .edges
+            .iter()
+            .map(|e| {
+                Aabb::of(
+                    e.iter()
+                        .flat_map(|&i| [&self.start[i as usize], &self.target[i as usize]]),
+                )
+                .inflated(reach)
+            })
+            .collect();
         if self.tri_bvh.len() == self.tri_boxes.len() {
             self.tri_bvh.refit(&self.tri_boxes);
             self.vert_bvh.refit(&self.vert_boxes);
@@ -272,8 +311,38 @@ impl MeshCollider {
             self.tri_bvh = Bvh::build(&self.tri_boxes);
             self.vert_bvh = Bvh::build(&self.vert_boxes);
         }
+        // The active edges may change as the mesh deforms: rebuilt, unless the same count.
+        if self.edge_bvh.len() == self.edge_boxes.len() && !self.edge_bvh.is_empty() {
+            self.edge_bvh.refit(&self.edge_boxes);
+        } else {
+            self.edge_bvh = Bvh::build(&self.edge_boxes);
+        }
         self.fresh_at = reach;
         self.cache.stale = true;
+    }
+
+    /// The active edges at the target (face normals already computed): borders, and folds
+    /// sharper than [`ACTIVE_EDGE_DEGREES`].
+    fn active_edges(&mut self) {
+        let cos = ACTIVE_EDGE_DEGREES.to_radians().cos();
+        self.edges.clear();
+        for (t, (tri, across)) in self.triangles.iter().zip(&self.neighbours).enumerate() {
+            for k in 0..3 {
+                let n = across[k];
+                let active = if n == NONE {
+                    true
+                } else {
+                    (t as u32) < n && self.face_normal[t].dot(&self.face_normal[n as usize]) < cos
+                };
+                if active {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    self.edges.push([a.min(b), a.max(b)]);
+                }
+            }
+        }
+        // An edge of three or more faces appears once per face.
+        self.edges.sort_unstable();
+        self.edges.dedup();
     }
 
     /// The call succeeded: the mesh is where the host put it.
@@ -363,6 +432,8 @@ impl MeshCollider {
     ) {
         self.refresh_candidates(x, cloth_triangles, margin, skin);
         self.cache.nearest.resize(x.len(), NONE);
+        self.cache.touching.clear();
+        self.cache.touching.resize(x.len(), false);
         let friction = self.friction;
         // Cloth vertex against the nearest mesh triangle.
         for (i, cands) in self.cache.vertex.iter().enumerate() {
@@ -389,6 +460,7 @@ impl MeshCollider {
             if let Some((d, t, w, r)) = best {
                 let (d, dir) = self.signed(t, d, w, &r);
                 if d < margin {
+                    self.cache.touching[i] = true;
                     out.push(Contact {
                         idx: [i as u32, 0, 0, 0],
                         coef: [1.0, 0.0, 0.0, 0.0],
@@ -437,6 +509,43 @@ impl MeshCollider {
                 });
             }
         }
+        // Mesh edge against cloth edge, where the nearest points are inside both edges (at an
+        // end, a vertex contact above takes it) and neither cloth vertex touches the mesh
+        // already: edge contacts catch what the vertices miss (a thin collider between them),
+        // and do not double the push where the cloth lies on the mesh.
+        for (e, cands) in self.cache.edge.iter().enumerate() {
+            if cands.is_empty() {
+                continue;
+            }
+            let [i0, i1] = self.cache.cloth_edges[e];
+            if self.cache.touching[i0 as usize] || self.cache.touching[i1 as usize] {
+                continue;
+            }
+            let (p0, p1) = (x[i0 as usize], x[i1 as usize]);
+            for &m in cands {
+                let [j0, j1] = self.edges[m as usize];
+                let (q0, q1) = (self.at(j0, f), self.at(j1, f));
+                let (s, t) = closest_on_segments(&p0, &p1, &q0, &q1);
+                if !(s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0) {
+                    continue;
+                }
+                let r = (p0 + s * (p1 - p0)) - (q0 + t * (q1 - q0));
+                let d = r.norm();
+                if d >= margin || d <= 1e-12 {
+                    continue;
+                }
+                let (v0, v1) = (self.velocity[j0 as usize], self.velocity[j1 as usize]);
+                out.push(Contact {
+                    idx: [i0, i1, 0, 0],
+                    coef: [1.0 - s, s, 0.0, 0.0],
+                    len: 2,
+                    dir: r / d,
+                    depth: (margin - d).min(max_depth),
+                    surface_velocity: v0 + t * (v1 - v0),
+                    friction,
+                });
+            }
+        }
     }
 
     /// Looks up again the candidates of every cloth vertex and triangle that moved more than
@@ -450,6 +559,9 @@ impl MeshCollider {
             c.vertex_at.resize(x.len(), Vec3::zeros());
             c.triangle.resize_with(cloth_triangles.len(), Vec::new);
             c.triangle_at.resize(cloth_triangles.len(), Vec3::zeros());
+            c.cloth_edges = unique_edges(cloth_triangles);
+            c.edge.resize_with(c.cloth_edges.len(), Vec::new);
+            c.edge_at.resize(c.cloth_edges.len(), Vec3::zeros());
             c.stale = false;
         }
         let moved = |at: &Vec3, p: &Vec3| (p - at).norm_squared() > 0.25 * skin * skin;
@@ -489,7 +601,32 @@ impl MeshCollider {
             let q = Aabb::of(tri.iter().map(|&i| &x[i as usize])).inflated(skin);
             self.vert_bvh.overlapping(&q, |m| list.push(m));
         }
+        for (e, &[i0, i1]) in c.cloth_edges.iter().enumerate() {
+            let (p0, p1) = (&x[i0 as usize], &x[i1 as usize]);
+            let centre = 0.5 * (p0 + p1);
+            if !(all || moved(&c.edge_at[e], &centre)) {
+                continue;
+            }
+            c.edge_at[e] = centre;
+            let list = &mut c.edge[e];
+            list.clear();
+            // The mesh edges' boxes hold `reach` already.
+            let q = Aabb::of([p0, p1]).inflated(skin);
+            self.edge_bvh.overlapping(&q, |m| list.push(m));
+        }
     }
+}
+
+/// Every edge of `triangles` once, its ends in ascending order, sorted.
+fn unique_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = triangles
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
 }
 
 /// Signed volume enclosed by closed triangles (positive when they face outward).
@@ -609,6 +746,45 @@ mod tests {
     }
 
     /// A mesh vertex within the margin of a cloth triangle pushes the triangle's vertices.
+    #[test]
+    fn borders_and_folds_are_active_edges_and_flat_ones_are_not() {
+        // A square of two triangles folded along its diagonal: flat, then at 90 degrees.
+        let flat = [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        let tris = [[0, 1, 2], [0, 2, 3]];
+        let mut m = MeshCollider::new(&flat, &tris, None).unwrap();
+        m.begin_call(0.01, 0.01);
+        assert_eq!(m.edges.len(), 4, "the four borders: {:?}", m.edges);
+        assert!(!m.edges.contains(&[0, 2]));
+        let mut folded = flat;
+        folded[3] = Vec3::new(0.5, 0.5, 0.7);
+        m.set(&folded, None).unwrap();
+        m.begin_call(0.01, 0.01);
+        assert!(m.edges.contains(&[0, 2]), "the fold: {:?}", m.edges);
+        // A cloth edge crossing under the fold, its ends far from the mesh, is pushed by it.
+        let cloth = vec![
+            Vec3::new(0.2, 0.8, -0.005),
+            Vec3::new(1.4, -0.4, -0.005),
+            Vec3::new(5.0, 5.0, 5.0),
+        ];
+        let mut out = Vec::new();
+        m.contacts(&cloth, &[[0, 1, 2]], 1.0, 0.01, 0.01, 1.0, &mut out);
+        let edge = out.iter().find(|c| c.len == 2).expect("an edge contact");
+        assert_eq!(edge.idx[..2], [0, 1]);
+        assert!(
+            edge.dir.z < -0.99 && (edge.depth - 0.005).abs() < 1e-9,
+            "{edge:?}"
+        );
+        // Flat again: the diagonal is no longer active.
+        m.set(&flat, None).unwrap();
+        m.begin_call(0.01, 0.01);
+        assert_eq!(m.edges.len(), 4, "{:?}", m.edges);
+    }
+
     #[test]
     fn a_thin_bar_pushes_the_cloth_triangle_it_is_under() {
         let (x, t) = bar(Vec3::new(0.3, 0.3, -1.0), Vec3::new(0.3, 0.3, 1.0), 0.002, 2);

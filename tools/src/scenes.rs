@@ -531,6 +531,24 @@ pub fn collision_towel(
     thickness: f64,
     integrator: Integrator,
 ) -> Result<Cloth, Error> {
+    let model = Model {
+        self_collision_thickness: thickness,
+        self_collision_friction: 0.3,
+        ..Model::underwater()
+    };
+    collision_towel_with(w, h, spacing, y, pose, model, integrator)
+}
+
+/// [`collision_towel`] with a model of the caller's.
+pub fn collision_towel_with(
+    w: u32,
+    h: u32,
+    spacing: f64,
+    y: f64,
+    pose: TowelPose,
+    model: Model,
+    integrator: Integrator,
+) -> Result<Cloth, Error> {
     let area = spacing * spacing * f64::from((w.max(2) - 1) * (h.max(2) - 1));
     let grid = GridSpec {
         width: w,
@@ -539,11 +557,6 @@ pub fn collision_towel(
         total_mass: area,
     }
     .build()?;
-    let model = Model {
-        self_collision_thickness: thickness,
-        self_collision_friction: 0.3,
-        ..Model::underwater()
-    };
     let config = ClothConfig {
         model,
         scheme: Scheme::DEFAULT,
