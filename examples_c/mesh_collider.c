@@ -72,6 +72,13 @@ int main(void) {
         fprintf(stderr, "mesh collider: %s\n", fc_last_error_message());
         return 1;
     }
+    /* The box keeps the cloth at the description's margin; a collider may have its own. */
+    float margin = 0.0f;
+    if (fc_cloth_set_collider_margin(cloth, id, 0.01f) != FC_OK ||
+        fc_cloth_get_collider_margin(cloth, id, &margin) != FC_OK || margin != 0.01f) {
+        fprintf(stderr, "collider margin: %s\n", fc_last_error_message());
+        return 1;
+    }
     size_t verts = 0, tris = 0;
     fc_cloth_get_mesh_collider(cloth, id, &verts, &tris);
     printf("collider %u vertices %zu triangles %zu\n", id, verts, tris);

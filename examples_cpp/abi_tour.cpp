@@ -62,6 +62,9 @@ int main(int argc, char** argv) try {
     tri[1] = tri[4] = tri[7] = -0.81f;
     cloth.set_mesh_collider(mesh, tri);
     cloth.set_collider_friction(mesh, 0.2f);
+    cloth.set_collider_margin(mesh, 0.02f);
+    require(cloth.collider_margin(mesh) == 0.02f, "mesh collider margin");
+    require(std::fabs(cloth.collider_margin(sphere) - 0.01f) < 1e-6f, "the description's margin");
     require(cloth.mesh_collider_size(mesh)[1] == 1, "mesh collider size");
     bool thrown = false;
     try {

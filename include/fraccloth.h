@@ -790,6 +790,27 @@ FcStatus fc_cloth_set_capsule(FcCloth *cloth,
 FcStatus fc_cloth_set_collider_friction(FcCloth *cloth, uint32_t id, float friction);
 
 /**
+ * Sets collider `id`'s own margin, m (>= 0, finite; any kind, meshes too): the distance from
+ * it at which the cloth is pushed away, instead of the description's `collision_margin` (a
+ * collider's own thickness, as Blender's per-object collision settings give it). Stiffness
+ * and damping stay the description's. Kept when the collider is moved; a collider added
+ * again starts at the description's margin.
+ *
+ * # Safety
+ * `cloth` NULL or live.
+ */
+FcStatus fc_cloth_set_collider_margin(FcCloth *cloth, uint32_t id, float margin);
+
+/**
+ * Writes collider `id`'s margin, m (its own, or the description's `collision_margin`), into
+ * `*margin` (`FC_ERROR_OUT_OF_RANGE` if there is no such collider).
+ *
+ * # Safety
+ * `cloth` NULL or live; `margin` NULL or writable.
+ */
+FcStatus fc_cloth_get_collider_margin(const FcCloth *cloth, uint32_t id, float *margin);
+
+/**
  * Removes collider `id` (`FC_ERROR_OUT_OF_RANGE` if there is none); the id may be reused.
  *
  * # Safety

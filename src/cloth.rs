@@ -127,6 +127,15 @@ impl Default for ClothConfig {
     }
 }
 
+/// An analytic collider as the host set it, with its friction and its own margin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ColliderSlot {
+    pub shape: Collider,
+    pub friction: f64,
+    /// Its own margin, m, or the model's (`None`).
+    pub margin: Option<f64>,
+}
+
 /// One cloth: topology, configuration and state.
 #[derive(Clone, Debug)]
 pub struct Cloth {
@@ -142,7 +151,7 @@ pub struct Cloth {
     pin_list: Vec<u32>,
     pin_target: Vec<Vec3>,
     /// Colliders by id, each with its friction coefficient.
-    collider_slots: Vec<Option<(Collider, f64)>>,
+    collider_slots: Vec<Option<ColliderSlot>>,
     colliders: Vec<Collider>,
     friction: Vec<f64>,
     /// Triangle-mesh colliders by id (ids shared with `collider_slots`: an id is in at most
@@ -361,17 +370,21 @@ impl Cloth {
         if id >= self.collider_slots.len() {
             self.collider_slots.resize(id + 1, None);
         }
-        self.collider_slots[id] = Some((collider, 0.0));
+        self.collider_slots[id] = Some(ColliderSlot {
+            shape: collider,
+            friction: 0.0,
+            margin: None,
+        });
         self.rebuild_colliders();
         Ok(id as u32)
     }
 
-    /// Replaces collider `id` (its shape may change; its friction is kept).
+    /// Replaces collider `id` (its shape may change; its friction and margin are kept).
     pub fn set_collider(&mut self, id: u32, collider: Collider) -> Result<(), Error> {
         let collider = checked_collider(collider)?;
-        let slot = self.collider_slot(id)?;
-        let friction = slot.map_or(0.0, |s| s.1);
-        *slot = Some((collider, friction));
+        if let Some(slot) = self.collider_slot(id)? {
+            slot.shape = collider;
+        }
         self.rebuild_colliders();
         Ok(())
     }
@@ -383,11 +396,46 @@ impl Cloth {
             mesh.friction = friction;
             return Ok(());
         }
-        if let Some((_, f)) = self.collider_slot(id)? {
-            *f = friction;
+        if let Some(slot) = self.collider_slot(id)? {
+            slot.friction = friction;
         }
         self.rebuild_colliders();
         Ok(())
+    }
+
+    /// Sets the margin of collider `id` (any kind, meshes too), m (>= 0): the distance from it
+    /// at which the cloth is pushed away, instead of the model's `collision_margin` (a collider's
+    /// own thickness: a rough rock kept further off than a smooth hull). The contact stiffness
+    /// and damping stay the model's.
+    pub fn set_collider_margin(&mut self, id: u32, margin: f64) -> Result<(), Error> {
+        check_non_negative("collider margin", margin)?;
+        if margin.is_nan() || margin >= 1e6 {
+            return Err(Error::invalid(format!(
+                "collider margin must be below 1e6 m, got {margin}"
+            )));
+        }
+        if let Some(Some(mesh)) = self.mesh_slots.get_mut(id as usize) {
+            mesh.margin = Some(margin);
+            return Ok(());
+        }
+        if let Some(slot) = self.collider_slot(id)? {
+            slot.margin = Some(margin);
+        }
+        self.rebuild_colliders();
+        Ok(())
+    }
+
+    /// The margin collider `id` keeps the cloth at, m: its own, or the model's.
+    pub fn collider_margin(&self, id: u32) -> Option<f64> {
+        let own = if let Some(Some(mesh)) = self.mesh_slots.get(id as usize) {
+            Some(mesh.margin)
+        } else {
+            self.collider_slots
+                .get(id as usize)
+                .and_then(Option::as_ref)
+                .map(|s| s.margin)
+        };
+        own.map(|m| m.unwrap_or(self.config.model.collision_margin))
     }
 
     /// Removes collider `id` (any kind, meshes too); its id may be reused.
@@ -401,7 +449,8 @@ impl Cloth {
         Ok(())
     }
 
-    /// Every collider present.
+    /// Every analytic collider present, as the contacts see it: grown by the difference of its
+    /// own margin and the model's, where it has one ([`Cloth::set_collider_margin`]).
     pub fn colliders(&self) -> &[Collider] {
         &self.colliders
     }
@@ -411,7 +460,7 @@ impl Cloth {
         self.collider_slots
             .get(id as usize)
             .and_then(Option::as_ref)
-            .map(|s| &s.0)
+            .map(|s| &s.shape)
     }
 
     /// Friction coefficient of collider `id` (any kind).
@@ -422,7 +471,7 @@ impl Cloth {
         self.collider_slots
             .get(id as usize)
             .and_then(Option::as_ref)
-            .map(|s| s.1)
+            .map(|s| s.friction)
     }
 
     /// The smallest id free among the analytic and the mesh colliders.
@@ -434,7 +483,7 @@ impl Cloth {
         (0..).find(|&i| !taken(i)).unwrap_or(0)
     }
 
-    fn collider_slot(&mut self, id: u32) -> Result<&mut Option<(Collider, f64)>, Error> {
+    fn collider_slot(&mut self, id: u32) -> Result<&mut Option<ColliderSlot>, Error> {
         match self.collider_slots.get_mut(id as usize) {
             Some(slot @ Some(_)) => Ok(slot),
             _ => Err(Error::out_of_range(format!("no collider with id {id}"))),
@@ -444,9 +493,13 @@ impl Cloth {
     fn rebuild_colliders(&mut self) {
         self.colliders.clear();
         self.friction.clear();
-        for (c, f) in self.collider_slots.iter().flatten() {
-            self.colliders.push(*c);
-            self.friction.push(*f);
+        let margin = self.config.model.collision_margin;
+        for slot in self.collider_slots.iter().flatten() {
+            self.colliders.push(match slot.margin {
+                Some(own) => slot.shape.grown(own - margin),
+                None => slot.shape,
+            });
+            self.friction.push(slot.friction);
         }
     }
 

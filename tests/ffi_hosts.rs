@@ -160,6 +160,26 @@ fn colliders_by_id() {
             FC_ERROR_INVALID_ARGUMENT
         );
         assert_eq!(fc_cloth_set_collider_friction(c, 7, 0.5), FC_ERROR_OUT_OF_RANGE);
+        // A collider's own margin: set, read back, refused when negative, not finite or absent.
+        let mut margin = 0.0f32;
+        assert_eq!(fc_cloth_get_collider_margin(c, capsule, &mut margin), FC_OK);
+        assert_eq!(margin, fc_cloth_desc_default().collision_margin as f32);
+        assert_eq!(fc_cloth_set_collider_margin(c, capsule, 0.03), FC_OK);
+        assert_eq!(fc_cloth_get_collider_margin(c, capsule, &mut margin), FC_OK);
+        assert_eq!(margin, 0.03);
+        for bad in [-0.01, f32::NAN, f32::INFINITY] {
+            assert_eq!(
+                fc_cloth_set_collider_margin(c, capsule, bad),
+                FC_ERROR_INVALID_ARGUMENT,
+                "{bad}"
+            );
+        }
+        assert_eq!(fc_cloth_set_collider_margin(c, 7, 0.01), FC_ERROR_OUT_OF_RANGE);
+        assert_eq!(
+            fc_cloth_get_collider_margin(c, 7, &mut margin),
+            FC_ERROR_OUT_OF_RANGE
+        );
+        assert_eq!(fc_cloth_get_collider_margin(c, capsule, null_mut()), FC_OK);
         let zero = [0.0f32; 3];
         assert_eq!(
             fc_cloth_set_plane(c, plane, p.as_ptr(), zero.as_ptr(), null()),

@@ -313,6 +313,16 @@ public:
     void set_collider_friction(uint32_t id, float friction) {
         check(fc_cloth_set_collider_friction(handle_, id, friction));
     }
+    /// Collider `id`'s own margin, m (>= 0), instead of the description's collision_margin.
+    void set_collider_margin(uint32_t id, float margin) {
+        check(fc_cloth_set_collider_margin(handle_, id, margin));
+    }
+    /// Collider `id`'s margin, m: its own, or the description's collision_margin.
+    float collider_margin(uint32_t id) const {
+        float m = 0.0f;
+        check(fc_cloth_get_collider_margin(handle_, id, &m));
+        return m;
+    }
     void remove_collider(uint32_t id) { check(fc_cloth_remove_collider(handle_, id)); }
     /// Colliders read back (m, m/s); throw with FC_ERROR_OUT_OF_RANGE for an id of another kind.
     struct Sphere { Vec3f center; float radius; };

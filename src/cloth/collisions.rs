@@ -72,15 +72,18 @@ impl Cloth {
         self.self_collision.looks
     }
 
-    fn mesh_reach(&self) -> (f64, f64) {
-        let margin = self.config.model.collision_margin;
+    /// A mesh collider's margin (its own or the model's) and the skin its candidates reach
+    /// beyond it.
+    fn mesh_reach(model_margin: f64, mesh: &MeshCollider) -> (f64, f64) {
+        let margin = mesh.margin.unwrap_or(model_margin);
         (margin, MESH_SKIN_MARGINS * margin)
     }
 
     /// A step call of `dt` seconds begins: each mesh collider's velocities and swept boxes.
     pub(super) fn begin_collider_motion(&mut self, dt: f64) {
-        let (margin, skin) = self.mesh_reach();
+        let model_margin = self.config.model.collision_margin;
         for mesh in self.mesh_slots.iter_mut().flatten() {
+            let (margin, skin) = Self::mesh_reach(model_margin, mesh);
             mesh.begin_call(dt, margin + skin);
         }
     }
@@ -96,12 +99,12 @@ impl Cloth {
     /// the end of this step) and of the cloth with itself, their forces added to the forces
     /// before the force pass. Nothing without meshes or self-collision.
     pub(super) fn collisions(&mut self, fraction: Option<f64>) {
-        let (margin, skin) = self.mesh_reach();
         let s = &mut self.scratch;
         s.contacts.clear();
         let m = &self.config.model;
         let f = fraction.unwrap_or(1.0);
         for mesh in self.mesh_slots.iter_mut().flatten() {
+            let (margin, skin) = Self::mesh_reach(m.collision_margin, mesh);
             // A step outside a call (a snapshot's trial step) finds the boxes made here.
             mesh.refresh(margin + skin);
             mesh.contacts(
@@ -215,6 +218,7 @@ impl Cloth {
                 }
             }
             w.f64(mesh.friction);
+            w.f64(mesh.margin.unwrap_or(-1.0));
         }
         let (vt, ee) = self.self_collision.pairs();
         for pairs in [vt, ee] {
@@ -228,7 +232,11 @@ impl Cloth {
     }
 
     /// Reads and checks what [`Self::write_collision_state`] wrote.
-    pub(super) fn read_collision_state(&self, r: &mut ByteReader) -> Result<CollisionState, Error> {
+    pub(super) fn read_collision_state(
+        &self,
+        r: &mut ByteReader,
+        version: u32,
+    ) -> Result<CollisionState, Error> {
         let bad = |what: &str| Error::invalid(format!("snapshot: bad {what}"));
         let slots = r.len(None, 1)?;
         let mut meshes = Vec::new();
@@ -257,9 +265,11 @@ impl Cloth {
                     if !(friction.is_finite() && friction >= 0.0) {
                         return Err(bad("mesh collider friction"));
                     }
+                    let margin = if version >= 6 { read_margin(r)? } else { None };
                     let mut mesh = MeshCollider::new(&start, &tris, None)?;
                     mesh.set(&target, given)?;
                     mesh.friction = friction;
+                    mesh.margin = margin;
                     Some(mesh)
                 }
                 _ => return Err(bad("mesh collider slot tag")),
@@ -297,5 +307,17 @@ impl Cloth {
         self.mesh_slots = state.meshes;
         self.self_collision
             .set_pairs(state.vertex_triangle, state.edge_edge);
+    }
+}
+
+/// A collider's own margin as a snapshot holds it: -1 for the model's, else the margin (m).
+pub(super) fn read_margin(r: &mut ByteReader) -> Result<Option<f64>, Error> {
+    let m = r.f64()?;
+    if m == -1.0 {
+        Ok(None)
+    } else if (0.0..1e6).contains(&m) {
+        Ok(Some(m))
+    } else {
+        Err(Error::invalid(format!("snapshot: bad collider margin {m}")))
     }
 }

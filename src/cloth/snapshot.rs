@@ -1,23 +1,26 @@
 //! Snapshots: the complete state of a cloth as bytes, to save a bake and resume it later
 //! (or undo in a host), continuing bitwise identically.
 //!
-//! Format version 5, little-endian; version 4 (no collision state) is read as a cloth with no
-//! mesh collider and no remembered self-collision pair. Older versions are refused: version 1
+//! Format version 6, little-endian; version 5 (no colliders' own margins) is read with every
+//! collider at the model's margin, version 4 (no collision state) as a cloth with no mesh
+//! collider and no remembered self-collision pair. Older versions are refused: version 1
 //! stored the SOE modes in their in-memory block layout, version 2 unshifted modes, version 3
 //! the SOE history's past
 //! sum instead of the sample that waits to be folded (`history/soe.rs`).
 //!
 //! ```text
-//! header   b"FCSNAP\0\0"  u32 version = 5  u32 flags = 0  u64 payload_len
+//! header   b"FCSNAP\0\0"  u32 version = 6  u32 flags = 0  u64 payload_len
 //! payload  u64 vertex_count  u64 spring_count  u64 triangle_count  u64 topology_fingerprint
 //!          u8 history_tag  u64 history_config_fingerprint
 //!          f64 time  u64 steps  vec3 current  f64 solver_tolerance  u32 solver_max_iterations
 //!          vec3s positions  vec3s velocities  f64s pin_weights  u64 n + u32[n] pin_order
-//!          vec3s pin_targets  u64 slots, per slot: u8 present [u8 kind, shape f64s, f64 friction]
+//!          vec3s pin_targets  u64 slots, per slot: u8 present [u8 kind, shape f64s, f64 friction,
+//!            f64 margin (-1: the model's)]
 //!          history state (scheme specific: see history/*.rs `write_state`)
 //!          [history state of the springs, with rotation-invariant fractional springs only]
 //!          u64 mesh slots, per slot: u8 present [u64 nv, u64 nt, u32[3 nt] triangles,
-//!            vec3s start, vec3s target, u8 has_velocities [vec3s velocities], f64 friction]
+//!            vec3s start, vec3s target, u8 has_velocities [vec3s velocities], f64 friction,
+//!            f64 margin (-1: the model's)]
 //!          u64 n + n (u32 vertex, u32 triangle, i8 side)  self-collision pairs
 //!          u64 n + n (u32 edge, u32 edge, i8 side)
 //! trailer  u32 CRC-32 (IEEE) of header and payload
@@ -40,7 +43,7 @@ use crate::integrate::SolverSettings;
 
 const MAGIC: &[u8; 8] = b"FCSNAP\0\0";
 /// Current format version.
-pub const SNAPSHOT_VERSION: u32 = 5;
+pub const SNAPSHOT_VERSION: u32 = 6;
 const HEADER: usize = 8 + 4 + 4 + 8;
 
 /// FNV-1a over a stream of u64 words: cheap identity checks, not security.
@@ -190,10 +193,11 @@ impl Cloth {
         for slot in &self.collider_slots {
             match slot {
                 None => w.u8(0),
-                Some((c, friction)) => {
+                Some(slot) => {
                     w.u8(1);
-                    write_collider(w, c);
-                    w.f64(*friction);
+                    write_collider(w, &slot.shape);
+                    w.f64(slot.friction);
+                    w.f64(slot.margin.unwrap_or(-1.0));
                 }
             }
         }
@@ -213,9 +217,9 @@ impl Cloth {
         let mut r = ByteReader::new(bytes);
         r.bytes(8)?;
         let version = r.u32()?;
-        if version != SNAPSHOT_VERSION && version != 4 {
+        if !(4..=SNAPSHOT_VERSION).contains(&version) {
             return Err(Error::invalid(format!(
-                "snapshot format version {version}; this library reads versions 4 and {SNAPSHOT_VERSION}"
+                "snapshot format version {version}; this library reads versions 4 to {SNAPSHOT_VERSION}"
             )));
         }
         let _flags = r.u32()?;
@@ -283,7 +287,16 @@ impl Cloth {
                     if !(friction.is_finite() && friction >= 0.0) {
                         return Err(Error::invalid("snapshot: bad collider friction"));
                     }
-                    Some((c, friction))
+                    let margin = if version >= 6 {
+                        super::collisions::read_margin(&mut r)?
+                    } else {
+                        None
+                    };
+                    Some(super::ColliderSlot {
+                        shape: c,
+                        friction,
+                        margin,
+                    })
                 }
                 k => return Err(Error::invalid(format!("snapshot: bad collider slot tag {k}"))),
             });
@@ -295,7 +308,7 @@ impl Cloth {
         let mut histories = self.histories.clone();
         histories.read_state(&mut r)?;
         let collisions = if version >= 5 {
-            self.read_collision_state(&mut r)?
+            self.read_collision_state(&mut r, version)?
         } else {
             super::collisions::CollisionState {
                 meshes: Vec::new(),

@@ -73,6 +73,8 @@ pub struct MeshCollider {
     fresh_at: f64,
     /// Coulomb friction coefficient.
     pub friction: f64,
+    /// Its own margin, m, or the cloth's (`None`).
+    pub margin: Option<f64>,
     cache: Candidates,
 }
 
@@ -175,6 +177,7 @@ impl MeshCollider {
             edge_bvh: Bvh::default(),
             fresh_at: f64::NAN,
             friction: 0.0,
+            margin: None,
             cache: Candidates::default(),
         };
         mesh.set_velocities(velocities)?;

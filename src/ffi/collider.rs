@@ -220,6 +220,46 @@ pub unsafe extern "C" fn fc_cloth_set_collider_friction(
     })
 }
 
+/// Sets collider `id`'s own margin, m (>= 0, finite; any kind, meshes too): the distance from
+/// it at which the cloth is pushed away, instead of the description's `collision_margin` (a
+/// collider's own thickness, as Blender's per-object collision settings give it). Stiffness
+/// and damping stay the description's. Kept when the collider is moved; a collider added
+/// again starts at the description's margin.
+///
+/// # Safety
+/// `cloth` NULL or live.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_set_collider_margin(cloth: *mut FcCloth, id: u32, margin: f32) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle_mut(cloth) }?;
+        Ok(cloth.set_collider_margin(id, f64::from(margin))?)
+    })
+}
+
+/// Writes collider `id`'s margin, m (its own, or the description's `collision_margin`), into
+/// `*margin` (`FC_ERROR_OUT_OF_RANGE` if there is no such collider).
+///
+/// # Safety
+/// `cloth` NULL or live; `margin` NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_collider_margin(
+    cloth: *const FcCloth,
+    id: u32,
+    margin: *mut f32,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle(cloth) }?;
+        let m = cloth
+            .collider_margin(id)
+            .ok_or_else(|| FfiError::from(crate::Error::out_of_range(format!("no collider with id {id}"))))?;
+        // SAFETY: NULL or writable (caller's promise).
+        unsafe { super::cloth::put(margin, m as f32) };
+        Ok(())
+    })
+}
+
 /// Removes collider `id` (`FC_ERROR_OUT_OF_RANGE` if there is none); the id may be reused.
 ///
 /// # Safety

@@ -63,6 +63,26 @@ fn radial(r: Vec3) -> (f64, Vec3) {
 }
 
 impl Collider {
+    /// The same collider with its surface moved out by `delta` m (in by a negative one): a
+    /// contact within margin `m` of it is a contact within `m + delta` of this one, with the
+    /// same force. How a collider's own margin is made from the cloth's.
+    pub fn grown(&self, delta: f64) -> Collider {
+        match *self {
+            Collider::Sphere(s) => Collider::Sphere(Sphere {
+                radius: s.radius + delta,
+                ..s
+            }),
+            Collider::Plane(p) => Collider::Plane(Plane {
+                point: p.point + delta * p.normal,
+                ..p
+            }),
+            Collider::Capsule(c) => Collider::Capsule(Capsule {
+                radius: c.radius + delta,
+                ..c
+            }),
+        }
+    }
+
     /// Signed distance from the surface (negative inside), outward normal, surface velocity.
     pub fn probe(&self, p: &Vec3) -> (f64, Vec3, Vec3) {
         match self {

@@ -10,8 +10,8 @@ Physics > fraccloth panel (Properties editor, Physics tab). "Bake underwater clo
   object (one dimension near zero) is an infinite plane through its origin along its local Z
   axis, a long one (longest dimension over twice the next) a capsule along that axis, any other
   a sphere of half its largest dimension around its origin (objects that are not meshes are
-  always fitted). "Collider friction" applies to them all, except a collider whose own panel
-  says "As a collider: Own friction" (its friction then);
+  always fitted). "Collider friction" and "Collision margin" apply to them all, except a
+  collider whose own panel says "As a collider: Own friction" or "Own margin" (its own then);
 - "Self-collision" (a thickness in m, 0 = off) keeps the cloth from passing through itself;
 - the scene's frame range is baked at the scene's frame rate, each frame split into steps of
   "Time step"; the result is written to a PC2 (or MDD) point cache by the fraccloth library and
@@ -193,6 +193,8 @@ class FracclothSettings(bpy.types.PropertyGroup):
     friction: bpy.props.FloatProperty(name="Collider friction", description="How much the colliders grip the cloth (0 = slippery, 1 = grippy); a collider with its own friction (its panel's \"As a collider\") uses that", default=0.0, min=0.0, soft_max=1.0)
     collider_own_friction: bpy.props.BoolProperty(name="Own friction", description="When this object is a collider of a fraccloth cloth, it grips the cloth with its own friction below instead of the cloth's Collider friction", default=False)
     collider_friction: bpy.props.FloatProperty(name="Friction", description="How much this object grips a fraccloth cloth that collides with it (0 = slippery, 1 = grippy)", default=0.5, min=0.0, soft_max=1.0)
+    collider_own_margin: bpy.props.BoolProperty(name="Own margin", description="When this object is a collider of a fraccloth cloth, it keeps the cloth at its own distance below instead of the cloth's Collision margin", default=False)
+    collider_margin: bpy.props.FloatProperty(name="Margin", description="Distance from this object at which a fraccloth cloth is pushed away, m", default=0.01, min=0.0, soft_max=0.05, precision=4)
     collision_margin: bpy.props.FloatProperty(name="Collision margin", description="Distance from a collider at which the cloth is pushed away, m", default=0.01, min=0.0, soft_max=0.05)
     collider_shape: bpy.props.EnumProperty(name="Collider shape", items=COLLIDER_ITEMS, default="MESH",
                                            description="How collider objects are seen: their own mesh every frame, or a fitted sphere, capsule or plane (faster)")
@@ -290,6 +292,15 @@ def collider_friction_of(s, o):
     if own is not None and own.collider_own_friction:
         return own.collider_friction
     return s.friction
+
+
+def collider_margin_of(o):
+    """Collider `o`'s own margin in metres of the library (its "As a collider: Own margin"),
+    or None for the cloth's Collision margin."""
+    own = getattr(o, "fraccloth", None)
+    if own is not None and own.collider_own_margin:
+        return own.collider_margin
+    return None
 
 
 def collider_specs_for(s, others):
@@ -474,6 +485,9 @@ def build_cloth(context, obj, others):
         else:
             cid = cloth.add_sphere(spec[1], spec[2])
         cloth.set_collider_friction(cid, collider_friction_of(s, o))
+        margin = collider_margin_of(o)
+        if margin is not None:
+            cloth.set_collider_margin(cid, margin)
         ids.append(cid)
     fps = context.scene.render.fps / context.scene.render.fps_base
     frame_dt = 1.0 / fps
@@ -784,10 +798,12 @@ class FRACCLOTH_PT_panel(bpy.types.Panel):
                 box.label(text="Colliders: mesh objects with Collision physics, and meshes selected with the cloth")
         box = layout.box()
         box.label(text="As a collider of another fraccloth cloth")
-        box.prop(s, "collider_own_friction")
-        row = box.row()
-        row.prop(s, "collider_friction")
-        row.enabled = s.collider_own_friction
+        for own, value in (("collider_own_friction", "collider_friction"), ("collider_own_margin", "collider_margin")):
+            row = box.row()
+            row.prop(s, own)
+            sub = row.row()
+            sub.prop(s, value)
+            sub.enabled = getattr(s, own)
         row = layout.row()
         row.operator(FRACCLOTH_OT_bake.bl_idname)
         row.operator(FRACCLOTH_OT_free_bake.bl_idname)

@@ -482,8 +482,8 @@ def test_an_object_with_collision_physics_collides_unselected(addon, tmp_path):
 
 
 def test_a_collider_with_its_own_friction_grips_with_it(addon, tmp_path, monkeypatch):
-    """Per-object collision settings: a collider's own friction ("As a collider: Own friction")
-    replaces the cloth's Collider friction for that collider only."""
+    """Per-object collision settings: a collider's own friction and margin ("As a collider: Own
+    friction", "Own margin") replace the cloth's for that collider only."""
     import fraccloth
 
     cloth, others = make_scene(tmp_path, "PC2")
@@ -502,10 +502,15 @@ def test_a_collider_with_its_own_friction_grips_with_it(addon, tmp_path, monkeyp
         return real(self, cid, friction)
 
     monkeypatch.setattr(fraccloth.Cloth, "set_collider_friction", spy)
+    ball.fraccloth.collider_own_margin = True
+    ball.fraccloth.collider_margin = 0.025
     for shape in ("MESH", "FITTED"):
         s.collider_shape = shape
         calls.clear()
         objects = addon.collider_objects(s, others)
-        addon.build_cloth(bpy.context, cloth, others)
+        built, _, _, ids = addon.build_cloth(bpy.context, cloth, others)
         want = [0.7 if o is ball else 0.1 for o in objects]
         assert calls == pytest.approx(want), shape
+        # The ball keeps the cloth at its own margin, the floor at the cloth's.
+        margins = [built.collider_margin(i) for i in ids]
+        assert margins == pytest.approx([0.025 if o is ball else s.collision_margin for o in objects], rel=1e-5)

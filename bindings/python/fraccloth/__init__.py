@@ -187,6 +187,8 @@ _SIGNATURES = {
     "fc_cloth_add_capsule": (_c.c_int, [_P, _F3, _F3, _c.c_float, _F3, _U32P]),
     "fc_cloth_set_capsule": (_c.c_int, [_P, _c.c_uint32, _F3, _F3, _c.c_float, _F3]),
     "fc_cloth_set_collider_friction": (_c.c_int, [_P, _c.c_uint32, _c.c_float]),
+    "fc_cloth_set_collider_margin": (_c.c_int, [_P, _c.c_uint32, _c.c_float]),
+    "fc_cloth_get_collider_margin": (_c.c_int, [_P, _c.c_uint32, _c.POINTER(_c.c_float)]),
     "fc_cloth_remove_collider": (_c.c_int, [_P, _c.c_uint32]),
     "fc_cloth_get_sphere": (_c.c_int, [_P, _c.c_uint32, _F3, _c.POINTER(_c.c_float)]),
     "fc_cloth_get_plane": (_c.c_int, [_P, _c.c_uint32, _F3, _F3, _F3]),
@@ -664,6 +666,17 @@ class Cloth:
     def set_collider_friction(self, id: int, friction: float) -> None:
         """Coulomb friction coefficient (>= 0) of collider ``id``."""
         _check(library.fc_cloth_set_collider_friction(self._h, id, friction))
+
+    def set_collider_margin(self, id: int, margin: float) -> None:
+        """Collider ``id``'s own margin, m (>= 0; any kind, meshes too): the distance from it at
+        which the cloth is pushed away, instead of the description's ``collision_margin``."""
+        _check(library.fc_cloth_set_collider_margin(self._h, id, margin))
+
+    def collider_margin(self, id: int) -> float:
+        """Collider ``id``'s margin, m: its own, or the description's ``collision_margin``."""
+        m = ctypes.c_float()
+        _check(library.fc_cloth_get_collider_margin(self._h, id, ctypes.byref(m)))
+        return m.value
 
     def remove_collider(self, id: int) -> None:
         """Removes collider ``id`` (any kind, meshes too); its id may be reused by a later add."""

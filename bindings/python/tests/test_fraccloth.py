@@ -322,7 +322,7 @@ def test_triangle_mesh_collider_and_self_collision():
 def test_a_description_prints_its_fields():
     desc = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
     text = repr(desc)
-    assert text.startswith("FcClothDesc(") and "added_mass=10.0" in text and "gravity=(0.0, -9.81, 0.0)" in text
+    assert text.startswith("FcClothDesc(") and "added_mass=8.0" in text and "form_drag_scale=0.012" in text and "gravity=(0.0, -9.81, 0.0)" in text
     assert str(desc) == text and text.count("=") == len(fraccloth.FcClothDesc._fields_)
 
 
@@ -334,3 +334,17 @@ def test_a_wrong_argument_type_is_a_type_error_that_names_the_call():
             bad()
         assert not isinstance(info.value, ctypes.ArgumentError)
     cloth.step(1e-4)  # still usable
+
+
+def test_a_colliders_own_margin():
+    desc = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
+    desc.width, desc.height = 5, 5
+    cloth = fraccloth.Cloth.grid(desc)
+    cid = cloth.add_sphere((0.0, -1.0, 0.0), 0.1)
+    assert cloth.collider_margin(cid) == pytest.approx(desc.collision_margin)
+    cloth.set_collider_margin(cid, 0.03)
+    assert cloth.collider_margin(cid) == pytest.approx(0.03)
+    with pytest.raises(fraccloth.Error):
+        cloth.set_collider_margin(cid, -1.0)
+    with pytest.raises(fraccloth.Error):
+        cloth.collider_margin(99)
