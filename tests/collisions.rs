@@ -114,55 +114,11 @@ fn a_towel_on_a_turning_torus_stays_outside_it() {
     );
 }
 
-/// A hanging towel, a bar of 4 mm across (the towel's spacing is 2 cm) sweeping through it
-/// sideways: the bar catches the towel and carries it, no vertex slips past.
-#[test]
-fn a_bar_thinner_than_the_spacing_catches_the_towel() {
-    let mut cloth = collision_towel(
-        21,
-        21,
-        0.02,
-        0.0,
-        TowelPose::Hanging,
-        0.0,
-        Integrator::SymplecticEuler,
-    )
-    .unwrap();
-    let top: Vec<u32> = (0..21).collect();
-    cloth.set_pinned(&top).unwrap();
-    // A horizontal bar along x through the towel's lower half, 10 cm in front of it (z).
-    let (bx, bt) = bar(Vec3::new(-0.4, -0.3, 0.0), Vec3::new(0.4, -0.3, 0.0), 0.002, 1);
-    let at = |z: f64| -> Vec<Vec3> { bx.iter().map(|p| p + Vec3::new(0.0, 0.0, z)).collect() };
-    let id = cloth.add_mesh_collider(&at(0.1), &bt, None).unwrap();
-    let mut z = 0.1;
-    for _ in 0..60 {
-        // 0.1 m/s towards and through the towel's plane (z decreasing).
-        z -= 0.1 / FPS;
-        cloth.set_mesh_collider(id, &at(z), None).unwrap();
-        cloth.step(1.0 / FPS).unwrap();
-    }
-    // The bar ended 10 cm behind the towel's rest plane: the towel's lower rows went with it.
-    let bottom = &cloth.positions()[20 * 21..];
-    let behind = bottom.iter().filter(|p| p.z < z + 0.001).count();
-    let mean_z = bottom.iter().map(|p| p.z).sum::<f64>() / bottom.len() as f64;
-    println!("bar at z = {z:.3}; bottom row mean z {mean_z:.3}; {behind} bottom vertices behind the bar");
-    assert_eq!(behind, 0, "no vertex of the bottom row slipped past the bar");
-    assert!(
-        mean_z < z + 0.03,
-        "the towel was carried by the bar: {mean_z} vs bar {z}"
-    );
-}
-
-/// The bar again, 2 mm across, between two rows of the towel (1 cm from each) and with a margin
-/// of 3 mm: no cloth vertex comes within reach of the bar and no bar vertex is near the towel
-/// (its ends are 20 cm beyond its sides), so only the contacts of the bar's edges with the
-/// towel's edges can catch it.
-#[test]
-fn a_bar_between_two_rows_catches_the_towel_by_its_edges() {
-    let model = Model {
-        collision_margin: 0.003,
-        ..Model::underwater()
-    };
+/// Sweeps a horizontal bar along x at height `y`, `half_width` m thick, from 10 cm in front of a
+/// hanging 21 x 21 towel of 2 cm spacing (pinned along its top) to 10 cm behind it at 0.1 m/s;
+/// returns the bar's final z, the bottom row's mean z and how many of its vertices are behind
+/// the bar.
+fn sweep_bar(model: Model, y: f64, half_width: f64) -> (f64, f64, usize) {
     let mut cloth = fraccloth_tools::scenes::collision_towel_with(
         21,
         21,
@@ -175,11 +131,12 @@ fn a_bar_between_two_rows_catches_the_towel_by_its_edges() {
     .unwrap();
     let top: Vec<u32> = (0..21).collect();
     cloth.set_pinned(&top).unwrap();
-    let (bx, bt) = bar(Vec3::new(-0.4, -0.31, 0.0), Vec3::new(0.4, -0.31, 0.0), 0.001, 1);
+    let (bx, bt) = bar(Vec3::new(-0.4, y, 0.0), Vec3::new(0.4, y, 0.0), half_width, 1);
     let at = |z: f64| -> Vec<Vec3> { bx.iter().map(|p| p + Vec3::new(0.0, 0.0, z)).collect() };
     let id = cloth.add_mesh_collider(&at(0.1), &bt, None).unwrap();
     let mut z = 0.1;
     for _ in 0..60 {
+        // 0.1 m/s towards and through the towel's plane (z decreasing).
         z -= 0.1 / FPS;
         cloth.set_mesh_collider(id, &at(z), None).unwrap();
         cloth.step(1.0 / FPS).unwrap();
@@ -187,7 +144,37 @@ fn a_bar_between_two_rows_catches_the_towel_by_its_edges() {
     let bottom = &cloth.positions()[20 * 21..];
     let behind = bottom.iter().filter(|p| p.z < z + 0.001).count();
     let mean_z = bottom.iter().map(|p| p.z).sum::<f64>() / bottom.len() as f64;
-    println!("bar between rows at z = {z:.3}; bottom row mean z {mean_z:.3}; {behind} behind it");
+    println!("bar at y {y}, z = {z:.3}; bottom row mean z {mean_z:.3}; {behind} bottom vertices behind it");
+    (z, mean_z, behind)
+}
+
+/// A hanging towel, a bar of 4 mm across (the towel's spacing is 2 cm) sweeping through it
+/// sideways along a row: the bar catches the towel and carries it, no vertex slips past.
+#[test]
+fn a_bar_thinner_than_the_spacing_catches_the_towel() {
+    let model = Model {
+        self_collision_friction: 0.3,
+        ..Model::underwater()
+    };
+    let (z, mean_z, behind) = sweep_bar(model, -0.3, 0.002);
+    assert_eq!(behind, 0, "no vertex of the bottom row slipped past the bar");
+    assert!(
+        mean_z < z + 0.03,
+        "the towel was carried by the bar: {mean_z} vs bar {z}"
+    );
+}
+
+/// The bar again, 2 mm across, between two rows of the towel (1 cm from each) and with a margin
+/// of 3 mm: no cloth vertex comes within reach of the bar and no bar vertex is near the towel
+/// (its ends are 20 cm beyond its sides), so only the contacts of the bar's edges with the
+/// towel's edges can catch it (without them the towel stays where it hung).
+#[test]
+fn a_bar_between_two_rows_catches_the_towel_by_its_edges() {
+    let model = Model {
+        collision_margin: 0.003,
+        ..Model::underwater()
+    };
+    let (z, mean_z, behind) = sweep_bar(model, -0.31, 0.001);
     assert_eq!(behind, 0, "no vertex of the bottom row slipped past the bar");
     assert!(
         mean_z < z + 0.03,
