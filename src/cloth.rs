@@ -392,15 +392,11 @@ impl Cloth {
     /// Sets the Coulomb friction coefficient (>= 0) of collider `id` (any kind, meshes too).
     pub fn set_collider_friction(&mut self, id: u32, friction: f64) -> Result<(), Error> {
         check_non_negative("friction", friction)?;
-        if let Some(Some(mesh)) = self.mesh_slots.get_mut(id as usize) {
-            mesh.friction = friction;
-            return Ok(());
-        }
-        if let Some(slot) = self.collider_slot(id)? {
-            slot.friction = friction;
-        }
-        self.rebuild_colliders();
-        Ok(())
+        self.with_collider(
+            id,
+            |mesh| mesh.friction = friction,
+            |slot| slot.friction = friction,
+        )
     }
 
     /// Sets the margin of collider `id` (any kind, meshes too), m (>= 0): the distance from it
@@ -414,12 +410,27 @@ impl Cloth {
                 "collider margin must be below 1e6 m, got {margin}"
             )));
         }
-        if let Some(Some(mesh)) = self.mesh_slots.get_mut(id as usize) {
-            mesh.margin = Some(margin);
+        self.with_collider(
+            id,
+            |mesh| mesh.margin = Some(margin),
+            |slot| slot.margin = Some(margin),
+        )
+    }
+
+    /// Changes collider `id`: a mesh collider by `mesh`, an analytic one by `slot` (then the
+    /// contacts' list is rebuilt).
+    fn with_collider(
+        &mut self,
+        id: u32,
+        mesh: impl FnOnce(&mut MeshCollider),
+        slot: impl FnOnce(&mut ColliderSlot),
+    ) -> Result<(), Error> {
+        if let Some(Some(m)) = self.mesh_slots.get_mut(id as usize) {
+            mesh(m);
             return Ok(());
         }
-        if let Some(slot) = self.collider_slot(id)? {
-            slot.margin = Some(margin);
+        if let Some(s) = self.collider_slot(id)? {
+            slot(s);
         }
         self.rebuild_colliders();
         Ok(())

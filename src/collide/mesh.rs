@@ -558,11 +558,14 @@ impl MeshCollider {
         let c = &mut self.cache;
         let all = c.stale || c.vertex.len() != x.len() || c.triangle.len() != cloth_triangles.len();
         if all {
+            // The cloth's edges once (a moving mesh makes every call `all`).
+            if c.triangle.len() != cloth_triangles.len() || c.cloth_edges.is_empty() {
+                c.cloth_edges = unique_edges(cloth_triangles);
+            }
             c.vertex.resize_with(x.len(), Vec::new);
             c.vertex_at.resize(x.len(), Vec3::zeros());
             c.triangle.resize_with(cloth_triangles.len(), Vec::new);
             c.triangle_at.resize(cloth_triangles.len(), Vec3::zeros());
-            c.cloth_edges = unique_edges(cloth_triangles);
             c.edge.resize_with(c.cloth_edges.len(), Vec::new);
             c.edge_at.resize(c.cloth_edges.len(), Vec3::zeros());
             c.stale = false;
