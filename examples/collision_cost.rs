@@ -7,7 +7,7 @@
 //! crossing triangle pairs at any frame.
 //!
 //! `cargo run --release --example collision_cost -- [rounds] [case]` (default 3 rounds, every
-//! case; `case` 0-3 runs one)
+//! case; `case` 0-4 runs one)
 
 use std::time::Instant;
 
@@ -109,6 +109,7 @@ fn main() {
             false,
         ),
         ("61x41 0.5 Hz 4 cm, 10k-tri mesh", towel(0.5, 0.04), 0.0, true),
+        ("61x41 2 Hz 4 cm, self 4 mm", towel(2.0, 0.04), 0.004, false),
     ];
     let only: Option<usize> = std::env::args().nth(2).and_then(|s| s.parse().ok());
     for (k, (name, base, thickness, mesh)) in cases.into_iter().enumerate() {

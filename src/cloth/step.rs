@@ -351,6 +351,7 @@ impl Cloth {
         }
         s.projected.resize(self.x.len(), 0.0);
         let m = &self.config.model;
+        let normals = s.force_pass.normals_to_write(self.x.len());
         forces::turning_forces(
             m,
             t,
@@ -358,6 +359,7 @@ impl Cloth {
             &s.v_rel,
             &mut s.turning,
             &mut s.projected,
+            normals,
             &mut s.prior_forces,
         );
     }

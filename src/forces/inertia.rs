@@ -180,8 +180,9 @@ pub fn patch_normals(x: &[Vec3], t: &Topology, normals: &mut [Vec3], projected: 
 /// Adds the forces of the carried water as the cloth turns and stretches,
 /// `dT/dx - (dM/dt) v`, to `out` (one per particle), for the normal added mass of `m` at
 /// positions `x` and velocities relative to the water `v`, and writes every vertex's
-/// projected-area ratio into `projected` ([`patch_normals`]). Nothing without normal added
-/// mass.
+/// projected-area ratio into `projected` ([`patch_normals`]) and its unit normal into
+/// `normals` (the same bits as [`super::vertex_normals_with`]: the same face sums in the same
+/// order, so the force pass need not sum them again). Nothing without normal added mass.
 ///
 /// With `a_i = N_i / |N_i(rest)|` (see [`patch_normals`]) and `k_i = m_a A_i`, the water's kinetic
 /// energy is `T = 1/2 sum k_i (v_i . a_i)^2` and its mass matrix `k_i a_i a_i^T`:
@@ -193,6 +194,7 @@ pub fn patch_normals(x: &[Vec3], t: &Topology, normals: &mut [Vec3], projected: 
 ///
 /// Both are quadratic in the velocity and bounded (no division by the normal's length):
 /// they enter every integrator as known forces of the step's start.
+#[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 pub fn turning_forces(
     m: &Model,
     t: &Topology,
@@ -200,6 +202,7 @@ pub fn turning_forces(
     v: &[Vec3],
     scratch: &mut TurningScratch,
     projected: &mut [f64],
+    normals: &mut [Vec3],
     out: &mut [Vec3],
 ) {
     let ma = m.water.added_mass;
@@ -209,12 +212,13 @@ pub fn turning_forces(
     // Four passes, faces and vertices in turn; each element is computed alone (by the
     // functions below), so a large cloth spreads them over the pool with the same bits.
     if crate::parallel::worth_it(x.len()) {
-        turning_parallel(ma, t, x, v, scratch, projected, out);
+        turning_parallel(ma, t, x, v, scratch, projected, normals, out);
     } else {
-        turning_serial(ma, t, x, v, scratch, projected, out);
+        turning_serial(ma, t, x, v, scratch, projected, normals, out);
     }
 }
 
+#[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 fn turning_serial(
     ma: f64,
     t: &Topology,
@@ -222,6 +226,7 @@ fn turning_serial(
     v: &[Vec3],
     scratch: &mut TurningScratch,
     projected: &mut [f64],
+    normals: &mut [Vec3],
     out: &mut [Vec3],
 ) {
     let (areas, triangles, vertex_triangles) = (&t.areas, &t.triangles, &t.vertex_triangles);
@@ -250,6 +255,7 @@ fn turning_serial(
             &v[i],
             o,
             &mut projected[i],
+            &mut normals[i],
         );
         patches.push(w);
     }
@@ -262,6 +268,7 @@ fn turning_serial(
     }
 }
 
+#[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 fn turning_parallel(
     ma: f64,
     t: &Topology,
@@ -269,6 +276,7 @@ fn turning_parallel(
     v: &[Vec3],
     scratch: &mut TurningScratch,
     projected: &mut [f64],
+    normals: &mut [Vec3],
     out: &mut [Vec3],
 ) {
     use rayon::prelude::*;
@@ -290,10 +298,11 @@ fn turning_parallel(
         patches.par_iter_mut(),
         out.par_iter_mut(),
         projected.par_iter_mut(),
+        normals.par_iter_mut(),
     )
         .into_par_iter()
         .enumerate()
-        .for_each(|(i, (w, o, p))| {
+        .for_each(|(i, (w, o, p, n))| {
             let k = ma * areas[i];
             *w = patch_turning(
                 faces,
@@ -304,6 +313,7 @@ fn turning_parallel(
                 &v[i],
                 o,
                 p,
+                n,
             );
         });
     let patches = &*patches;
@@ -326,7 +336,7 @@ fn face_and_rate(x: &[Vec3], v: &[Vec3], t: &[u32; 3]) -> (Vec3, Vec3) {
 }
 
 /// At one vertex (its faces `row`, `k = m_a A`): subtracts the force of the patch's turning from
-/// `o`, writes the projected-area ratio, and returns the vertex's `w`.
+/// `o`, writes the projected-area ratio and the unit normal, and returns the vertex's `w`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn patch_turning(
@@ -338,12 +348,15 @@ fn patch_turning(
     v: &Vec3,
     o: &mut Vec3,
     projected: &mut f64,
+    normal: &mut Vec3,
 ) -> Vec3 {
     let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
     for &t in row {
         big_n += faces[t as usize];
         big_ndot += rates[t as usize];
     }
+    let len = big_n.norm();
+    *normal = if len > 0.0 { big_n / len } else { big_n };
     let (a, adot) = (scale * big_n, scale * big_ndot);
     *projected = a.norm();
     let av = a.dot(v);
@@ -427,7 +440,12 @@ mod tests {
         let mut got = vec![Vec3::zeros(); x.len()];
         let mut s = TurningScratch::default();
         let mut projected = vec![0.0; x.len()];
-        turning_forces(&m, &t, &x, &v, &mut s, &mut projected, &mut got);
+        let mut normals = vec![Vec3::zeros(); x.len()];
+        turning_forces(&m, &t, &x, &v, &mut s, &mut projected, &mut normals, &mut got);
+        // The normals are the force pass's, bit for bit (it reads these instead).
+        let mut want_normals = vec![Vec3::zeros(); x.len()];
+        crate::forces::normals::vertex_normals(&x, &t.triangles, &mut want_normals);
+        assert_eq!(normals, want_normals);
         // The ratios are the patches' own, 1 at rest.
         let (mut n, mut p) = (vec![Vec3::zeros(); x.len()], vec![0.0; x.len()]);
         patch_normals(&x, &t, &mut n, &mut p);
@@ -467,7 +485,16 @@ mod tests {
         // Nothing without normal added mass.
         let mut none = vec![Vec3::zeros(); x.len()];
         let plain = Model::fractional();
-        turning_forces(&plain, &t, &x, &v, &mut s, &mut projected, &mut none);
+        turning_forces(
+            &plain,
+            &t,
+            &x,
+            &v,
+            &mut s,
+            &mut projected,
+            &mut normals,
+            &mut none,
+        );
         assert!(none.iter().all(|f| *f == Vec3::zeros()));
     }
 

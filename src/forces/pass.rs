@@ -71,11 +71,23 @@ impl ForceScratch {
     }
 
     /// The vertex normals at `x`, computed now for a whole-cloth pass before the force pass,
-    /// which then reads them instead of computing them again (once a step).
+    /// which then reads them instead of computing them again (once a step). Not computed
+    /// again when an earlier pass of the same step wrote them ([`Self::normals_to_write`]).
     pub(crate) fn normals_ahead(&mut self, x: &[Vec3], topology: &crate::topology::Topology) -> &[Vec3] {
-        compute_normals(x, topology, self);
-        self.normals_ready = true;
+        if !self.normals_ready || self.normals.len() != x.len() {
+            compute_normals(x, topology, self);
+            self.normals_ready = true;
+        }
         &self.normals
+    }
+
+    /// The buffer for the vertex normals of the coming pass's positions, `n` of them, for a
+    /// pass before it that computes them anyway ([`crate::forces::turning_forces`]); the
+    /// caller must fill every one, with the bits of [`super::vertex_normals_with`].
+    pub(crate) fn normals_to_write(&mut self, n: usize) -> &mut [Vec3] {
+        self.normals.resize(n, Vec3::zeros());
+        self.normals_ready = true;
+        &mut self.normals
     }
 }
 
