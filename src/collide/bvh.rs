@@ -180,6 +180,99 @@ impl Bvh {
         self.nodes.first().map_or(Aabb::empty(), |n| n.bounds)
     }
 
+    /// The tree against itself split into independent walks for [`Bvh::self_overlapping`]:
+    /// node pairs whose item pairs together are every pair once, expanded level by level
+    /// until there are at least `tasks` of them (fewer when the tree is small), for a pool.
+    pub fn self_tasks(&self, tasks: usize) -> Vec<(u32, u32)> {
+        if self.nodes.is_empty() {
+            return Vec::new();
+        }
+        let mut out = vec![(0u32, 0u32)];
+        while out.len() < tasks {
+            let mut next = Vec::with_capacity(3 * out.len());
+            let mut grew = false;
+            for &(a, b) in &out {
+                let before = next.len();
+                self.expand(a, b, &mut next);
+                grew |= !(next.len() == before + 1 && next[before] == (a, b));
+            }
+            out = next;
+            if !grew {
+                break;
+            }
+        }
+        out
+    }
+
+    /// One level of the walk of node pair `(a, b)`: pushes its children's pairs onto `out`, or
+    /// the pair itself when both are leaves (nothing when their bounds are apart).
+    fn expand(&self, a: u32, b: u32, out: &mut Vec<(u32, u32)>) {
+        let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
+        if a == b {
+            if na.count > 0 {
+                out.push((a, b));
+            } else {
+                let c = na.first;
+                out.extend([(c, c), (c + 1, c + 1), (c, c + 1)]);
+            }
+            return;
+        }
+        if !na.bounds.overlaps(&nb.bounds) {
+            return;
+        }
+        match (na.count > 0, nb.count > 0) {
+            (true, true) => out.push((a, b)),
+            (true, false) => out.extend([(a, nb.first), (a, nb.first + 1)]),
+            (false, true) => out.extend([(na.first, b), (na.first + 1, b)]),
+            (false, false) => {
+                let (ca, cb) = (na.first, nb.first);
+                out.extend([(ca, cb), (ca, cb + 1), (ca + 1, cb), (ca + 1, cb + 1)]);
+            }
+        }
+    }
+
+    /// Calls `f(i, j)` once for every pair of distinct items under the node pair `task` (from
+    /// [`Bvh::self_tasks`]) whose boxes overlap, `i` and `j` in no set order. The tree walked
+    /// against itself visits each pair of overlapping nodes once, where a query per item walks
+    /// from the root for each and meets each pair twice.
+    pub fn self_overlapping(&self, task: (u32, u32), mut f: impl FnMut(u32, u32)) {
+        let mut stack = vec![task];
+        let mut next = Vec::with_capacity(4);
+        while let Some((a, b)) = stack.pop() {
+            let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
+            let leaves = na.count > 0 && nb.count > 0;
+            if !leaves {
+                next.clear();
+                self.expand(a, b, &mut next);
+                stack.extend_from_slice(&next);
+                continue;
+            }
+            let items = |n: &Node| &self.order[n.first as usize..(n.first + n.count) as usize];
+            if a == b {
+                let items = items(na);
+                for (k, &i) in items.iter().enumerate() {
+                    for &j in &items[k + 1..] {
+                        if self.boxes[i as usize].overlaps(&self.boxes[j as usize]) {
+                            f(i, j);
+                        }
+                    }
+                }
+            } else if na.bounds.overlaps(&nb.bounds) {
+                for &i in items(na) {
+                    let bi = &self.boxes[i as usize];
+                    if !bi.overlaps(&nb.bounds) {
+                        continue;
+                    }
+                    for &j in items(nb) {
+                        if bi.overlaps(&self.boxes[j as usize]) {
+                            f(i, j);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// Calls `f` with every item whose box overlaps `q`.
     pub fn overlapping(&self, q: &Aabb, mut f: impl FnMut(u32)) {
         if self.nodes.is_empty() {
@@ -270,6 +363,46 @@ mod tests {
                 }
             })
             .collect()
+    }
+
+    /// The tree walked against itself finds every overlapping pair exactly once, whatever
+    /// the number of tasks it is split into, before and after a refit.
+    #[test]
+    fn self_overlaps_match_brute_force() {
+        for n in [0usize, 1, 3, 5, 700] {
+            let mut b = boxes(n);
+            let mut bvh = Bvh::build(&b);
+            for round in 0..2 {
+                let mut brute = Vec::new();
+                for i in 0..n as u32 {
+                    for j in i + 1..n as u32 {
+                        if b[i as usize].overlaps(&b[j as usize]) {
+                            brute.push((i, j));
+                        }
+                    }
+                }
+                assert!(
+                    n < 700 || brute.len() > 100,
+                    "the test meets overlaps: {}",
+                    brute.len()
+                );
+                for tasks in [1, 7, 64] {
+                    let mut found = Vec::new();
+                    for task in bvh.self_tasks(tasks) {
+                        bvh.self_overlapping(task, |i, j| found.push((i.min(j), i.max(j))));
+                    }
+                    found.sort_unstable();
+                    assert_eq!(found, brute, "{n} boxes, round {round}, {tasks} tasks");
+                }
+                for x in &mut b {
+                    *x = Aabb {
+                        min: x.min * 1.1 + Vec3::new(0.3, 0.0, 0.0),
+                        max: x.max * 1.1 + Vec3::new(0.3, 0.0, 0.0),
+                    };
+                }
+                bvh.refit(&b);
+            }
+        }
     }
 
     /// Overlap queries find exactly what a brute-force scan finds, before and after a refit.

@@ -2,7 +2,8 @@
 //! vertex and a triangle, and between two edges, that are not neighbours.
 //!
 //! **Pairs** are found with two [`Bvh`]s (the cloth's triangles and edges, refitted, never
-//! rebuilt) and kept in a list while they are within `thickness + skin` of each other; the
+//! rebuilt: a query per vertex into the triangles' tree, the edges' tree walked against
+//! itself, and cheap ball tests before the exact distances) and kept in a list while they are within `thickness + skin` of each other; the
 //! list is looked up again once some vertex has moved `skin / 2` since the last look (a Verlet
 //! list, `skin = thickness`). No pair outside the list can come within the thickness before
 //! the next look. Pairs nearer than 2.2 thicknesses at rest (neighbours of a fine mesh)
@@ -179,6 +180,33 @@ fn edge_edge(x: &[Vec3], e: &[u32; 2], f: &[u32; 2]) -> (f64, f64, f64, Vec3, Ve
     let (s, t) = closest_on_segments(&p0, &p1, &q0, &q1);
     let r = (p0 + s * (p1 - p0)) - (q0 + t * (q1 - q0));
     (r.norm(), s, t, r, (p1 - p0).cross(&(q1 - q0)))
+}
+
+/// Whether vertex `p` and triangle `t` of positions `x` are surely further than `reach` apart:
+/// the vertex's distance from the triangle's centroid less the farthest corner's is.
+#[inline]
+fn ball_apart(x: &[Vec3], p: u32, t: &[u32; 3], reach: f64) -> bool {
+    let [a, b, c] = t.map(|i| x[i as usize]);
+    let centre = (a + b + c) / 3.0;
+    let radius2 = (a - centre)
+        .norm_squared()
+        .max((b - centre).norm_squared())
+        .max((c - centre).norm_squared());
+    (x[p as usize] - centre).norm() - radius2.sqrt() >= reach
+}
+
+/// Whether edges `e` and `f` of positions `x` are surely further than `reach` apart: the
+/// distance of their midpoints less their half lengths (the balls around them) is.
+#[inline]
+fn balls_apart(x: &[Vec3], e: &[u32; 2], f: &[u32; 2], reach: f64) -> bool {
+    let (p0, p1, q0, q1) = (
+        x[e[0] as usize],
+        x[e[1] as usize],
+        x[f[0] as usize],
+        x[f[1] as usize],
+    );
+    let gap = 0.5 * ((p0 + p1) - (q0 + q1)).norm() - 0.5 * ((p1 - p0).norm() + (q1 - q0).norm());
+    gap >= reach
 }
 
 fn side(v: f64) -> i8 {
@@ -384,10 +412,12 @@ impl SelfCollision {
                     max: x[p as usize],
                 };
                 tri_bvh.overlapping(&q, |t| {
-                    if excluded.vertex_excludes(p, t) {
+                    let tri = &triangles[t as usize];
+                    // Cheap rejections first: its own triangles (always excluded), then
+                    // triangles whose enclosing ball is beyond reach.
+                    if tri.contains(&p) || ball_apart(x, p, tri, reach) || excluded.vertex_excludes(p, t) {
                         return;
                     }
-                    let tri = &triangles[t as usize];
                     let (d, w, r) = vertex_triangle(x, p, tri);
                     if d >= reach {
                         return;
@@ -414,32 +444,37 @@ impl SelfCollision {
             starts.iter().flat_map(|&lo| vertex_pairs(lo)).collect()
         };
         vt.sort_unstable();
-        let (edges, edge_bvh, edge_boxes) = (&self.edges, &self.edge_bvh, &self.edge_boxes);
-        let edge_pairs = |lo: usize| -> Vec<Pair> {
+        // Edge pairs from the edge tree walked against itself (each overlapping pair of boxes
+        // once), split into tasks for the pool on a large cloth.
+        let (edges, edge_bvh) = (&self.edges, &self.edge_bvh);
+        let edge_pairs = |task: &(u32, u32)| -> Vec<Pair> {
             let mut out = Vec::new();
-            for e in lo as u32..(lo + chunk).min(edges.len()) as u32 {
-                let edge = &edges[e as usize];
-                edge_bvh.overlapping(&edge_boxes[e as usize], |f| {
-                    if f <= e || excluded.edge_excludes(e, f) {
-                        return;
-                    }
-                    let other = &edges[f as usize];
-                    let (d, a, b, r, n) = edge_edge(x, edge, other);
-                    if d >= reach {
-                        return;
-                    }
-                    let interior = a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0;
-                    let s = remembered(&old_ee, e, f).unwrap_or(if interior { side(r.dot(&n)) } else { 0 });
-                    out.push((e, f, s));
-                });
-            }
+            edge_bvh.self_overlapping(*task, |i, j| {
+                let (e, f) = (i.min(j), i.max(j));
+                let (edge, other) = (&edges[e as usize], &edges[f as usize]);
+                // Cheap rejections first: edges sharing a vertex (always excluded), then
+                // edges whose enclosing balls are beyond reach.
+                if edge.iter().any(|v| other.contains(v)) || balls_apart(x, edge, other, reach) {
+                    return;
+                }
+                if excluded.edge_excludes(e, f) {
+                    return;
+                }
+                let (d, a, b, r, n) = edge_edge(x, edge, other);
+                if d >= reach {
+                    return;
+                }
+                let interior = a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0;
+                let s = remembered(&old_ee, e, f).unwrap_or(if interior { side(r.dot(&n)) } else { 0 });
+                out.push((e, f, s));
+            });
             out
         };
-        let starts: Vec<usize> = (0..edges.len()).step_by(chunk).collect();
+        let tasks = edge_bvh.self_tasks(if par { 64 } else { 1 });
         let mut ee: Vec<Pair> = if par {
-            starts.par_iter().flat_map_iter(|&lo| edge_pairs(lo)).collect()
+            tasks.par_iter().flat_map_iter(edge_pairs).collect()
         } else {
-            starts.iter().flat_map(|&lo| edge_pairs(lo)).collect()
+            tasks.iter().flat_map(edge_pairs).collect()
         };
         ee.sort_unstable();
         self.vertex_triangle = vt;
