@@ -371,7 +371,11 @@ fn the_2_hz_swing_with_self_collision_never_crosses_itself() {
     }
     println!("2 Hz 4 cm swing, 61 x 41: {worst} crossing pairs at worst, up to {pairs} vertex-triangle pairs in reach");
     assert_eq!(worst, 0, "no triangle pair crosses at any frame");
-    assert!(scene.cloth.positions().iter().all(|p| p.iter().all(|c| c.is_finite())));
+    assert!(scene
+        .cloth
+        .positions()
+        .iter()
+        .all(|p| p.iter().all(|c| c.is_finite())));
 }
 
 /// A refused step call leaves a cloth with collisions exactly as it was, self-collision's
