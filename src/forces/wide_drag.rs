@@ -18,7 +18,8 @@
 //! the rest mesh, [`pass_spread`]), and the mean squares of passes add, so a smoothing of rms
 //! radius `L` takes `L^2 / r1^2` passes: the same length on any mesh, at any resolution (and
 //! a cost that grows as `(L / spacing)^2`: 2 passes at 1 cm for the preset's 1.2 cm, 8 at
-//! 0.5 cm, at most [`MAX_PASSES`]).
+//! 0.5 cm, at most [`MAX_PASSES`]). A pass runs its rows in blocks of eight, one vector lane a
+//! row ([`Blocks`]), with the bits of the rows summed one by one.
 
 use crate::math::Vec3;
 use crate::model::Model;
@@ -39,13 +40,90 @@ struct Stencil {
     offsets: Vec<u32>,
     cols: Vec<u32>,
     weights: Vec<f64>,
+    /// The same rows in blocks of [`LANES`].
+    blocks: Blocks,
+}
+
+/// Rows a block holds (one vector of f64 at AVX-512).
+const LANES: usize = 8;
+
+/// The rows of a [`Stencil`] in blocks of [`LANES`]: block b holds as many entries a lane as its
+/// longest row (`starts[b] .. starts[b + 1]`, in units of a lane's entry); entry k of lane l at
+/// `(starts[b] + k) * LANES + l`. A shorter row is padded with weight 0 on column 0 after its
+/// entries, so each lane sums its row's entries in the row's order, then adds zeros: the bits
+/// of the rows summed one by one (`x + 0 = x`), in a shape the vector unit takes whole.
+#[derive(Clone, Debug, Default)]
+struct Blocks {
+    starts: Vec<u32>,
+    cols: Vec<u32>,
+    weights: Vec<f64>,
+}
+
+impl Blocks {
+    fn new(s: &Stencil) -> Self {
+        let n = s.offsets.len().saturating_sub(1);
+        let row = |i: usize| s.offsets[i] as usize..s.offsets[i + 1] as usize;
+        let mut b = Self {
+            starts: vec![0],
+            ..Self::default()
+        };
+        for first in (0..n).step_by(LANES) {
+            let rows = first..(first + LANES).min(n);
+            let width = rows.clone().map(|i| row(i).len()).max().unwrap_or(0);
+            let at = b.cols.len();
+            b.cols.resize(at + width * LANES, 0);
+            b.weights.resize(at + width * LANES, 0.0);
+            for i in rows {
+                for (k, e) in row(i).enumerate() {
+                    b.cols[at + k * LANES + i - first] = s.cols[e];
+                    b.weights[at + k * LANES + i - first] = s.weights[e];
+                }
+            }
+            b.starts.push((b.cols.len() / LANES) as u32);
+        }
+        b
+    }
+}
+
+crate::simd_dispatch! { fn blocks_widest(b: &Blocks, first: usize, u: &[f64], out: &mut [f64]) => apply_blocks }
+
+/// Rows `first ..` (a multiple of [`LANES`]) of `b` times `u`, into `out`; `u.len()` a power of
+/// two, so that a column masked by `u.len() - 1` (a no-op: every column is below it) needs no
+/// bounds check and the lanes load as one gather.
+#[inline(always)]
+fn apply_blocks(b: &Blocks, first: usize, u: &[f64], out: &mut [f64]) {
+    let mask = u.len() - 1;
+    let u = &u[..=mask];
+    for (k, o) in out.chunks_mut(LANES).enumerate() {
+        let block = first / LANES + k;
+        let (lo, hi) = (b.starts[block] as usize, b.starts[block + 1] as usize);
+        let cols = &b.cols[lo * LANES..hi * LANES];
+        let weights = &b.weights[lo * LANES..hi * LANES];
+        // Each lane's sum starts as an iterator's sum of f64 does (-0.0), so the first entry
+        // comes through exactly.
+        let mut acc = [-0.0f64; LANES];
+        for (c, w) in cols.chunks_exact(LANES).zip(weights.chunks_exact(LANES)) {
+            let c: &[u32; LANES] = c.try_into().expect("a lane's entries");
+            let w: &[f64; LANES] = w.try_into().expect("a lane's entries");
+            for l in 0..LANES {
+                acc[l] += w[l] * u[c[l] as usize & mask];
+            }
+        }
+        o.copy_from_slice(&acc[..o.len()]);
+    }
 }
 
 impl Stencil {
     /// `out = rows . u`; each row alone, so a large cloth spreads them over the pool with the
-    /// same bits.
+    /// same bits. `u` may be longer than `out` (padded to a power of two, see [`Blocks`]).
     fn apply(&self, u: &[f64], out: &mut [f64]) {
         let parallel = crate::parallel::worth_it(out.len());
+        if u.len().is_power_of_two() && self.blocks.starts.len() == out.len().div_ceil(LANES) + 1 {
+            crate::parallel::chunks(parallel, out, crate::parallel::CHUNK, |first, chunk| {
+                blocks_widest(&self.blocks, first, u, chunk)
+            });
+            return;
+        }
         crate::parallel::chunks(parallel, out, crate::parallel::CHUNK, |first, chunk| {
             for (k, o) in chunk.iter_mut().enumerate() {
                 let i = first + k;
@@ -81,6 +159,7 @@ impl Stencil {
             }
             s.offsets.push(s.cols.len() as u32);
         }
+        s.blocks = Blocks::new(&s);
         s
     }
 }
@@ -182,12 +261,18 @@ fn pass_spread(t: &Topology, s: &Stencil) -> f64 {
 /// `u <- S u` (`transpose`: `u <- S^T u`): the whole passes, then the partial one,
 /// `(1 - p) u + p S1 u`. `S^T` applies the transposed passes in reverse order.
 fn apply(w: &RestWeights, transpose: bool, u: &mut Vec<f64>, b: &mut Vec<f64>) {
-    b.resize(u.len(), 0.0);
+    // Both buffers padded with zeros to a power of two (the blocked rows read `u` without
+    // bounds checks, [`Blocks`]); the rows write the first `n`, the padding stays zero.
+    let n = u.len();
+    let padded = n.next_power_of_two();
+    u.resize(padded, 0.0);
+    b.clear();
+    b.resize(padded, 0.0);
     let one = if transpose { &w.backward } else { &w.forward };
     let partial = |u: &mut Vec<f64>, b: &mut Vec<f64>| {
         if w.partial > 0.0 {
-            one.apply(u, b);
-            for (ui, bi) in u.iter_mut().zip(b.iter()) {
+            one.apply(u, &mut b[..n]);
+            for (ui, bi) in u[..n].iter_mut().zip(&b[..n]) {
                 *ui += w.partial * (bi - *ui);
             }
         }
@@ -196,12 +281,13 @@ fn apply(w: &RestWeights, transpose: bool, u: &mut Vec<f64>, b: &mut Vec<f64>) {
         partial(u, b);
     }
     for _ in 0..w.passes {
-        one.apply(u, b);
+        one.apply(u, &mut b[..n]);
         std::mem::swap(u, b);
     }
     if !transpose {
         partial(u, b);
     }
+    u.truncate(n);
 }
 
 /// Whether the form drag of `m` acts on the smoothed normal velocity (this module) rather than
@@ -256,6 +342,67 @@ mod tests {
         }
         .build()
         .expect("a grid")
+    }
+
+    /// A fan of 13 triangles around a centre vertex and a ring, then a strip: rows of 3 to 14
+    /// entries, blocks of mixed widths.
+    fn fan() -> Topology {
+        use crate::topology::{MeshMass, MeshSpec};
+        let k = 13u32;
+        let mut positions = vec![Vec3::zeros()];
+        for i in 0..k {
+            let a = std::f64::consts::TAU * f64::from(i) / f64::from(k);
+            positions.push(Vec3::new(0.02 * a.cos(), 0.02 * a.sin(), 0.0));
+            positions.push(Vec3::new(
+                0.035 * a.cos(),
+                0.035 * a.sin(),
+                0.001 * f64::from(i % 3),
+            ));
+        }
+        let mut indices = Vec::new();
+        for i in 0..k {
+            let (r0, r1) = (1 + 2 * i, 1 + 2 * ((i + 1) % k));
+            indices.extend([0, r0, r1]);
+            indices.extend([r0, r0 + 1, r1]);
+        }
+        MeshSpec {
+            positions: &positions,
+            indices: &indices,
+            face_size: 3,
+            mass: MeshMass::Total(0.01),
+        }
+        .build()
+        .expect("a fan")
+    }
+
+    /// The blocked rows give the bits of the rows summed one by one, on a grid (rows of 7) and
+    /// on a fan whose centre has 14 entries beside rows of 4-6, for any values (signed zeros
+    /// too).
+    #[test]
+    fn blocked_rows_give_the_bits_of_the_rows() {
+        for t in [grid(13, 9, 0.01), fan()] {
+            let s = one_pass(&t);
+            let n = t.vertex_count();
+            let widths: Vec<u32> = s.blocks.starts.windows(2).map(|w| w[1] - w[0]).collect();
+            let mut u: Vec<f64> = (0..n).map(|i| ((i * 7919 % 101) as f64 - 50.0) * 0.013).collect();
+            u[1] = -0.0;
+            u[2] = 0.0;
+            let mut padded = u.clone();
+            padded.resize(n.next_power_of_two(), 0.0);
+            let (mut by_rows, mut by_blocks) = (vec![0.0; n], vec![0.0; n]);
+            s.apply(&u, &mut by_rows);
+            assert!(
+                !u.len().is_power_of_two(),
+                "the rows' path is the one tested against"
+            );
+            s.apply(&padded, &mut by_blocks);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&by_rows), bits(&by_blocks), "widths {widths:?}");
+            assert!(
+                widths.iter().any(|&w| w != widths[0]),
+                "blocks of mixed widths: {widths:?}"
+            );
+        }
     }
 
     #[test]
