@@ -40,8 +40,6 @@ struct Stencil {
     offsets: Vec<u32>,
     cols: Vec<u32>,
     weights: Vec<f64>,
-    /// The same rows in blocks of [`LANES`].
-    blocks: Blocks,
 }
 
 /// Rows a block holds (one vector of f64 at AVX-512).
@@ -54,6 +52,8 @@ const LANES: usize = 8;
 /// of the rows summed one by one (`x + 0 = x`), in a shape the vector unit takes whole.
 #[derive(Clone, Debug, Default)]
 struct Blocks {
+    /// Rows.
+    rows: usize,
     starts: Vec<u32>,
     cols: Vec<u32>,
     weights: Vec<f64>,
@@ -64,6 +64,7 @@ impl Blocks {
         let n = s.offsets.len().saturating_sub(1);
         let row = |i: usize| s.offsets[i] as usize..s.offsets[i + 1] as usize;
         let mut b = Self {
+            rows: n,
             starts: vec![0],
             ..Self::default()
         };
@@ -113,28 +114,31 @@ fn apply_blocks(b: &Blocks, first: usize, u: &[f64], out: &mut [f64]) {
     }
 }
 
-impl Stencil {
-    /// `out = rows . u`; each row alone, so a large cloth spreads them over the pool with the
-    /// same bits. `u` may be longer than `out` (padded to a power of two, see [`Blocks`]).
+impl Blocks {
+    /// `out = rows . u`, `u` padded with zeros to a power of two (at least `out.len()`); rows in
+    /// chunks, so a large cloth spreads them over the pool with the same bits.
     fn apply(&self, u: &[f64], out: &mut [f64]) {
+        debug_assert!(u.len().is_power_of_two() && u.len() >= out.len());
         let parallel = crate::parallel::worth_it(out.len());
-        if u.len().is_power_of_two() && self.blocks.starts.len() == out.len().div_ceil(LANES) + 1 {
-            crate::parallel::chunks(parallel, out, crate::parallel::CHUNK, |first, chunk| {
-                blocks_widest(&self.blocks, first, u, chunk)
-            });
-            return;
-        }
         crate::parallel::chunks(parallel, out, crate::parallel::CHUNK, |first, chunk| {
-            for (k, o) in chunk.iter_mut().enumerate() {
-                let i = first + k;
-                let (a, b) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
-                *o = self.cols[a..b]
-                    .iter()
-                    .zip(&self.weights[a..b])
-                    .map(|(&j, w)| w * u[j as usize])
-                    .sum();
-            }
+            blocks_widest(self, first, u, chunk)
         });
+    }
+}
+
+impl Stencil {
+    /// `out = rows . u`, each row summed in order: the reference [`Blocks::apply`] is tested
+    /// against.
+    #[cfg(test)]
+    fn apply(&self, u: &[f64], out: &mut [f64]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            let (a, b) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
+            *o = self.cols[a..b]
+                .iter()
+                .zip(&self.weights[a..b])
+                .map(|(&j, w)| w * u[j as usize])
+                .sum();
+        }
     }
 
     /// The transposed rows, each in ascending column order.
@@ -159,7 +163,6 @@ impl Stencil {
             }
             s.offsets.push(s.cols.len() as u32);
         }
-        s.blocks = Blocks::new(&s);
         s
     }
 }
@@ -168,8 +171,8 @@ impl Stencil {
 #[derive(Clone, Debug)]
 struct RestWeights {
     /// One pass ([`one_pass`]) and its transpose.
-    forward: Stencil,
-    backward: Stencil,
+    forward: Blocks,
+    backward: Blocks,
     /// Whole passes and the weight of the last partial one, for the model's length.
     passes: usize,
     partial: f64,
@@ -192,8 +195,8 @@ impl RestWeights {
         };
         let passes = total.floor();
         Self {
-            backward: forward.transpose(t.vertex_count()),
-            forward,
+            backward: Blocks::new(&forward.transpose(t.vertex_count())),
+            forward: Blocks::new(&forward),
             passes: passes as usize,
             partial: total - passes,
             length,
@@ -312,7 +315,7 @@ pub fn add_wide_form_drag(
     let WideDragScratch { a, b, rest } = scratch;
     let length = m.water.form_drag_scale;
     let w = match rest {
-        Some(w) if w.length == length && w.forward.offsets.len() == normals.len() + 1 => w,
+        Some(w) if w.length == length && w.forward.rows == normals.len() => w,
         _ => rest.insert(RestWeights::new(t, length)),
     };
     a.clear();
@@ -382,8 +385,9 @@ mod tests {
     fn blocked_rows_give_the_bits_of_the_rows() {
         for t in [grid(13, 9, 0.01), fan()] {
             let s = one_pass(&t);
+            let blocks = Blocks::new(&s);
             let n = t.vertex_count();
-            let widths: Vec<u32> = s.blocks.starts.windows(2).map(|w| w[1] - w[0]).collect();
+            let widths: Vec<u32> = blocks.starts.windows(2).map(|w| w[1] - w[0]).collect();
             let mut u: Vec<f64> = (0..n).map(|i| ((i * 7919 % 101) as f64 - 50.0) * 0.013).collect();
             u[1] = -0.0;
             u[2] = 0.0;
