@@ -47,9 +47,11 @@ const LANES: usize = 8;
 
 /// The rows of a [`Stencil`] in blocks of [`LANES`]: block b holds as many entries a lane as its
 /// longest row (`starts[b] .. starts[b + 1]`, in units of a lane's entry); entry k of lane l at
-/// `(starts[b] + k) * LANES + l`. A shorter row is padded with weight 0 on column 0 after its
-/// entries, so each lane sums its row's entries in the row's order, then adds zeros: the bits
-/// of the rows summed one by one (`x + 0 = x`), in a shape the vector unit takes whole.
+/// `(starts[b] + k) * LANES + l`. A shorter row is padded after its entries with weight 0 on
+/// column `rows`, the first slot of the values' padding, which holds -0.0 ([`apply`]): each lane
+/// sums its row's entries in the row's order and then adds `0 x -0.0 = -0.0`, which leaves any
+/// sum as it is, a zero's sign included: the bits of the rows summed one by one, in a shape the
+/// vector unit takes whole.
 #[derive(Clone, Debug, Default)]
 struct Blocks {
     /// Rows.
@@ -72,7 +74,7 @@ impl Blocks {
             let rows = first..(first + LANES).min(n);
             let width = rows.clone().map(|i| row(i).len()).max().unwrap_or(0);
             let at = b.cols.len();
-            b.cols.resize(at + width * LANES, 0);
+            b.cols.resize(at + width * LANES, n as u32);
             b.weights.resize(at + width * LANES, 0.0);
             for i in rows {
                 for (k, e) in row(i).enumerate() {
@@ -264,13 +266,14 @@ fn pass_spread(t: &Topology, s: &Stencil) -> f64 {
 /// `u <- S u` (`transpose`: `u <- S^T u`): the whole passes, then the partial one,
 /// `(1 - p) u + p S1 u`. `S^T` applies the transposed passes in reverse order.
 fn apply(w: &RestWeights, transpose: bool, u: &mut Vec<f64>, b: &mut Vec<f64>) {
-    // Both buffers padded with zeros to a power of two (the blocked rows read `u` without
-    // bounds checks, [`Blocks`]); the rows write the first `n`, the padding stays zero.
+    // Both buffers padded with -0.0 to a power of two above `n` (the blocked rows read `u`
+    // without bounds checks and their padding entries read slot `n`, [`Blocks`]); the rows
+    // write the first `n`, the padding stays -0.0.
     let n = u.len();
-    let padded = n.next_power_of_two();
-    u.resize(padded, 0.0);
+    let padded = (n + 1).next_power_of_two();
+    u.resize(padded, -0.0);
     b.clear();
-    b.resize(padded, 0.0);
+    b.resize(padded, -0.0);
     let one = if transpose { &w.backward } else { &w.forward };
     let partial = |u: &mut Vec<f64>, b: &mut Vec<f64>| {
         if w.partial > 0.0 {
@@ -388,20 +391,22 @@ mod tests {
             let blocks = Blocks::new(&s);
             let n = t.vertex_count();
             let widths: Vec<u32> = blocks.starts.windows(2).map(|w| w[1] - w[0]).collect();
-            let mut u: Vec<f64> = (0..n).map(|i| ((i * 7919 % 101) as f64 - 50.0) * 0.013).collect();
-            u[1] = -0.0;
-            u[2] = 0.0;
-            let mut padded = u.clone();
-            padded.resize(n.next_power_of_two(), 0.0);
-            let (mut by_rows, mut by_blocks) = (vec![0.0; n], vec![0.0; n]);
-            s.apply(&u, &mut by_rows);
-            assert!(
-                !u.len().is_power_of_two(),
-                "the rows' path is the one tested against"
-            );
-            s.apply(&padded, &mut by_blocks);
-            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!(bits(&by_rows), bits(&by_blocks), "widths {widths:?}");
+            // Mixed values with signed zeros, and values all -0.0 but one: rows that sum to -0.0
+            // beside rows that do not.
+            let mut mixed: Vec<f64> = (0..n).map(|i| ((i * 7919 % 101) as f64 - 50.0) * 0.013).collect();
+            mixed[1] = -0.0;
+            mixed[2] = 0.0;
+            let mut zeros = vec![-0.0; n];
+            zeros[0] = 1.0;
+            for u in [mixed, zeros] {
+                let mut padded = u.clone();
+                padded.resize((n + 1).next_power_of_two(), -0.0);
+                let (mut by_rows, mut by_blocks) = (vec![0.0; n], vec![0.0; n]);
+                s.apply(&u, &mut by_rows);
+                blocks.apply(&padded, &mut by_blocks);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&by_rows), bits(&by_blocks), "widths {widths:?}");
+            }
             assert!(
                 widths.iter().any(|&w| w != widths[0]),
                 "blocks of mixed widths: {widths:?}"
