@@ -1,5 +1,5 @@
 //! Closest points and crossings between points, segments and triangles: the exact geometry
-//! every collision pass and every intersection count is built on.
+//! every collision pass and every intersection count is built on; and a triangle list's edges.
 //!
 //! Closest point on a triangle: Ericson, *Real-Time Collision Detection* (2005), 5.1.5, by
 //! Voronoi regions; closest points of two segments: the same book, 5.1.9. The crossing tests
@@ -7,6 +7,17 @@
 //! opposite sides of the triangle's plane and the crossing point is inside the triangle.
 
 use crate::math::Vec3;
+
+/// The unique edges of some triangles, `[i, j]` with i < j, sorted.
+pub fn edges_of(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut e: Vec<[u32; 2]> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| [t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])]))
+        .collect();
+    e.sort_unstable();
+    e.dedup();
+    e
+}
 
 /// Closest point of triangle `(a, b, c)` to `p`, as barycentric weights `[wa, wb, wc]` (each in
 /// [0, 1], summing to 1). A degenerate triangle gives the closest point of its longest edge.

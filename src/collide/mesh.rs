@@ -33,7 +33,7 @@
 
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
-use super::geometry::{closest_on_segments, closest_on_triangle};
+use super::geometry::{closest_on_segments, closest_on_triangle, edges_of};
 use crate::error::Error;
 use crate::math::Vec3;
 
@@ -560,7 +560,7 @@ impl MeshCollider {
         if all {
             // The cloth's edges once (a moving mesh makes every call `all`).
             if c.triangle.len() != cloth_triangles.len() || c.cloth_edges.is_empty() {
-                c.cloth_edges = unique_edges(cloth_triangles);
+                c.cloth_edges = edges_of(cloth_triangles);
             }
             c.vertex.resize_with(x.len(), Vec::new);
             c.vertex_at.resize(x.len(), Vec3::zeros());
@@ -621,18 +621,6 @@ impl MeshCollider {
             self.edge_bvh.overlapping(&q, |m| list.push(m));
         }
     }
-}
-
-/// Every edge of `triangles` once, its ends in ascending order, sorted.
-fn unique_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let mut edges: Vec<[u32; 2]> = triangles
-        .iter()
-        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
-        .map(|[a, b]| [a.min(b), a.max(b)])
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    edges
 }
 
 /// Signed volume enclosed by closed triangles (positive when they face outward).
@@ -751,7 +739,8 @@ mod tests {
         assert!(out[0].dir.y > 0.9);
     }
 
-    /// A mesh vertex within the margin of a cloth triangle pushes the triangle's vertices.
+    /// A mesh's borders and its folds sharper than the threshold are active edges; an edge
+    /// between two faces in one plane is not.
     #[test]
     fn borders_and_folds_are_active_edges_and_flat_ones_are_not() {
         // A square of two triangles folded along its diagonal: flat, then at 90 degrees.
@@ -791,6 +780,7 @@ mod tests {
         assert_eq!(m.edges.len(), 4, "{:?}", m.edges);
     }
 
+    /// A mesh vertex within the margin of a cloth triangle pushes the triangle's vertices.
     #[test]
     fn a_thin_bar_pushes_the_cloth_triangle_it_is_under() {
         let (x, t) = bar(Vec3::new(0.3, 0.3, -1.0), Vec3::new(0.3, 0.3, 1.0), 0.002, 2);

@@ -22,7 +22,7 @@
 
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
-use super::geometry::{closest_on_segments, closest_on_triangle};
+use super::geometry::{closest_on_segments, closest_on_triangle, edges_of};
 use crate::math::Vec3;
 
 /// The skin of the pair list, in thicknesses: pairs within `(1 + SKIN)` thicknesses are kept,
@@ -145,17 +145,6 @@ impl Exclusions {
         );
         self.ee[a..b].binary_search(&f).is_ok()
     }
-}
-
-/// The unique edges of some triangles, `[i, j]` with i < j, sorted.
-pub fn edges_of(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let mut e: Vec<[u32; 2]> = triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| [t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])]))
-        .collect();
-    e.sort_unstable();
-    e.dedup();
-    e
 }
 
 /// Distance between vertex `p` and triangle `t` of positions `x`, with the weights and the

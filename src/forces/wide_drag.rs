@@ -272,8 +272,9 @@ fn apply(w: &RestWeights, transpose: bool, u: &mut Vec<f64>, b: &mut Vec<f64>) {
     let n = u.len();
     let padded = (n + 1).next_power_of_two();
     u.resize(padded, -0.0);
-    b.clear();
+    // `b`'s first `n` are written before they are read; only its padding must be -0.0.
     b.resize(padded, -0.0);
+    b[n..].fill(-0.0);
     let one = if transpose { &w.backward } else { &w.forward };
     let partial = |u: &mut Vec<f64>, b: &mut Vec<f64>| {
         if w.partial > 0.0 {
