@@ -462,3 +462,57 @@ fn a_colliders_own_margin_keeps_the_cloth_further_off() {
         assert_eq!(own.positions(), resumed.positions());
     }
 }
+
+/// The underwater swing (0.5 Hz, 4 cm, 61 x 41, symplectic Euler at the automatic step) against
+/// a 10k-triangle ball, finer than the cloth, that touches the towel where it starts: no frame
+/// is refused (the contacts' stiffness is in the step's estimate, and a mesh finer than the
+/// cloth does not push a triangle once per mesh vertex under it), no vertex ends up inside the
+/// ball, and the towel does touch it.
+#[test]
+fn a_towel_against_a_fine_ball_bakes_without_a_refused_frame() {
+    use fraccloth::collide::shapes::uv_sphere;
+    use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
+    let drive = Drive {
+        amplitude: 0.04,
+        frequency: 0.5,
+        ..Drive::of(SceneKind::Swing, Variant::Underwater)
+    };
+    let spec = SceneSpec {
+        width: 61,
+        height: 41,
+        drive,
+        dt: 1.0 / FPS,
+        max_substep: fraccloth::cloth::AUTO,
+        integrator: Integrator::SymplecticEuler,
+        model: Some(Model::underwater()),
+        ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
+    };
+    let mut scene = spec.build().unwrap();
+    let (centre, radius) = (Vec3::new(0.3, -0.3, 0.1), 0.1);
+    let (x, t) = uv_sphere(centre, radius, 100, 51);
+    assert!(t.len() >= 10_000);
+    scene.cloth.add_mesh_collider(&x, &t, None).unwrap();
+    let distance = |x: &[Vec3]| {
+        x.iter()
+            .map(|p| (p - centre).norm() - radius)
+            .fold(f64::INFINITY, f64::min)
+    };
+    // It starts within the margin (1 cm) of the ball: in contact.
+    let margin = scene.cloth.config().model.collision_margin;
+    let start = distance(scene.cloth.positions());
+    assert!(start < 0.5 * margin, "the towel starts {start} m from the ball");
+    let mut refused = Vec::new();
+    for f in 1..=60 {
+        scene.run_until(f as f64 / FPS).unwrap();
+        let stats = scene.cloth.step_stats();
+        if stats.retries > 0 {
+            refused.push((f, stats.retries, stats.substeps));
+        }
+        let inside = vertices_inside(scene.cloth.positions(), &x, &t);
+        assert_eq!(inside, 0, "frame {f}: {inside} vertices inside the ball");
+    }
+    assert!(
+        refused.is_empty(),
+        "refused frames (frame, retries, substeps): {refused:?}"
+    );
+}

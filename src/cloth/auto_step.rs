@@ -106,6 +106,7 @@ impl Cloth {
     /// Advances by `dt` with the automatic step (module docs).
     pub(super) fn step_auto(&mut self, dt: f64) -> Result<(), crate::error::Error> {
         use crate::error::ErrorKind;
+        self.measure_contact_weights();
         let h = self.auto_substep(dt);
         let limit = f64::from(super::MAX_SUBSTEPS);
         let mut n = if h > 0.0 {
@@ -145,13 +146,15 @@ impl Cloth {
     }
 
     /// The automatic step's substep for a call of `dt` seconds whose pins end at their
-    /// targets: [`safety`] times the smallest bound (module docs), never above `dt`.
+    /// targets: [`safety`] times the smallest bound (module docs), never above `dt`, with the
+    /// mesh contacts measured as the last automatic step began.
     pub fn auto_substep(&self, dt: f64) -> f64 {
+        let weight = &self.scratch.contact_weight;
         // Fractional damping's current-rate weight grows as h^{1/2}: the bound at the bound.
-        let mut h = self.substep_bound(dt, 0.0);
+        let mut h = self.substep_bound(dt, 0.0, weight);
         if self.fractional_damping() {
             for _ in 0..3 {
-                h = self.substep_bound(dt, h);
+                h = self.substep_bound(dt, h, weight);
             }
         }
         (safety(self.config.integrator) * h).min(dt)
@@ -164,8 +167,9 @@ impl Cloth {
     }
 
     /// The smallest bound over the particles and pins (module docs); `h` the step at which the
-    /// half-derivative's current-rate weight `h^{1/2} / Gamma(3/2)` is taken (0: none).
-    fn substep_bound(&self, dt: f64, h: f64) -> f64 {
+    /// half-derivative's current-rate weight `h^{1/2} / Gamma(3/2)` is taken (0: none);
+    /// `weight` each vertex's contact weight (`Cloth::measure_contact_weights`; empty: none).
+    fn substep_bound(&self, dt: f64, h: f64, weight: &[f64]) -> f64 {
         let w0 = h.sqrt() / GAMMA_3_2;
         let m = &self.config.model;
         let t = &self.topology;
@@ -212,9 +216,13 @@ impl Cloth {
                 / mass;
             let mut omega2 = 2.0 * k / mass;
             let mut gamma = 2.0 * c / mass + drag;
-            if !self.colliders.is_empty() {
-                omega2 += m.collision_stiffness / mass;
-                gamma += m.collision_damping / mass;
+            // Contacts: every vertex may touch an analytic collider; the mesh colliders' and
+            // self-collision's by their weight.
+            let touch =
+                f64::from(u8::from(!self.colliders.is_empty())) + weight.get(i).copied().unwrap_or(0.0);
+            if touch > 0.0 {
+                omega2 += touch * m.collision_stiffness / mass;
+                gamma += touch * m.collision_damping / mass;
             }
             if !implicit {
                 bound = bound.min(oscillator * symplectic_bound(omega2, gamma));

@@ -79,6 +79,46 @@ impl Cloth {
         (margin, MESH_SKIN_MARGINS * margin)
     }
 
+    /// Each vertex's contact weight for the automatic step, in units of `collision_stiffness`
+    /// (and `collision_damping`), into `scratch.contact_weight` (left empty when nothing
+    /// touches): Gershgorin's bound on the contacts' row of the stiffness matrix,
+    /// `sum_e |c_j| sum_l |c_l|`, for the mesh colliders' contacts where the cloth and the meshes
+    /// are as the call begins (a function of the state, so a resumed snapshot steps alike). A
+    /// contact that begins within the call is not foreseen, nor are self-collision's (a
+    /// crumpled cloth's many pairs would make the bound far smaller than the step it needs,
+    /// measured): a frame they make unstable is retried with more substeps.
+    pub(super) fn measure_contact_weights(&mut self) {
+        let s = &mut self.scratch;
+        s.contact_weight.clear();
+        s.start_contacts.clear();
+        let model_margin = self.config.model.collision_margin;
+        for mesh in self.mesh_slots.iter_mut().flatten() {
+            let (margin, skin) = Self::mesh_reach(model_margin, mesh);
+            mesh.refresh(margin + skin);
+            mesh.contacts(
+                &self.x,
+                &self.topology.triangles,
+                0.0,
+                margin,
+                skin,
+                MESH_MAX_DEPTH_MARGINS * margin,
+                &mut s.start_contacts,
+            );
+        }
+        if s.start_contacts.is_empty() {
+            return;
+        }
+        s.contact_weight.resize(self.x.len(), 0.0);
+        for e in &s.start_contacts {
+            let sum: f64 = e.terms().map(|(_, c)| c.abs()).sum();
+            for (j, c) in e.terms() {
+                if let Some(w) = s.contact_weight.get_mut(j) {
+                    *w += c.abs() * sum;
+                }
+            }
+        }
+    }
+
     /// A step call of `dt` seconds begins: each mesh collider's velocities and swept boxes.
     pub(super) fn begin_collider_motion(&mut self, dt: f64) {
         let model_margin = self.config.model.collision_margin;

@@ -106,6 +106,10 @@ pub(super) struct StepScratch {
     pub prior_forces: Vec<Vec3>,
     /// The collision pass's contact elements (mesh colliders, self-collision).
     pub contacts: Vec<crate::collide::Contact>,
+    /// The mesh colliders' contacts where a call begins, and each vertex's weight from them
+    /// (`Cloth::measure_contact_weights`; empty without contacts).
+    pub start_contacts: Vec<crate::collide::Contact>,
+    pub contact_weight: Vec<f64>,
     pub turning: forces::TurningScratch,
     /// The wide form drag's buffers and rest weights.
     pub wide_drag: forces::WideDragScratch,

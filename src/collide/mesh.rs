@@ -12,10 +12,15 @@
 //!   (every edge shared by two triangles) the side comes from the angle-weighted pseudo-normal
 //!   of the nearest feature (Baerentzen & Aanaes 2005), so a vertex that ends up inside is
 //!   pushed out along it, however deep (a vertex found inside no triangle's reach is matched
-//!   to the nearest triangle of the whole mesh); an open mesh is a two-sided shell.
+//!   to the nearest triangle of the whole mesh, looked up again at every substep; one deeper
+//!   than the reach but within some triangle's box is pushed along the nearest of those, not
+//!   always the shortest way out); an open mesh is a two-sided shell.
 //! - *mesh vertex against cloth triangle*: a mesh vertex within the margin of a cloth triangle
-//!   pushes the triangle's three vertices by their barycentric weights, so a collider thinner
-//!   than the cloth's spacing (a bar, a fin, a finger tip) cannot slip between cloth vertices.
+//!   none of whose corners touches the mesh already pushes the triangle's three vertices by
+//!   their barycentric weights, so a collider thinner than the cloth's spacing (a bar, a fin, a
+//!   finger tip) cannot slip between cloth vertices; where a corner touches, its vertex contact
+//!   holds the triangle (else a finely tessellated mesh would push a triangle once per mesh
+//!   vertex under it: a contact stiffness that grew with the mesh's resolution).
 //! - *mesh edge against cloth edge*: where the nearest points of a mesh edge and a cloth edge
 //!   lie inside both (not at an end) and within the margin, and neither cloth vertex touches
 //!   the mesh already, the cloth edge's two vertices are pushed by their weights: a thin
@@ -36,6 +41,7 @@ use super::contact::Contact;
 use super::geometry::{closest_on_segments, closest_on_triangle, edges_of};
 use crate::error::Error;
 use crate::math::Vec3;
+use crate::topology::Adjacency;
 
 const NONE: u32 = u32::MAX;
 
@@ -78,24 +84,51 @@ pub struct MeshCollider {
     cache: Candidates,
 }
 
-/// Each cloth vertex's and triangle's candidates (see the module docs).
+/// Each cloth vertex's, triangle's and edge's candidates (see the module docs), and which of
+/// them have any (the contact loops visit only those, in ascending order).
 #[derive(Clone, Debug, Default)]
 struct Candidates {
     vertex: Vec<Vec<u32>>,
     vertex_at: Vec<Vec3>,
     triangle: Vec<Vec<u32>>,
-    triangle_at: Vec<Vec3>,
     /// The cloth's edges (each once) and each one's candidate mesh edges.
     cloth_edges: Vec<[u32; 2]>,
     edge: Vec<Vec<u32>>,
-    edge_at: Vec<Vec3>,
+    /// The cloth's triangles and edges of each vertex (a triangle or edge looks again when
+    /// one of its vertices does).
+    vertex_triangles: Adjacency,
+    vertex_edges: Adjacency,
+    /// The vertices, triangles and edges with candidates, ascending.
+    with_vertex: Vec<u32>,
+    with_triangle: Vec<u32>,
+    with_edge: Vec<u32>,
+    /// Vertices, triangles and edges that look again at this substep.
+    looked: Vec<u32>,
+    dirty_triangles: Vec<u32>,
+    dirty_edges: Vec<u32>,
     /// Each cloth vertex's nearest triangle at the last substep (tested first).
     nearest: Vec<u32>,
     /// Whether each cloth vertex touches the mesh at this substep (its edges then need no
-    /// edge contact).
+    /// edge contact), and the vertices set.
     touching: Vec<bool>,
+    touched: Vec<u32>,
     /// Every list must be looked up again (the mesh moved, or the cloth changed).
     stale: bool,
+}
+
+/// Updates `with` (ascending indices of non-empty `lists`) after the lists of `changed` were
+/// looked up again.
+fn update_with(with: &mut Vec<u32>, lists: &[Vec<u32>], changed: &[u32]) {
+    if changed.is_empty() {
+        return;
+    }
+    with.retain(|&k| !lists[k as usize].is_empty());
+    let before = with.len();
+    with.extend(changed.iter().filter(|&&k| !lists[k as usize].is_empty()));
+    if with.len() > before {
+        with.sort_unstable();
+        with.dedup();
+    }
 }
 
 fn check_points(what: &str, p: &[Vec3]) -> Result<(), Error> {
@@ -367,27 +400,14 @@ impl MeshCollider {
 
     /// Outward pseudo-normal of the feature of triangle `t` at barycentric weights `w`.
     fn pseudo_normal(&self, t: u32, w: [f64; 3]) -> Vec3 {
-        let tri = &self.triangles[t as usize];
-        let face = self.face_normal[t as usize];
-        match [w[0] <= 0.0, w[1] <= 0.0, w[2] <= 0.0] {
-            // On the edge opposite corner z: edge (z+1, z+2), which is edge index (z+1) % 3.
-            [true, false, false] | [false, true, false] | [false, false, true] => {
-                let z = w.iter().position(|&wk| wk <= 0.0).unwrap_or(0);
-                let o = self.neighbours[t as usize][(z + 1) % 3];
-                if o == NONE {
-                    face
-                } else {
-                    (face + self.face_normal[o as usize])
-                        .try_normalize(0.0)
-                        .unwrap_or(face)
-                }
-            }
-            // At the corner whose weight is not zero.
-            [false, true, true] => self.vertex_normal[tri[0] as usize],
-            [true, false, true] => self.vertex_normal[tri[1] as usize],
-            [true, true, false] => self.vertex_normal[tri[2] as usize],
-            _ => face,
-        }
+        pseudo_normal(
+            &self.triangles,
+            &self.neighbours,
+            &self.face_normal,
+            &self.vertex_normal,
+            t,
+            w,
+        )
     }
 
     /// Unsigned distance from triangle `t` (at fraction `f`) to `p`, the closest point's
@@ -434,26 +454,34 @@ impl MeshCollider {
         out: &mut Vec<Contact>,
     ) {
         self.refresh_candidates(x, cloth_triangles, margin, skin);
-        self.cache.nearest.resize(x.len(), NONE);
-        self.cache.touching.clear();
-        self.cache.touching.resize(x.len(), false);
+        let c = &mut self.cache;
+        c.nearest.resize(x.len(), NONE);
+        for &i in &c.touched {
+            c.touching[i as usize] = false;
+        }
+        c.touched.clear();
+        c.touching.resize(x.len(), false);
         let friction = self.friction;
         // Cloth vertex against the nearest mesh triangle.
-        for (i, cands) in self.cache.vertex.iter().enumerate() {
+        for &i in &self.cache.with_vertex {
+            let i = i as usize;
+            let cands = &self.cache.vertex[i];
             let p = &x[i];
             let mut best: Option<(f64, u32, [f64; 3], Vec3)> = None;
-            // The last nearest first; then only triangles whose swept box is nearer than the
-            // best so far (the box holds the triangle at every fraction of the call). Nearest
-            // by unsigned distance; the side only for the nearest.
+            // The last nearest first; then only triangles whose swept box is not farther than
+            // the best so far (the box holds the triangle at every fraction of the call).
+            // Nearest by unsigned distance, the lower index among equals (a point on an edge
+            // two triangles share is as near to both: the contact does not depend on the
+            // order they are tried in); the side only for the nearest.
             let hint = self.cache.nearest.get(i).copied().filter(|t| cands.contains(t));
             for &t in hint.iter().chain(cands.iter().filter(|&&t| Some(t) != hint)) {
                 if let Some(b) = &best {
-                    if self.tri_boxes[t as usize].distance2(p) >= b.0 * b.0 {
+                    if self.tri_boxes[t as usize].distance2(p) > b.0 * b.0 {
                         continue;
                     }
                 }
                 let (d, w, r) = self.nearest_on(t, f, p);
-                if best.is_none_or(|b| d < b.0) {
+                if best.is_none_or(|b| d < b.0 || (d == b.0 && t < b.1)) {
                     best = Some((d, t, w, r));
                 }
             }
@@ -464,6 +492,7 @@ impl MeshCollider {
                 let (d, dir) = self.signed(t, d, w, &r);
                 if d < margin {
                     self.cache.touching[i] = true;
+                    self.cache.touched.push(i as u32);
                     out.push(Contact {
                         idx: [i as u32, 0, 0, 0],
                         coef: [1.0, 0.0, 0.0, 0.0],
@@ -477,12 +506,15 @@ impl MeshCollider {
             }
         }
         // Mesh vertex against cloth triangle.
-        for (t, cands) in self.cache.triangle.iter().enumerate() {
-            // Most cloth triangles have no mesh vertex near: nothing to read for them.
-            if cands.is_empty() {
+        for &t in &self.cache.with_triangle {
+            let cands = &self.cache.triangle[t as usize];
+            let tri = cloth_triangles[t as usize];
+            // Where a corner touches the mesh already, its vertex contact holds the triangle:
+            // a finely tessellated mesh under the cloth would otherwise push each triangle once
+            // per mesh vertex under it, a stiffness that grows with the mesh's resolution.
+            if tri.iter().any(|&i| self.cache.touching[i as usize]) {
                 continue;
             }
-            let tri = cloth_triangles[t];
             let [a, b, c] = tri.map(|i| x[i as usize]);
             let near = Aabb::of([&a, &b, &c]).inflated(margin);
             for &m in cands {
@@ -516,11 +548,9 @@ impl MeshCollider {
         // end, a vertex contact above takes it) and neither cloth vertex touches the mesh
         // already: edge contacts catch what the vertices miss (a thin collider between them),
         // and do not double the push where the cloth lies on the mesh.
-        for (e, cands) in self.cache.edge.iter().enumerate() {
-            if cands.is_empty() {
-                continue;
-            }
-            let [i0, i1] = self.cache.cloth_edges[e];
+        for &e in &self.cache.with_edge {
+            let cands = &self.cache.edge[e as usize];
+            let [i0, i1] = self.cache.cloth_edges[e as usize];
             if self.cache.touching[i0 as usize] || self.cache.touching[i1 as usize] {
                 continue;
             }
@@ -551,27 +581,34 @@ impl MeshCollider {
         }
     }
 
-    /// Looks up again the candidates of every cloth vertex and triangle that moved more than
-    /// `skin / 2` since it last looked (all of them after the mesh moved).
+    /// Looks up again the candidates of every cloth vertex that moved more than `skin / 2`
+    /// since it last looked, and of its triangles and edges (all of them after the mesh moved).
+    /// A triangle's (edge's) vertices have then moved at most `skin` since it looked (each
+    /// at most `skin / 2` since its own look, which was no later), which its query's `skin` and
+    /// the mesh's boxes' `reach` cover.
     fn refresh_candidates(&mut self, x: &[Vec3], cloth_triangles: &[[u32; 3]], margin: f64, skin: f64) {
         let reach = margin + skin;
         let c = &mut self.cache;
-        let all = c.stale || c.vertex.len() != x.len() || c.triangle.len() != cloth_triangles.len();
+        let resized = c.vertex.len() != x.len() || c.triangle.len() != cloth_triangles.len();
+        if resized || c.cloth_edges.is_empty() {
+            // The cloth's edges and incidences once (a moving mesh makes every call `all`).
+            c.cloth_edges = edges_of(cloth_triangles);
+            c.vertex_triangles = Adjacency::triangles(x.len(), cloth_triangles);
+            c.vertex_edges = Adjacency::edges(x.len(), &c.cloth_edges);
+        }
+        let all = c.stale || resized;
         if all {
-            // The cloth's edges once (a moving mesh makes every call `all`).
-            if c.triangle.len() != cloth_triangles.len() || c.cloth_edges.is_empty() {
-                c.cloth_edges = edges_of(cloth_triangles);
-            }
             c.vertex.resize_with(x.len(), Vec::new);
             c.vertex_at.resize(x.len(), Vec3::zeros());
             c.triangle.resize_with(cloth_triangles.len(), Vec::new);
-            c.triangle_at.resize(cloth_triangles.len(), Vec3::zeros());
             c.edge.resize_with(c.cloth_edges.len(), Vec::new);
-            c.edge_at.resize(c.cloth_edges.len(), Vec3::zeros());
             c.stale = false;
         }
         let moved = |at: &Vec3, p: &Vec3| (p - at).norm_squared() > 0.25 * skin * skin;
         let bounds = self.tri_bvh.bounds();
+        c.looked.clear();
+        c.dirty_triangles.clear();
+        c.dirty_edges.clear();
         for i in 0..x.len() {
             if !(all || moved(&c.vertex_at[i], &x[i])) {
                 continue;
@@ -591,35 +628,98 @@ impl MeshCollider {
                 });
                 if let Some((t, _)) = nearest {
                     list.push(t);
+                    // Inside, the nearest of the whole mesh changes with every move: looked up
+                    // again at the next substep (outside, it is beyond reach: no contact).
+                    let [a, b, cc] = self.triangles[t as usize].map(|k| self.target[k as usize]);
+                    let w = closest_on_triangle(&p, &a, &b, &cc);
+                    let r = p - (w[0] * a + w[1] * b + w[2] * cc);
+                    if r.dot(&pseudo_normal(
+                        &self.triangles,
+                        &self.neighbours,
+                        &self.face_normal,
+                        &self.vertex_normal,
+                        t,
+                        w,
+                    )) < 0.0
+                    {
+                        c.vertex_at[i] = Vec3::repeat(f64::INFINITY);
+                    }
                 }
             }
-        }
-        for (t, tri) in cloth_triangles.iter().enumerate() {
-            let centre = (x[tri[0] as usize] + x[tri[1] as usize] + x[tri[2] as usize]) / 3.0;
-            if !(all || moved(&c.triangle_at[t], &centre)) {
-                continue;
+            if !all {
+                c.looked.push(i as u32);
+                c.dirty_triangles.extend_from_slice(c.vertex_triangles.row(i));
+                c.dirty_edges.extend_from_slice(c.vertex_edges.row(i));
             }
-            c.triangle_at[t] = centre;
-            let list = &mut c.triangle[t];
+        }
+        if all {
+            c.dirty_triangles.extend(0..cloth_triangles.len() as u32);
+            c.dirty_edges.extend(0..c.cloth_edges.len() as u32);
+        } else {
+            c.dirty_triangles.sort_unstable();
+            c.dirty_triangles.dedup();
+            c.dirty_edges.sort_unstable();
+            c.dirty_edges.dedup();
+        }
+        for &t in &c.dirty_triangles {
+            let tri = &cloth_triangles[t as usize];
+            let list = &mut c.triangle[t as usize];
             list.clear();
-            // The vertices' boxes hold `reach` already; the triangle's grows by the skin it may
-            // move before it looks again.
+            // The vertices' boxes hold `reach` already; the triangle's grows by the skin its
+            // vertices may move before it looks again.
             let q = Aabb::of(tri.iter().map(|&i| &x[i as usize])).inflated(skin);
             self.vert_bvh.overlapping(&q, |m| list.push(m));
         }
-        for (e, &[i0, i1]) in c.cloth_edges.iter().enumerate() {
-            let (p0, p1) = (&x[i0 as usize], &x[i1 as usize]);
-            let centre = 0.5 * (p0 + p1);
-            if !(all || moved(&c.edge_at[e], &centre)) {
-                continue;
-            }
-            c.edge_at[e] = centre;
-            let list = &mut c.edge[e];
+        for &e in &c.dirty_edges {
+            let [i0, i1] = c.cloth_edges[e as usize];
+            let list = &mut c.edge[e as usize];
             list.clear();
             // The mesh edges' boxes hold `reach` already.
-            let q = Aabb::of([p0, p1]).inflated(skin);
+            let q = Aabb::of([&x[i0 as usize], &x[i1 as usize]]).inflated(skin);
             self.edge_bvh.overlapping(&q, |m| list.push(m));
         }
+        if all {
+            c.with_vertex.clear();
+            c.with_triangle.clear();
+            c.with_edge.clear();
+            c.looked.extend(0..x.len() as u32);
+        }
+        update_with(&mut c.with_vertex, &c.vertex, &c.looked);
+        update_with(&mut c.with_triangle, &c.triangle, &c.dirty_triangles);
+        update_with(&mut c.with_edge, &c.edge, &c.dirty_edges);
+    }
+}
+
+/// Outward pseudo-normal of the feature of triangle `t` (of a mesh with these neighbours,
+/// face normals and vertex normals) at barycentric weights `w`.
+fn pseudo_normal(
+    triangles: &[[u32; 3]],
+    neighbours: &[[u32; 3]],
+    face_normal: &[Vec3],
+    vertex_normal: &[Vec3],
+    t: u32,
+    w: [f64; 3],
+) -> Vec3 {
+    let tri = &triangles[t as usize];
+    let face = face_normal[t as usize];
+    match [w[0] <= 0.0, w[1] <= 0.0, w[2] <= 0.0] {
+        // On the edge opposite corner z: edge (z+1, z+2), which is edge index (z+1) % 3.
+        [true, false, false] | [false, true, false] | [false, false, true] => {
+            let z = w.iter().position(|&wk| wk <= 0.0).unwrap_or(0);
+            let o = neighbours[t as usize][(z + 1) % 3];
+            if o == NONE {
+                face
+            } else {
+                (face + face_normal[o as usize])
+                    .try_normalize(0.0)
+                    .unwrap_or(face)
+            }
+        }
+        // At the corner whose weight is not zero.
+        [false, true, true] => vertex_normal[tri[0] as usize],
+        [true, false, true] => vertex_normal[tri[1] as usize],
+        [true, true, false] => vertex_normal[tri[2] as usize],
+        _ => face,
     }
 }
 
@@ -795,6 +895,106 @@ mod tests {
         let mut out = Vec::new();
         m.contacts(&cloth, &[[0, 2, 1]], 1.0, 0.01, 0.01, 1.0, &mut out);
         assert!(out.iter().any(|c| c.len == 3 && c.dir.y > 0.99), "{out:?}");
+    }
+
+    /// A cloth lying on a mesh much finer than itself is held by its vertices' contacts alone:
+    /// the mesh's vertices under its triangles add nothing (else the push would grow with the
+    /// mesh's resolution). Where no corner touches, they do push
+    /// (`a_thin_bar_pushes_the_cloth_triangle_it_is_under`).
+    #[test]
+    fn a_fine_mesh_under_the_cloth_pushes_only_its_vertices() {
+        // A 60 x 60 mm floor of 1 mm squares at y = 0, two triangles each way.
+        let n = 61u32;
+        let x: Vec<Vec3> = (0..n * n)
+            .map(|k| {
+                Vec3::new(
+                    f64::from(k % n) * 0.001 - 0.02,
+                    0.0,
+                    f64::from(k / n) * 0.001 - 0.02,
+                )
+            })
+            .collect();
+        let t: Vec<[u32; 3]> = (0..n - 1)
+            .flat_map(|r| (0..n - 1).map(move |c| r * n + c))
+            .flat_map(|k| [[k, k + n, k + 1], [k + 1, k + n, k + n + 1]])
+            .collect();
+        let mut m = MeshCollider::new(&x, &t, None).unwrap();
+        m.begin_call(0.01, 0.015);
+        // A 2 cm cloth square 5 mm above it, inside the margin of 1 cm.
+        let cloth = vec![
+            Vec3::new(0.0, 0.005, 0.0),
+            Vec3::new(0.02, 0.005, 0.0),
+            Vec3::new(0.0, 0.005, 0.02),
+            Vec3::new(0.02, 0.005, 0.02),
+        ];
+        let tris = [[0, 2, 1], [1, 2, 3]];
+        let mut out = Vec::new();
+        m.contacts(&cloth, &tris, 1.0, 0.01, 0.005, 1.0, &mut out);
+        assert_eq!(out.len(), 4, "contacts: {}", out.len());
+        assert!(out.iter().all(|c| c.len == 1 && c.dir.y > 0.99));
+    }
+
+    /// The kept candidate lists give exactly the contacts a fresh look gives, substep after
+    /// substep, while a cloth sheet moves about and through a bar and a ball (a vertex, its
+    /// triangles and its edges look again only once it has moved half the skin).
+    #[test]
+    fn kept_candidates_give_the_contacts_of_a_fresh_look() {
+        use crate::collide::shapes::{bar, uv_sphere};
+        let (mut x, mut t) = uv_sphere(Vec3::new(0.0, 0.0, 0.0), 0.05, 24, 13);
+        let (bx, bt) = bar(Vec3::new(-0.2, 0.02, 0.03), Vec3::new(0.2, 0.02, 0.03), 0.002, 4);
+        let base = x.len() as u32;
+        x.extend(bx);
+        t.extend(bt.iter().map(|tri| tri.map(|i| i + base)));
+        let mut kept = MeshCollider::new(&x, &t, None).unwrap();
+        kept.begin_call(0.01, 0.015);
+        // A 12 x 12 sheet of 1 cm, swept across the ball and the bar with a wobble.
+        let n = 12u32;
+        let tris: Vec<[u32; 3]> = (0..n - 1)
+            .flat_map(|r| (0..n - 1).map(move |c| r * n + c))
+            .flat_map(|k| [[k, k + n, k + 1], [k + 1, k + n, k + n + 1]])
+            .collect();
+        let (mut with_vertex, mut with_triangle, mut with_edge) = (0, 0, 0);
+        for step in 0..400 {
+            let s = f64::from(step) * 1e-3;
+            let cloth: Vec<Vec3> = (0..n * n)
+                .map(|k| {
+                    let (u, v) = (f64::from(k % n) * 0.01 - 0.055, f64::from(k / n) * 0.01 - 0.055);
+                    Vec3::new(
+                        u + 0.3 * s - 0.06,
+                        v,
+                        0.08 - 0.15 * s + 0.004 * (40.0 * u + 90.0 * s).sin(),
+                    )
+                })
+                .collect();
+            let mut a = Vec::new();
+            kept.contacts(&cloth, &tris, 1.0, 0.01, 0.005, 0.03, &mut a);
+            let mut fresh = kept.clone();
+            fresh.cache = Candidates::default();
+            let mut b = Vec::new();
+            fresh.contacts(&cloth, &tris, 1.0, 0.01, 0.005, 0.03, &mut b);
+            // The same contacts, to rounding; a vertex deeper inside the ball than the reach
+            // (margin and skin) is pushed out along a triangle near it, not always the nearest
+            // (module docs), so only its contact is compared.
+            assert_eq!(a.len(), b.len(), "step {step}");
+            for (p, q) in a.iter().zip(&b) {
+                let deep = p.depth >= 0.015 && q.depth >= 0.015;
+                let close = p.idx == q.idx
+                    && p.len == q.len
+                    && (deep
+                        || (0..4).all(|k| (p.coef[k] - q.coef[k]).abs() < 1e-12)
+                            && (p.dir - q.dir).norm() < 1e-12
+                            && (p.depth - q.depth).abs() < 1e-15);
+                assert!(close, "step {step}: {p:?} against {q:?}");
+            }
+            with_vertex += a.iter().filter(|c| c.len == 1).count();
+            with_triangle += a.iter().filter(|c| c.len == 3).count();
+            with_edge += a.iter().filter(|c| c.len == 2).count();
+        }
+        // Every kind of contact was compared.
+        assert!(
+            with_vertex > 100 && with_triangle > 0 && with_edge > 0,
+            "{with_vertex} {with_triangle} {with_edge}"
+        );
     }
 
     #[test]

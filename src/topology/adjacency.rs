@@ -52,6 +52,15 @@ impl Adjacency {
         Self::from_pairs(n, pairs)
     }
 
+    /// Edges (each `[i, j]`) of each vertex.
+    pub fn edges(n: usize, edges: &[[u32; 2]]) -> Self {
+        let pairs = edges
+            .iter()
+            .enumerate()
+            .flat_map(|(e, ends)| ends.map(|v| (v, e as u32)));
+        Self::from_pairs(n, pairs)
+    }
+
     /// Runs touching each chunk of `crate::parallel::CHUNK` vertices (as the `i` end or as
     /// the `j` end), in ascending run order.
     pub fn chunk_runs(n: usize, runs: &[super::SpringRun]) -> Self {
