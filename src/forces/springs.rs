@@ -150,7 +150,8 @@ fn run_kernel_uniform(p: &Params<'_>, run: &SpringRun, first_spring: usize, rest
 }
 
 /// Springs `first_spring ..` of `run`, as many as `out` holds. With `UNIFORM`, every spring
-/// has the rest length `uniform_rest` and `p.rest` is not read (same arithmetic either way).
+/// has the rest length `uniform_rest` and `p.rest` is not read (same arithmetic either way);
+/// without, padding slots (a negative-signed rest length) are set to no force.
 #[inline(always)]
 fn run_kernel<'a, const UNIFORM: bool>(
     p: &Params<'a>,
@@ -209,8 +210,18 @@ fn run_kernel<'a, const UNIFORM: bool>(
             [qxi, qyi, qzi],
             [qxj, qyj, qzj],
             rest_at,
-            [fx, fy, fz],
+            [&mut *fx, &mut *fy, &mut *fz],
         );
+    }
+    if !UNIFORM {
+        // Padding slots (rest length -0.0, `topology::PAD_REST`) get no force: a mask over the
+        // slice, vectorised, instead of a walk over a list of pads (an irregular mesh's runs
+        // hold many).
+        for t in 0..n {
+            if rest[t].is_sign_negative() {
+                (fx[t], fy[t], fz[t]) = (0.0, 0.0, 0.0);
+            }
+        }
     }
 }
 

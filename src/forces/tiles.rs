@@ -254,17 +254,23 @@ fn evaluate(
 }
 
 /// Evaluates the slots `s .. s + out[0].len()` of run `k` into `out`; padding slots were
-/// evaluated like springs and are set to no force.
+/// evaluated like springs and are set to no force (a uniform run's from the list of pads, which
+/// are few there; an irregular mesh's runs hold many, set in the spring kernel).
 #[inline]
 fn evaluate_slots(p: &Params<'_>, tr: &TileRuns, k: usize, s: usize, out: [&mut [f64]; 3]) {
     let run = &tr.runs[k];
     let [x, y, z] = out;
     match tr.uniform_rest[k] {
-        Some(r) => run_uniform_widest(p, run, s, r, [&mut *x, &mut *y, &mut *z]),
-        None => run_widest(p, run, s, [&mut *x, &mut *y, &mut *z]),
-    }
-    for q in tr.pads_in(s..s + x.len()) {
-        (x[q - s], y[q - s], z[q - s]) = (0.0, 0.0, 0.0);
+        Some(r) => {
+            run_uniform_widest(p, run, s, r, [&mut *x, &mut *y, &mut *z]);
+            for q in tr.pads_in(s..s + x.len()) {
+                (x[q - s], y[q - s], z[q - s]) = (0.0, 0.0, 0.0);
+            }
+        }
+        None => {
+            // Sets its padding to no force itself (by the sign of the rest length).
+            run_widest(p, run, s, [&mut *x, &mut *y, &mut *z]);
+        }
     }
 }
 

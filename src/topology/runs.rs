@@ -70,6 +70,10 @@ const MAX_GAP: u32 = 4;
 /// about 1.5x after), while a mesh whose runs lie far apart is not padded without bound.
 const MAX_PADDED: usize = 3;
 
+/// The rest length a padding slot holds: -0.0, so the force pass can tell padding from springs
+/// by the sign bit of the rest lengths it reads anyway.
+pub const PAD_REST: f64 = -0.0;
+
 /// The runs again, with runs of the same family and offset that are separated by a few missing
 /// springs joined into one by padding slots (a grid's rows break every horizontal, shear and
 /// bend run at the row end: padding makes each family one run). A slot is a real spring or
@@ -80,7 +84,8 @@ const MAX_PADDED: usize = 3;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TileRuns {
     pub runs: Vec<SpringRun>,
-    /// Rest length of each slot, m (0 for padding).
+    /// Rest length of each slot, m ([`PAD_REST`], -0.0, for padding: no spring's rest length,
+    /// which is never negative, has that sign).
     pub rest: Vec<f64>,
     /// Family of each slot (`SpringKind as u8`).
     pub kinds: Vec<u8>,
@@ -122,7 +127,7 @@ impl TileRuns {
                 (Some(gap), Some(last)) => {
                     for _ in 0..gap {
                         t.pads.push(t.rest.len() as u32);
-                        t.rest.push(0.0);
+                        t.rest.push(PAD_REST);
                         t.kinds.push(kind);
                     }
                     last.len += gap + r.len;
@@ -259,7 +264,9 @@ mod tests {
                         assert_eq!(p.kinds[slot], t.springs[s].kind as u8);
                         seen[s] += 1;
                     }
-                    None => assert!(pads.contains(&slot) && p.rest[slot] == 0.0),
+                    None => assert!(
+                        pads.contains(&slot) && p.rest[slot] == 0.0 && p.rest[slot].is_sign_negative()
+                    ),
                 }
             }
         }
