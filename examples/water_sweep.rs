@@ -8,7 +8,8 @@
 //! `current=X,Y,Z` (m/s; with `amp=0`, how far the tip leans and flutters), `integrator=symplectic|implicit|explicit|symplectic2|implicit2` [symplectic], `dt` [2 ms
 //! explicit, 1/30 s implicit], `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
 //! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag), `scale=` (its smoothing length, m),
-//! `skin=` (N s/m^3), `damping=` (spring damping), `mode=velocity|fractional|strain|none` (what the
+//! `skin=` (N s/m^3), `damping=` (spring damping), `bend=` (the bend springs' stiffness, times the
+//! preset's), `mode=velocity|fractional|strain|none` (what the
 //! springs damp), `history=` (history drag per area, N s^1/2/m^3; the SOE history is kept).
 
 use fraccloth::{Integrator, Model, Vec3};
@@ -43,6 +44,8 @@ fn main() {
     w_.form_drag_scale = num("scale", w_.form_drag_scale);
     w_.skin_drag = num("skin", w_.skin_drag);
     model.spring_damping = num("damping", model.spring_damping);
+    // Bending stiffness as a multiple of the preset's (its bend springs' k).
+    model.bend_stiffness *= num("bend", 1.0);
     model.water.history_drag = num("history", model.water.history_drag);
     if let Some(mode) = get("mode") {
         model.spring_damping_mode = match mode.as_str() {
