@@ -16,6 +16,6 @@ pub use adjacency::Adjacency;
 pub use assemble::Topology;
 pub use grid::{grid_index, GridSpec};
 pub use mesh::{MeshMass, MeshSpec, MAX_MESH_VERTICES};
-pub use runs::{for_each_piece, SpringRun, TileRuns};
+pub use runs::{for_each_piece, SpringRun, TileRuns, PAD_REST};
 pub use spring::{Spring, SpringKind};
 pub use tiling::{TileLayout, GATHER_RUNS};
