@@ -1,7 +1,8 @@
 //! The pictures of docs/collisions.md: the scenes of `tests/collisions.rs`, drawn as wireframes
 //! seen from the side (crossing triangles in red, colliders in grey), a row of frames each.
 //!
-//! `cargo run --release --example collision_pictures` writes `docs/collisions/*.png`.
+//! `cargo run --release --example collision_pictures` writes `docs/collisions/*.png` (the last, the
+//! underwater swing against a 10k-triangle ball, is `collision_cost`'s case 3).
 
 use fraccloth::collide::intersections::{crossing_pairs, self_intersections};
 use fraccloth::collide::shapes::{bar, torus};
@@ -174,6 +175,55 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         )?;
     }
     root.present()?;
-    println!("wrote docs/collisions/drop.png, torus.png, bar.png");
+
+    // 4. The underwater swing (61 x 41, 0.5 Hz, 4 cm) against a 10k-triangle ball it starts
+    // touching (`collision_cost` case 3): side view at 0.1, 1 and 2 s, with the substeps and
+    // refused attempts of the frame drawn.
+    use fraccloth::collide::shapes::uv_sphere;
+    use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
+    let spec = SceneSpec {
+        width: 61,
+        height: 41,
+        drive: Drive {
+            amplitude: 0.04,
+            frequency: 0.5,
+            ..Drive::of(SceneKind::Swing, Variant::Underwater)
+        },
+        dt: 1.0 / FPS,
+        max_substep: fraccloth::cloth::AUTO,
+        integrator: Integrator::SymplecticEuler,
+        model: Some(fraccloth::Model::underwater()),
+        ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
+    };
+    let mut scene = spec.build()?;
+    let (bx, bt) = uv_sphere(Vec3::new(0.3, -0.3, 0.1), 0.1, 100, 51);
+    scene.cloth.add_mesh_collider(&bx, &bt, None)?;
+    let root = BitMapBackend::new("docs/collisions/ball.png", (1500, 450)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let cells = root.split_evenly((1, 3));
+    let mut f = 0;
+    for (k, until) in [3, 30, 60].into_iter().enumerate() {
+        while f < until {
+            f += 1;
+            scene.run_until(f as f64 / FPS)?;
+        }
+        let stats = scene.cloth.step_stats();
+        let inside = fraccloth::collide::intersections::vertices_inside(scene.cloth.positions(), &bx, &bt);
+        panel(
+            &cells[k],
+            &format!(
+                "10k-triangle ball, {:.1} s: {} substeps, {} retries, {inside} inside",
+                f as f64 / FPS,
+                stats.substeps,
+                stats.retries
+            ),
+            &scene.cloth,
+            Some((&bx, &bt)),
+            side,
+            ((-0.25, 0.25), (-0.45, 0.02)),
+        )?;
+    }
+    root.present()?;
+    println!("wrote docs/collisions/drop.png, torus.png, bar.png, ball.png");
     Ok(())
 }
