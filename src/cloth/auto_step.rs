@@ -216,8 +216,8 @@ impl Cloth {
                 / mass;
             let mut omega2 = 2.0 * k / mass;
             let mut gamma = 2.0 * c / mass + drag;
-            // Contacts: every vertex may touch an analytic collider; the mesh colliders' and
-            // self-collision's by their weight.
+            // Contacts: every vertex may touch an analytic collider; the mesh colliders' by
+            // their weight where the call begins (self-collision's are left to the retries).
             let touch =
                 f64::from(u8::from(!self.colliders.is_empty())) + weight.get(i).copied().unwrap_or(0.0);
             if touch > 0.0 {

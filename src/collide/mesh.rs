@@ -31,10 +31,11 @@
 //!   the edges, and the vertex contacts hold the cloth.
 //!
 //! **Search.** Each call the swept boxes of the mesh's triangles and vertices (start to target)
-//! are refitted into three [`Bvh`]s (with its edges). Each cloth vertex (triangle, edge) keeps
-//! the candidates found
-//! within `margin + skin` of where it was when it last looked, and looks again once it has
-//! moved more than `skin / 2` (a Verlet list): most substeps test only a few exact distances.
+//! are refitted into three [`Bvh`]s (with its edges). Each cloth vertex keeps the candidates
+//! found within `margin + skin` of where it was when it last looked, and looks again once it has
+//! moved more than `skin / 2` (a Verlet list); its triangles and edges look again with it. Most
+//! substeps test only a few exact distances, and visit only the vertices, triangles and edges
+//! that have candidates.
 
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;

@@ -45,16 +45,17 @@ impl Adjacency {
 
     /// Triangles of each vertex.
     pub fn triangles(n: usize, triangles: &[[u32; 3]]) -> Self {
-        let pairs = triangles
-            .iter()
-            .enumerate()
-            .flat_map(|(t, tri)| tri.map(|v| (v, t as u32)));
-        Self::from_pairs(n, pairs)
+        Self::elements(n, triangles)
     }
 
     /// Edges (each `[i, j]`) of each vertex.
     pub fn edges(n: usize, edges: &[[u32; 2]]) -> Self {
-        let pairs = edges
+        Self::elements(n, edges)
+    }
+
+    /// Elements of `K` vertices each, of each vertex.
+    fn elements<const K: usize>(n: usize, elements: &[[u32; K]]) -> Self {
+        let pairs = elements
             .iter()
             .enumerate()
             .flat_map(|(e, ends)| ends.map(|v| (v, e as u32)));
