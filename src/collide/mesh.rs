@@ -622,27 +622,24 @@ impl MeshCollider {
             self.tri_bvh.overlapping(&q, |t| list.push(t));
             if list.is_empty() && self.closed && bounds.contains(&p) {
                 // Possibly deep inside: the nearest triangle of the whole mesh decides.
+                let (tris, target) = (&self.triangles, &self.target);
                 let nearest = self.tri_bvh.nearest(&p, f64::INFINITY, |t| {
-                    let [a, b, cc] = self.triangles[t as usize].map(|k| self.target[k as usize]);
-                    let w = closest_on_triangle(&p, &a, &b, &cc);
-                    (w[0] * a + w[1] * b + w[2] * cc - p).norm_squared()
+                    closest_at(target, &tris[t as usize], &p).1.norm_squared()
                 });
                 if let Some((t, _)) = nearest {
                     list.push(t);
                     // Inside, the nearest of the whole mesh changes with every move: looked up
                     // again at the next substep (outside, it is beyond reach: no contact).
-                    let [a, b, cc] = self.triangles[t as usize].map(|k| self.target[k as usize]);
-                    let w = closest_on_triangle(&p, &a, &b, &cc);
-                    let r = p - (w[0] * a + w[1] * b + w[2] * cc);
-                    if r.dot(&pseudo_normal(
-                        &self.triangles,
+                    let (w, r) = closest_at(target, &tris[t as usize], &p);
+                    let n = pseudo_normal(
+                        tris,
                         &self.neighbours,
                         &self.face_normal,
                         &self.vertex_normal,
                         t,
                         w,
-                    )) < 0.0
-                    {
+                    );
+                    if r.dot(&n) < 0.0 {
                         c.vertex_at[i] = Vec3::repeat(f64::INFINITY);
                     }
                 }
@@ -689,6 +686,14 @@ impl MeshCollider {
         update_with(&mut c.with_triangle, &c.triangle, &c.dirty_triangles);
         update_with(&mut c.with_edge, &c.edge, &c.dirty_edges);
     }
+}
+
+/// The weights of the point of triangle `tri` (of vertices `x`) nearest to `p`, and the vector
+/// from that point to `p`.
+fn closest_at(x: &[Vec3], tri: &[u32; 3], p: &Vec3) -> ([f64; 3], Vec3) {
+    let [a, b, c] = tri.map(|k| x[k as usize]);
+    let w = closest_on_triangle(p, &a, &b, &c);
+    (w, p - (w[0] * a + w[1] * b + w[2] * c))
 }
 
 /// Outward pseudo-normal of the feature of triangle `t` (of a mesh with these neighbours,
