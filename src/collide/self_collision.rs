@@ -11,7 +11,10 @@
 //!
 //! **Sides.** Each pair remembers which side of the triangle (of the two edges) it was on when
 //! it entered the list and keeps it for as long as it stays; a vertex pushed through a
-//! triangle in one step is pushed back, not on through. Together with the step limit (no
+//! triangle in one step is pushed back, not on through, and so is one found on the other side
+//! past the thickness but within the list's reach (no step brings a pair more than a thickness
+//! closer, so it went through). A pair apart and off the face (past an edge's end, or edges
+//! near parallel) forgets its side: it may go round the border of a fold. Together with the step limit (no
 //! vertex moves more than half the thickness in a step, `Cloth::limit_collision_step`) no pair can cross
 //! unnoticed. The sides are the only state self-collision keeps (snapshots carry them).
 //!
@@ -227,8 +230,9 @@ impl SelfCollision {
         out: &mut Vec<Contact>,
     ) {
         let skin = SKIN * thickness;
+        let reach = thickness + skin;
         if self.deformed(x, skin) {
-            self.look(x, rest, triangles, thickness + skin, EXCLUDED * thickness);
+            self.look(x, rest, triangles, reach, EXCLUDED * thickness);
         }
         let cap = 2.0 * thickness;
         // A contact between four vertices at signed distance `dist` along `dir`, if within the
@@ -255,12 +259,20 @@ impl SelfCollision {
                 continue;
             };
             if d >= thickness {
-                // Apart: nothing crosses, so the side is learnt afresh (a triangle that turned
-                // over).
-                if interior {
-                    *s = side(r.dot(&normal));
+                // Apart. Over the face on the other side of the remembered one, within the
+                // reach: it went through (a step moves a pair at most one thickness closer, so
+                // it cannot be past the reach already) and is pushed back. Else nothing
+                // crossed and the side is learnt afresh (a triangle that turned over).
+                let now = side(r.dot(&normal));
+                if !interior {
+                    // Beside the face it may go round the triangle's border: forgotten.
+                    *s = 0;
+                    continue;
                 }
-                continue;
+                if *s == 0 || now == *s || d >= reach {
+                    *s = now;
+                    continue;
+                }
             }
             if *s == 0 && interior {
                 // First over the triangle's face: the side it comes from is known now.
@@ -288,6 +300,10 @@ impl SelfCollision {
             let (ee, ff) = (&self.edges[e as usize], &self.edges[f as usize]);
             let (d, a, b, r, n) = edge_edge(x, ee, ff);
             if !(a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0) {
+                if d >= thickness {
+                    // Apart and past an end: it may go round the edge's end, forgotten.
+                    *s = 0;
+                }
                 continue;
             }
             // The side is kept relative to e x f, which means something only while the edges
@@ -297,11 +313,19 @@ impl SelfCollision {
             let n_len = n.norm();
             let conditioned = n_len > PARALLEL_SINE * lengths;
             if d >= thickness {
-                // Apart: nothing crosses, so the side is learnt afresh (edges that turned).
-                if conditioned {
-                    *s = side(r.dot(&n));
+                // Apart: as for a vertex and a triangle, on the other side within the reach
+                // they went through each other; else the side is learnt afresh (edges that
+                // turned). Turning through parallel flips `e x f` without crossing, so near
+                // parallel the side is forgotten.
+                if !conditioned {
+                    *s = 0;
+                    continue;
                 }
-                continue;
+                let now = side(r.dot(&n));
+                if *s == 0 || now == *s || d >= reach {
+                    *s = now;
+                    continue;
+                }
             }
             let (dist, dir) = if conditioned {
                 let n = n / n_len;
@@ -584,5 +608,45 @@ mod tests {
         sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out);
         let up = out.iter().find(|c| c.idx[0] == 3).unwrap();
         assert!(up.dir.y > 0.99 && (up.depth - 0.006).abs() < 1e-12, "{up:?}");
+    }
+
+    /// A vertex driven through a triangle past the thickness (but not past the reach) is still
+    /// known to have crossed and is pushed back with the largest depth; once past the reach it
+    /// is taken to be on the other side for good (a triangle that turned over).
+    #[test]
+    fn a_vertex_through_past_the_thickness_is_pushed_back() {
+        let t = vec![[0, 1, 2], [3, 4, 5]];
+        let mut x = vec![
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(-1.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.004, 0.0),
+            Vec3::new(0.0, 0.5, 0.1),
+            Vec3::new(0.1, 0.5, 0.0),
+        ];
+        let rest: Vec<Vec3> = x
+            .iter()
+            .map(|p| p + Vec3::new(0.0, 0.0, 5.0 * (p.y > 0.001) as u8 as f64))
+            .collect();
+        let mut sc = SelfCollision::new(&t);
+        let mut out = Vec::new();
+        let h = 0.005;
+        sc.contacts(&x, &rest, &t, h, 0.0, &mut out);
+        assert!(out.iter().any(|c| c.idx[0] == 3));
+        // Through by 1.5 thicknesses, in steps of less than the step limit's two vertices.
+        for y in [0.0015, -0.001, -0.004, -0.0075] {
+            x[3].y = y;
+            out.clear();
+            sc.contacts(&x, &rest, &t, h, 0.0, &mut out);
+        }
+        let up = out.iter().find(|c| c.idx[0] == 3).expect("still in contact");
+        assert!(up.dir.y > 0.99 && (up.depth - 2.0 * h).abs() < 1e-12, "{up:?}");
+        // Past the reach (two thicknesses below) and back within it: on the new side now.
+        for y in [-0.0105, -0.0075] {
+            x[3].y = y;
+            out.clear();
+            sc.contacts(&x, &rest, &t, h, 0.0, &mut out);
+        }
+        assert!(out.iter().all(|c| c.idx[0] != 3), "{out:?}");
     }
 }
