@@ -581,11 +581,12 @@ mod tests {
         assert!(out.is_empty());
     }
 
-    /// A vertex pushed through a triangle keeps the side it came from.
-    #[test]
-    fn a_crossed_vertex_is_pushed_back() {
+    /// A large triangle in the plane y = 0 and, 4 mm over its face, vertex 3 of a small second
+    /// triangle (the triangles, the positions, the rest positions: the second triangle 5 m
+    /// away, so the pair is no neighbour).
+    fn vertex_over_a_triangle() -> (Vec<[u32; 3]>, Vec<Vec3>, Vec<Vec3>) {
         let t = vec![[0, 1, 2], [3, 4, 5]];
-        let mut x = vec![
+        let x = vec![
             Vec3::new(-1.0, 0.0, -1.0),
             Vec3::new(-1.0, 0.0, 1.0),
             Vec3::new(1.0, 0.0, 0.0),
@@ -597,6 +598,13 @@ mod tests {
             .iter()
             .map(|p| p + Vec3::new(0.0, 0.0, 5.0 * (p.y > 0.001) as u8 as f64))
             .collect();
+        (t, x, rest)
+    }
+
+    /// A vertex pushed through a triangle keeps the side it came from.
+    #[test]
+    fn a_crossed_vertex_is_pushed_back() {
+        let (t, mut x, rest) = vertex_over_a_triangle();
         let mut sc = SelfCollision::new(&t);
         let mut out = Vec::new();
         sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out);
@@ -615,19 +623,7 @@ mod tests {
     /// is taken to be on the other side for good (a triangle that turned over).
     #[test]
     fn a_vertex_through_past_the_thickness_is_pushed_back() {
-        let t = vec![[0, 1, 2], [3, 4, 5]];
-        let mut x = vec![
-            Vec3::new(-1.0, 0.0, -1.0),
-            Vec3::new(-1.0, 0.0, 1.0),
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::new(0.0, 0.004, 0.0),
-            Vec3::new(0.0, 0.5, 0.1),
-            Vec3::new(0.1, 0.5, 0.0),
-        ];
-        let rest: Vec<Vec3> = x
-            .iter()
-            .map(|p| p + Vec3::new(0.0, 0.0, 5.0 * (p.y > 0.001) as u8 as f64))
-            .collect();
+        let (t, mut x, rest) = vertex_over_a_triangle();
         let mut sc = SelfCollision::new(&t);
         let mut out = Vec::new();
         let h = 0.005;
