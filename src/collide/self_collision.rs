@@ -201,6 +201,18 @@ fn balls_apart(x: &[Vec3], e: &[u32; 2], f: &[u32; 2], reach: f64) -> bool {
     gap >= reach
 }
 
+/// For a pair apart (past the thickness) at distance `d`, now on side `now` of its remembered
+/// side `s`: whether it is settled there, its side learnt afresh (unknown before, the same,
+/// or past the `reach`, where no step from a contact can have brought it). Else it went
+/// through and is to be pushed back.
+fn settled_apart(s: &mut i8, now: i8, d: f64, reach: f64) -> bool {
+    let settled = *s == 0 || now == *s || d >= reach;
+    if settled {
+        *s = now;
+    }
+    settled
+}
+
 fn side(v: f64) -> i8 {
     if v < 0.0 {
         -1
@@ -269,8 +281,7 @@ impl SelfCollision {
                     *s = 0;
                     continue;
                 }
-                if *s == 0 || now == *s || d >= reach {
-                    *s = now;
+                if settled_apart(s, now, d, reach) {
                     continue;
                 }
             }
@@ -322,8 +333,7 @@ impl SelfCollision {
                     continue;
                 }
                 let now = side(r.dot(&n));
-                if *s == 0 || now == *s || d >= reach {
-                    *s = now;
+                if settled_apart(s, now, d, reach) {
                     continue;
                 }
             }
@@ -637,12 +647,18 @@ mod tests {
         }
         let up = out.iter().find(|c| c.idx[0] == 3).expect("still in contact");
         assert!(up.dir.y > 0.99 && (up.depth - 2.0 * h).abs() < 1e-12, "{up:?}");
-        // Past the reach (two thicknesses below) and back within it: on the new side now.
+        // A fresh look here keeps the pair in the list (within the reach); then past the reach
+        // (two thicknesses below) and back within it, too little for another look: the pair
+        // learnt the new side as its own.
+        sc.look_again();
+        sc.contacts(&x, &rest, &t, h, 0.0, &mut out);
+        assert!(sc.pairs().0.iter().any(|q| q.0 == 3 && q.2 == 1));
         for y in [-0.0105, -0.0075] {
             x[3].y = y;
             out.clear();
             sc.contacts(&x, &rest, &t, h, 0.0, &mut out);
         }
         assert!(out.iter().all(|c| c.idx[0] != 3), "{out:?}");
+        assert!(sc.pairs().0.iter().any(|q| q.0 == 3 && q.2 == -1));
     }
 }
