@@ -19,6 +19,13 @@ pub fn edges_of(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
     e
 }
 
+/// The closest point of triangle `(a, b, c)` to `p` as its weights ([`closest_on_triangle`]),
+/// and the vector from that point to `p`.
+pub fn offset_from_triangle(p: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> ([f64; 3], Vec3) {
+    let w = closest_on_triangle(p, a, b, c);
+    (w, p - (w[0] * a + w[1] * b + w[2] * c))
+}
+
 /// Closest point of triangle `(a, b, c)` to `p`, as barycentric weights `[wa, wb, wc]` (each in
 /// [0, 1], summing to 1). A degenerate triangle gives the closest point of its longest edge.
 pub fn closest_on_triangle(p: &Vec3, a: &Vec3, b: &Vec3, c: &Vec3) -> [f64; 3] {

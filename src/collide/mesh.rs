@@ -39,7 +39,7 @@
 
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
-use super::geometry::{closest_on_segments, closest_on_triangle, edges_of};
+use super::geometry::{closest_on_segments, closest_on_triangle, edges_of, offset_from_triangle};
 use crate::error::Error;
 use crate::math::Vec3;
 use crate::topology::Adjacency;
@@ -415,8 +415,7 @@ impl MeshCollider {
     /// weights and the vector from it to `p`.
     fn nearest_on(&self, t: u32, f: f64, p: &Vec3) -> (f64, [f64; 3], Vec3) {
         let [a, b, c] = self.corners(t, f);
-        let w = closest_on_triangle(p, &a, &b, &c);
-        let r = p - (w[0] * a + w[1] * b + w[2] * c);
+        let (w, r) = offset_from_triangle(p, &a, &b, &c);
         (r.norm(), w, r)
     }
 
@@ -692,8 +691,7 @@ impl MeshCollider {
 /// from that point to `p`.
 fn closest_at(x: &[Vec3], tri: &[u32; 3], p: &Vec3) -> ([f64; 3], Vec3) {
     let [a, b, c] = tri.map(|k| x[k as usize]);
-    let w = closest_on_triangle(p, &a, &b, &c);
-    (w, p - (w[0] * a + w[1] * b + w[2] * c))
+    offset_from_triangle(p, &a, &b, &c)
 }
 
 /// Outward pseudo-normal of the feature of triangle `t` (of a mesh with these neighbours,

@@ -25,7 +25,7 @@
 
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
-use super::geometry::{closest_on_segments, closest_on_triangle, edges_of};
+use super::geometry::{closest_on_segments, edges_of, offset_from_triangle};
 use crate::math::Vec3;
 
 /// The skin of the pair list, in thicknesses: pairs within `(1 + SKIN)` thicknesses are kept,
@@ -155,8 +155,7 @@ impl Exclusions {
 fn vertex_triangle(x: &[Vec3], p: u32, t: &[u32; 3]) -> (f64, [f64; 3], Vec3) {
     let [a, b, c] = t.map(|i| x[i as usize]);
     let q = x[p as usize];
-    let w = closest_on_triangle(&q, &a, &b, &c);
-    let r = q - (w[0] * a + w[1] * b + w[2] * c);
+    let (w, r) = offset_from_triangle(&q, &a, &b, &c);
     (r.norm(), w, r)
 }
 
