@@ -47,3 +47,23 @@ fn committed_header_matches_cbindgen() {
          regenerate with FC_BLESS_HEADER=1 cargo test --test header and commit it"
     );
 }
+
+/// The header's words on `FC_PRESET_UNDERWATER` name the preset's coefficients as the model
+/// has them (they once still said 10 kg/m^2 after the preset changed to 8).
+#[test]
+fn the_header_names_the_underwater_presets_coefficients() {
+    let header = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("include/fraccloth.h"))
+        .expect("read header");
+    let end = header.find("FC_PRESET_UNDERWATER =").expect("the preset");
+    let start = header[..end].rfind("/**").expect("its comment");
+    let text = header[start..end].replace("\n   *", "");
+    let w = fraccloth::Model::underwater().water;
+    for said in [
+        format!("normal added mass ({} kg/m^2", w.added_mass),
+        format!("form drag (C_d = {})", w.form_drag),
+        format!("smoothed over {} m", w.form_drag_scale),
+        format!("skin drag ({} N s/m^3)", w.skin_drag),
+    ] {
+        assert!(text.contains(&said), "the header should say {said:?}: {text}");
+    }
+}

@@ -82,8 +82,8 @@ pub enum FcPreset {
     /// Regular cloth of Fig. 7, third column: damped springs, normal drag.
     FC_PRESET_REGULAR_NORMAL = 3,
     /// A wet towel in water: the paper's springs lightly velocity-damped, and per unit area the
-    /// water's normal added mass (10 kg/m^2), form drag (C_d = 1) and skin drag (1.15 N s/m^3),
-    /// symplectic Euler with the automatic step (`max_substep = FC_MAX_SUBSTEP_AUTO`: call
+    /// water's normal added mass (8 kg/m^2; none along the cloth), form drag (C_d = 1) on the
+    /// normal velocity smoothed over 0.012 m, and skin drag (1.15 N s/m^3), symplectic Euler with the automatic step (`max_substep = FC_MAX_SUBSTEP_AUTO`: call
     /// `fc_cloth_step` once per frame). The look, measured: docs/underwater.md.
     FC_PRESET_UNDERWATER = 4,
 }
