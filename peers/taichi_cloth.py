@@ -10,7 +10,8 @@ at a fixed step. The Taichi kernel is the usual form for a grid: one thread a pa
 its twelve neighbours (no atomics), double precision, both states kept so a step is one kernel.
 
 `--check` steps both for 0.2 s from a swung start and prints the largest difference of the
-positions (the two must be the same model: the figure is round-off, not physics). Without it,
+positions (the two must be the same model: the figure is round-off, not physics); it fails
+above 1e-12 m (CI runs it: `.ci/peer`). Without it,
 it times both: steps a second and particle-steps a second, best of `--rounds`, after a warm-up
 (Taichi's compile is not timed), each in the same process, alternately.
 
@@ -147,6 +148,8 @@ def main():
         diff = np.abs(cloth.positions_f64() - peer.positions()).max()
         moved = np.abs(cloth.positions_f64() - x0).max()
         print(f"{w}x{h}, {steps} steps of {a.dt} s: largest position difference {diff:.3e} m (largest displacement {moved:.3e} m)")
+        if not diff < 1e-12:
+            sys.exit("not the same model: the positions differ by more than round-off")
         return
     peer.run(a.dt, 5)  # compile
     cloth.step_substeps(5 * a.dt, 5)
