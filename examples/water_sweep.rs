@@ -4,7 +4,8 @@
 //!
 //! `cargo run --release --example water_sweep -- [KEY=VALUE ...]`
 //!
-//! Keys (defaults in brackets): `freq=0.25,0.5,1,2` (Hz), `amp=0.04` (m), `size=61x41`,
+//! Keys (defaults in brackets): `scene=swing|curtain` [swing; the curtain is 1 x 1.5 m],
+//! `freq=0.25,0.5,1,2` (Hz), `amp=0.04` (m), `size=61x41` [51x76 for the curtain],
 //! `current=X,Y,Z` (m/s; with `amp=0`, how far the tip leans and flutters), `integrator=symplectic|implicit|explicit|symplectic2|implicit2` [symplectic], `dt` [2 ms
 //! explicit, 1/30 s implicit], `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
 //! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag), `scale=` (its smoothing length, m),
@@ -28,7 +29,12 @@ fn main() {
         .split(',')
         .map(|f| f.parse().expect("a frequency"))
         .collect();
-    let (w, h) = get("size").map_or((61, 41), |s| {
+    let kind = match get("scene").as_deref() {
+        None | Some("swing") => SceneKind::Swing,
+        Some("curtain") => SceneKind::Curtain,
+        Some(other) => panic!("unknown scene {other} (swing or curtain)"),
+    };
+    let (w, h) = get("size").map_or(if kind == SceneKind::Curtain { (51, 76) } else { (61, 41) }, |s| {
         let (a, b) = s.split_once('x').expect("COLSxROWS");
         (a.parse().expect("cols"), b.parse().expect("rows"))
     });
@@ -92,7 +98,7 @@ fn main() {
                 }),
             },
             scheme: fraccloth::history::Scheme::DEFAULT,
-            ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
+            ..SceneSpec::paper(kind, Variant::Underwater)
         };
         let spec = SceneSpec {
             model: Some(Model {
