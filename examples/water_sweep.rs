@@ -34,10 +34,17 @@ fn main() {
         Some("curtain") => SceneKind::Curtain,
         Some(other) => panic!("unknown scene {other} (swing or curtain)"),
     };
-    let (w, h) = get("size").map_or(if kind == SceneKind::Curtain { (51, 76) } else { (61, 41) }, |s| {
-        let (a, b) = s.split_once('x').expect("COLSxROWS");
-        (a.parse().expect("cols"), b.parse().expect("rows"))
-    });
+    let (w, h) = get("size").map_or(
+        if kind == SceneKind::Curtain {
+            (51, 76)
+        } else {
+            (61, 41)
+        },
+        |s| {
+            let (a, b) = s.split_once('x').expect("COLSxROWS");
+            (a.parse().expect("cols"), b.parse().expect("rows"))
+        },
+    );
     let integrator = Integrator::ALL
         .into_iter()
         .find(|i| i.key() == get("integrator").as_deref().unwrap_or("symplectic"))

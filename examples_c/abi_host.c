@@ -2,8 +2,13 @@
  * tests/old_host.rs compiles it twice, against include/fraccloth.h and against a copy whose
  * FcClothDesc lacks its last fields (an "old" header), and runs both on the same library:
  * the library reads and writes only the host's struct_size bytes and defaults the rest, so
- * both must give the same trajectory, and nothing past the host's struct is written. */
+ * both must give the same trajectory, and nothing past the host's struct is written.
+ * `abi_host N` sets every byte of its description past the first N (the old host's
+ * struct_size) to fc_cloth_desc_default()'s after taking the preset: what the library gives the
+ * old host for the fields it lacks (a preset's own values there, such as the underwater
+ * preset's bend_reference_spacing, reach only hosts that know the field). */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "fraccloth.h"
@@ -18,7 +23,7 @@ static int fail(const char *what) {
   return 1;
 }
 
-int main(void) {
+int main(int argc, char **argv) {
   struct guarded g;
   size_t i;
   memset(g.canary, 0xAB, sizeof g.canary);
@@ -28,6 +33,12 @@ int main(void) {
   g.desc.width = 21;
   g.desc.height = 15;
   g.desc.spacing = 0.02f;
+  if (argc > 1) {
+    size_t known = (size_t)strtoul(argv[1], NULL, 10);
+    FcClothDesc defaults = fc_cloth_desc_default();
+    if (known < sizeof(FcClothDesc))
+      memcpy((char *)&g.desc + known, (const char *)&defaults + known, sizeof(FcClothDesc) - known);
+  }
 
   FcCloth *cloth = NULL;
   if (fc_cloth_create_grid(&g.desc, &cloth) != FC_OK) return fail("create");

@@ -15,8 +15,8 @@
 #include <stdint.h>
 
 #define FC_VERSION_MAJOR 0
-#define FC_VERSION_MINOR 8
-#define FC_VERSION_PATCH 3
+#define FC_VERSION_MINOR 9
+#define FC_VERSION_PATCH 0
 /* Equals fc_version() of the library this header belongs to. */
 #define FC_VERSION (FC_VERSION_MAJOR * 1000000 + FC_VERSION_MINOR * 1000 + FC_VERSION_PATCH)
 
@@ -160,7 +160,8 @@ typedef enum {
   /**
    * A wet towel in water: the paper's springs lightly velocity-damped, and per unit area the
    * water's normal added mass (8 kg/m^2; none along the cloth), form drag (C_d = 1) on the
-   * normal velocity smoothed over 0.012 m, and skin drag (1.15 N s/m^3), symplectic Euler with the automatic step (`max_substep = FC_MAX_SUBSTEP_AUTO`: call
+   * normal velocity smoothed over 0.012 m, and skin drag (1.15 N s/m^3); the bend springs'
+   * constant stated at 0.01 m spacing (`bend_reference_spacing`); symplectic Euler with the automatic step (`max_substep = FC_MAX_SUBSTEP_AUTO`: call
    * `fc_cloth_step` once per frame). The look, measured: docs/underwater.md.
    */
   FC_PRESET_UNDERWATER = 4,
@@ -411,6 +412,14 @@ typedef struct {
    * Default 0 (`FC_PRESET_UNDERWATER`: see docs/underwater.md).
    */
   double form_drag_scale;
+  /**
+   * Spacing at which `bend_stiffness` holds, m (>= 0; 0 = the paper's spring constant at
+   * any spacing). With a reference, a cloth of spacing h (a grid's `spacing`; for a mesh the
+   * side of a square of two of its triangles' mean area) takes
+   * `bend_stiffness * (reference / h)^2`, so its bending, and the look, do not change with
+   * the resolution. Default 0 (`FC_PRESET_UNDERWATER`: 0.01, see docs/underwater.md).
+   */
+  double bend_reference_spacing;
 } FcClothDesc;
 
 #ifdef __cplusplus

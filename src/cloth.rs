@@ -654,7 +654,7 @@ impl Cloth {
             e += inertia.kinetic_energy(v) - forces::body_force(m, t.masses[i]).dot(x);
         }
         for s in &t.springs {
-            let k = m.stiffness(s.kind);
+            let k = m.stiffness(s.kind, t.spacing);
             let d = (self.x[s.i as usize] - self.x[s.j as usize]).norm() - s.rest;
             e += 0.5 * k * d * d;
         }

@@ -38,8 +38,17 @@ pub struct Model {
     pub stretch_stiffness: f64,
     /// Shear spring constant, N/m.
     pub shear_stiffness: f64,
-    /// Bend spring constant, N/m.
+    /// Bend spring constant, N/m, at the spacing [`Model::bend_reference_spacing`] (if set).
     pub bend_stiffness: f64,
+    /// Spacing at which `bend_stiffness` holds, m (0: the paper's constant per spring at any
+    /// spacing). The bending a bend spring gives grows with the spacing it spans: a curtain
+    /// baked at 2 cm with the spring constant of 1 cm carries fewer, longer waves (measured,
+    /// `docs/underwater.md`). With a reference, a cloth of spacing `h` ([`Topology::spacing`])
+    /// takes `bend_stiffness (reference / h)^2` ([`Model::bend_scale`]), and looks the same at
+    /// any resolution.
+    ///
+    /// [`Topology::spacing`]: crate::topology::Topology::spacing
+    pub bend_reference_spacing: f64,
     /// Spring damping constant k_d: N s/m for [`SpringDamping::Velocity`], N s^{1/2}/m for fractional.
     pub spring_damping: f64,
     /// Which damping the springs carry.
@@ -128,12 +137,27 @@ impl Model {
         self.spring_damping * self.spring_damping_scale[kind as usize]
     }
 
-    /// Spring constant of a spring family, N/m.
-    pub fn stiffness(&self, kind: SpringKind) -> f64 {
+    /// Spring constant of a spring family on a cloth of spacing `spacing` (m;
+    /// [`crate::topology::Topology::spacing`]), N/m: the bend springs' scaled by
+    /// `(bend_reference_spacing / spacing)^2` when a reference is set.
+    pub fn stiffness(&self, kind: SpringKind, spacing: f64) -> f64 {
         match kind {
             SpringKind::Stretch => self.stretch_stiffness,
             SpringKind::Shear => self.shear_stiffness,
-            SpringKind::Bend => self.bend_stiffness,
+            SpringKind::Bend => self.bend_stiffness * self.bend_scale(spacing),
+        }
+    }
+
+    /// What multiplies `bend_stiffness` on a cloth of spacing `spacing`: 1 without a reference,
+    /// for a spacing that is not positive, or one equal to the reference in single precision
+    /// (the precision of `FcClothDesc.spacing`: a grid of 0.01 m through the ABI or from Rust
+    /// is the same cloth), else `(bend_reference_spacing / spacing)^2`.
+    pub fn bend_scale(&self, spacing: f64) -> f64 {
+        let r = self.bend_reference_spacing;
+        if r > 0.0 && spacing > 0.0 && r as f32 != spacing as f32 {
+            (r / spacing) * (r / spacing)
+        } else {
+            1.0
         }
     }
 
@@ -146,6 +170,7 @@ impl Model {
         check_non_negative("stretch_stiffness", self.stretch_stiffness)?;
         check_non_negative("shear_stiffness", self.shear_stiffness)?;
         check_non_negative("bend_stiffness", self.bend_stiffness)?;
+        check_non_negative("bend_reference_spacing", self.bend_reference_spacing)?;
         check_non_negative("spring_damping", self.spring_damping)?;
         for (name, v) in [
             "stretch_damping_scale",
@@ -191,6 +216,7 @@ impl Model {
             stretch_stiffness: 10.0,
             shear_stiffness: 2.0,
             bend_stiffness: 0.5,
+            bend_reference_spacing: 0.0,
             spring_damping: 0.35,
             spring_damping_mode: SpringDamping::Fractional,
             spring_damping_scale: [1.0; 3],
@@ -243,11 +269,14 @@ impl Model {
     ///
     /// Swung 4 cm at 0.25 to 2 Hz the towel hangs (0.89 of its length at 2 Hz) and shows bumps
     /// travelling down, more and shorter the brisker the swing (about 3.5 half-waves at
-    /// 0.5 Hz, 0.16 m/s; 6 at 2 Hz), the same within 14 % from 2 cm to 0.5 cm spacing.
+    /// 0.5 Hz, 0.16 m/s; 6 at 2 Hz), the same within 8 % from 2 cm to 0.5 cm spacing (its bend
+    /// springs' constant is stated at 1 cm, [`UNDERWATER_BEND_SPACING`], and scaled to the
+    /// cloth's spacing).
     pub fn underwater() -> Self {
         Self {
             spring_damping: UNDERWATER_SPRING_DAMPING,
             spring_damping_mode: SpringDamping::Velocity,
+            bend_reference_spacing: UNDERWATER_BEND_SPACING,
             viscous_drag: 0.0,
             history_drag: 0.0,
             normal_drag: 0.0,
@@ -262,6 +291,11 @@ impl Model {
         }
     }
 }
+
+/// The spacing the underwater preset's bend springs (0.5 N/m) were tuned at, m: the 1 cm grid
+/// its look was measured on. Other spacings scale the bend springs
+/// ([`Model::bend_reference_spacing`]).
+pub const UNDERWATER_BEND_SPACING: f64 = 0.01;
 
 /// Normal added mass of the underwater preset, kg/m^2. Potential flow gives
 /// `rho_w lambda / pi` for a sheet rippled at wavelength lambda (about 80 kg/m^2 for the
@@ -309,5 +343,34 @@ pub enum RegularDrag {
 impl Default for Model {
     fn default() -> Self {
         Self::fractional()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bend springs scale as the square of the reference over the spacing; the paper's
+    /// models (no reference) and a spacing equal to the reference in single precision do not.
+    #[test]
+    fn bend_springs_scale_with_the_square_of_the_spacing() {
+        let m = Model::underwater();
+        assert_eq!(
+            m.stiffness(SpringKind::Bend, f64::from(0.01f32)),
+            m.bend_stiffness
+        );
+        assert_eq!(m.stiffness(SpringKind::Bend, 0.01), m.bend_stiffness);
+        assert!((m.stiffness(SpringKind::Bend, 0.02) - 0.25 * m.bend_stiffness).abs() < 1e-15);
+        assert!((m.stiffness(SpringKind::Bend, 0.005) - 4.0 * m.bend_stiffness).abs() < 1e-14);
+        assert_eq!(m.stiffness(SpringKind::Stretch, 0.02), m.stretch_stiffness);
+        assert_eq!(m.stiffness(SpringKind::Shear, 0.02), m.shear_stiffness);
+        assert_eq!(m.stiffness(SpringKind::Bend, 0.0), m.bend_stiffness);
+        let paper = Model::fractional();
+        assert_eq!(paper.stiffness(SpringKind::Bend, 0.02), paper.bend_stiffness);
+        let bad = Model {
+            bend_reference_spacing: -1.0,
+            ..Model::underwater()
+        };
+        assert!(bad.validate().is_err());
     }
 }

@@ -81,12 +81,13 @@ fn symplectic_bound(omega2: f64, gamma: f64) -> f64 {
     ((gamma * gamma + 4.0 * omega2).sqrt() - gamma) / omega2
 }
 
-/// Explicit Euler's bound from damping in proportion to the springs (`c / k` per family).
-fn explicit_bound(m: &Model) -> f64 {
+/// Explicit Euler's bound from damping in proportion to the springs (`c / k` per family), on
+/// a cloth of spacing `spacing`.
+fn explicit_bound(m: &Model, spacing: f64) -> f64 {
     use crate::topology::SpringKind::*;
     let mut bound = f64::INFINITY;
     for kind in [Stretch, Shear, Bend] {
-        let (k, c) = (m.stiffness(kind), m.spring_damping_of(kind));
+        let (k, c) = (m.stiffness(kind, spacing), m.spring_damping_of(kind));
         // Undamped springs give no bound of this kind (explicit Euler then gains energy at any
         // step, slowly: half symplectic Euler's bound holds it for the shot's length).
         if k <= 0.0 || c <= 0.0 {
@@ -179,7 +180,7 @@ impl Cloth {
         // Explicit Euler: half symplectic Euler's bound (measured: docs/stability.md), and the
         // springs' damping bound.
         let mut bound = if explicit {
-            explicit_bound(m)
+            explicit_bound(m, t.spacing)
         } else {
             f64::INFINITY
         };
@@ -195,7 +196,7 @@ impl Cloth {
             let (mut k, mut c, mut shortest) = (0.0, 0.0, f64::INFINITY);
             for &e in t.vertex_springs.row(i) {
                 let s = &t.springs[(e / 2) as usize];
-                k += m.stiffness(s.kind);
+                k += m.stiffness(s.kind, t.spacing);
                 c += match rate {
                     DampingRate::Velocity => m.spring_damping_of(s.kind),
                     DampingRate::HalfDerivative => w0 * m.spring_damping_of(s.kind),
@@ -278,16 +279,16 @@ mod tests {
     fn undamped_springs_leave_explicit_euler_a_finite_step() {
         let mut m = Model::regular(crate::model::RegularDrag::Normal);
         m.spring_damping = 0.0;
-        assert_eq!(explicit_bound(&m), f64::INFINITY);
+        assert_eq!(explicit_bound(&m, 0.01), f64::INFINITY);
         m.spring_damping_mode = crate::model::SpringDamping::None;
-        assert_eq!(explicit_bound(&m), f64::INFINITY);
+        assert_eq!(explicit_bound(&m, 0.01), f64::INFINITY);
     }
 
     #[test]
     fn explicit_eulers_bound_for_the_papers_springs_is_its_measured_one() {
         // Eq. 5 springs, k_d 0.35, k 10: (k_d / (Gamma(3/2) k))^2 = 1.56 ms; the stability
         // map measured 1.3-1.7 ms on the swing (docs/stability.md).
-        let b = explicit_bound(&Model::fractional());
+        let b = explicit_bound(&Model::fractional(), 0.01);
         assert!((b - 1.56e-3).abs() < 0.01e-3, "{b}");
     }
 }

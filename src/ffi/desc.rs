@@ -83,7 +83,8 @@ pub enum FcPreset {
     FC_PRESET_REGULAR_NORMAL = 3,
     /// A wet towel in water: the paper's springs lightly velocity-damped, and per unit area the
     /// water's normal added mass (8 kg/m^2; none along the cloth), form drag (C_d = 1) on the
-    /// normal velocity smoothed over 0.012 m, and skin drag (1.15 N s/m^3), symplectic Euler with the automatic step (`max_substep = FC_MAX_SUBSTEP_AUTO`: call
+    /// normal velocity smoothed over 0.012 m, and skin drag (1.15 N s/m^3); the bend springs'
+    /// constant stated at 0.01 m spacing (`bend_reference_spacing`); symplectic Euler with the automatic step (`max_substep = FC_MAX_SUBSTEP_AUTO`: call
     /// `fc_cloth_step` once per frame). The look, measured: docs/underwater.md.
     FC_PRESET_UNDERWATER = 4,
 }
@@ -214,6 +215,12 @@ pub struct FcClothDesc {
     /// swing keeps its short bumps while the sheet's motion at large is damped in full.
     /// Default 0 (`FC_PRESET_UNDERWATER`: see docs/underwater.md).
     pub form_drag_scale: f64,
+    /// Spacing at which `bend_stiffness` holds, m (>= 0; 0 = the paper's spring constant at
+    /// any spacing). With a reference, a cloth of spacing h (a grid's `spacing`; for a mesh the
+    /// side of a square of two of its triangles' mean area) takes
+    /// `bend_stiffness * (reference / h)^2`, so its bending, and the look, do not change with
+    /// the resolution. Default 0 (`FC_PRESET_UNDERWATER`: 0.01, see docs/underwater.md).
+    pub bend_reference_spacing: f64,
 }
 
 /// Each ABI enumeration value beside the library's, once: [`FcClothDesc::config`] reads
@@ -355,6 +362,7 @@ impl FcClothDesc {
             bend_damping_scale: model.spring_damping_scale[2],
             added_mass_coefficient: model.water.added_mass_coefficient,
             form_drag_scale: model.water.form_drag_scale,
+            bend_reference_spacing: model.bend_reference_spacing,
         }
     }
 
@@ -421,6 +429,7 @@ impl FcClothDesc {
                 stretch_stiffness: self.stretch_stiffness,
                 shear_stiffness: self.shear_stiffness,
                 bend_stiffness: self.bend_stiffness,
+                bend_reference_spacing: self.bend_reference_spacing,
                 spring_damping: self.spring_damping,
                 spring_damping_mode,
                 spring_damping_scale: [

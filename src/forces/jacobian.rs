@@ -78,7 +78,7 @@ pub fn linearise(input: &ForceInput<'_>, normals: &[Vec3], projected: &[f64], ou
     let cd = super::spring_damping(m, &input.weights);
     let w0 = input.weights.of(super::Memory::Particles);
     for (k, s) in input.topology.springs.iter().enumerate() {
-        let ks = m.stiffness(s.kind);
+        let ks = m.stiffness(s.kind, input.topology.spacing);
         let l = input.x[s.i as usize] - input.x[s.j as usize];
         let len = l.norm();
         if len == 0.0 {

@@ -93,9 +93,9 @@ pub(super) fn params<'a>(
     }
     Params {
         stiffness: [
-            m.stiffness(SpringKind::Stretch),
-            m.stiffness(SpringKind::Shear),
-            m.stiffness(SpringKind::Bend),
+            m.stiffness(SpringKind::Stretch, t.spacing),
+            m.stiffness(SpringKind::Shear, t.spacing),
+            m.stiffness(SpringKind::Bend, t.spacing),
         ],
         kd: if rate.is_some() {
             [

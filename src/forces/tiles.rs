@@ -498,7 +498,8 @@ mod tests {
             let l = x[i] - x[j];
             let len = l.norm();
             let dir = l / len;
-            let mag = -m.stiffness(s.kind) * (len - s.rest) - m.spring_damping * (q[i] - q[j]).dot(&dir);
+            let mag =
+                -m.stiffness(s.kind, t.spacing) * (len - s.rest) - m.spring_damping * (q[i] - q[j]).dot(&dir);
             f[i] += mag * dir;
             f[j] -= mag * dir;
         }

@@ -33,6 +33,10 @@ pub struct Topology {
     pub patch_scale: Vec<f64>,
     /// Grid size (columns, rows) when the cloth was built from a grid.
     pub grid: Option<(u32, u32)>,
+    /// The cloth's spacing, m: a grid's own; for a mesh the side of a square of two of its
+    /// triangles' mean rest area (a grid's spacing for a triangulated grid, jittered or not;
+    /// 0 without triangles). What `Model::bend_reference_spacing` compares with.
+    pub spacing: f64,
     /// Springs touching each vertex (see [`Adjacency::springs`]).
     pub vertex_springs: Adjacency,
     /// Triangles touching each vertex.
@@ -85,6 +89,11 @@ impl Topology {
                 patch[i] += face;
             }
         }
+        let spacing = if triangles.is_empty() {
+            0.0
+        } else {
+            (2.0 * areas.iter().sum::<f64>() / triangles.len() as f64).sqrt()
+        };
         let patch_scale = patch
             .iter()
             .map(|p| if p.norm() > 0.0 { 1.0 / p.norm() } else { 0.0 })
@@ -105,6 +114,7 @@ impl Topology {
             springs,
             triangles,
             grid,
+            spacing,
         };
         t.tiled = TileLayout::of(&t.tile_runs);
         t

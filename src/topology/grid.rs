@@ -117,6 +117,7 @@ impl GridSpec {
             triangles,
             Some((w, h)),
         );
+        t.spacing = s;
         // Each cell gives a quarter of its area to each corner: s^2 inside, half on an edge,
         // a quarter at a corner.
         for j in 0..h {

@@ -234,6 +234,49 @@ mod tests {
         (x, idx)
     }
 
+    /// A mesh's spacing (what `Model::bend_reference_spacing` compares with) is its grid's for
+    /// a quad grid, and for a grid of triangles with its vertices moved in the plane.
+    #[test]
+    fn a_grid_mesh_has_its_grids_spacing() {
+        let (x, idx) = quad_grid(7, 5);
+        let quads = MeshSpec {
+            positions: &x,
+            indices: &idx,
+            face_size: 4,
+            mass: MeshMass::ArealDensity(1.0),
+        }
+        .build()
+        .unwrap();
+        assert!((quads.spacing - 0.1).abs() < 1e-12, "{}", quads.spacing);
+        // Triangles, every interior vertex moved: the same total area, the same spacing.
+        let moved: Vec<Vec3> = x
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                let (i, j) = (k % 7, k / 7);
+                let inside = i > 0 && i < 6 && j > 0 && j < 4;
+                p + if inside {
+                    Vec3::new(0.01 * (k % 3) as f64, -0.01 * (k % 2) as f64, 0.0)
+                } else {
+                    Vec3::zeros()
+                }
+            })
+            .collect();
+        let tris: Vec<u32> = idx
+            .chunks(4)
+            .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+            .collect();
+        let t = MeshSpec {
+            positions: &moved,
+            indices: &tris,
+            face_size: 3,
+            mass: MeshMass::ArealDensity(1.0),
+        }
+        .build()
+        .unwrap();
+        assert!((t.spacing - 0.1).abs() < 1e-12, "{}", t.spacing);
+    }
+
     #[test]
     fn two_triangles_give_five_edges_one_bend_and_lumped_masses() {
         let x = [

@@ -29,7 +29,7 @@ this add-on.
 bl_info = {
     "name": "fraccloth: underwater cloth",
     "author": "fraccloth developers",
-    "version": (0, 8, 3),
+    "version": (0, 9, 0),
     "blender": (4, 2, 0),
     "location": "Properties > Physics > fraccloth",
     "description": "Cloth that moves as if underwater (fractional mass-spring model), baked to a point cache",
@@ -81,19 +81,19 @@ DAMPING_ITEMS = [
 PRESETS = {
     "UNDERWATER": ("Underwater towel", "A wet towel in water: slow bumps that travel down it (the library's underwater preset)", None),
     "SILK": ("Light silk", "A thin, light scarf: billows and drifts, settles slowly", {
-        "stretch_stiffness": 4.0, "shear_stiffness": 0.8, "bend_stiffness": 0.02,
+        "stretch_stiffness": 4.0, "shear_stiffness": 0.8, "bend_stiffness": 0.02, "bend_spacing": 0.01,
         "damping_mode": "VELOCITY", "spring_damping": 0.005, "history_drag": 0.0, "viscous_drag": 0.0,
         "normal_drag": 0.0, "mass_per_area": 0.1, "cloth_density": 1300.0, "water_density": 1000.0,
         "entrained_mass": 2.0, "added_mass": 0.0, "form_drag": 1.0, "form_drag_scale": 0.0, "skin_drag": 0.5,
         "history": "OFF", "integrator": "SYMPLECTIC"}),
     "CANVAS": ("Heavy canvas", "A heavy sheet: sinks and folds in broad, slow waves", {
-        "stretch_stiffness": 40.0, "shear_stiffness": 8.0, "bend_stiffness": 4.0,
+        "stretch_stiffness": 40.0, "shear_stiffness": 8.0, "bend_stiffness": 4.0, "bend_spacing": 0.01,
         "damping_mode": "VELOCITY", "spring_damping": 0.05, "history_drag": 0.0, "viscous_drag": 0.0,
         "normal_drag": 0.0, "mass_per_area": 2.0, "cloth_density": 1500.0, "water_density": 1000.0,
         "entrained_mass": 10.0, "added_mass": 0.0, "form_drag": 1.5, "form_drag_scale": 0.0, "skin_drag": 0.0,
         "history": "OFF", "integrator": "SYMPLECTIC"}),
     "PAPER": ("Fractional (paper)", "The paper's fractional cloth: half-derivative springs and drags, no water inertia", {
-        "stretch_stiffness": 10.0, "shear_stiffness": 2.0, "bend_stiffness": 0.5,
+        "stretch_stiffness": 10.0, "shear_stiffness": 2.0, "bend_stiffness": 0.5, "bend_spacing": 0.0,
         "damping_mode": "FRACTIONAL", "spring_damping": 0.35, "history_drag": 2e-3, "viscous_drag": 1e-3,
         "normal_drag": 0.0, "mass_per_area": 1.0, "cloth_density": 1100.0, "water_density": 1000.0,
         "entrained_mass": 0.0, "added_mass": 0.0, "form_drag": 0.0, "form_drag_scale": 0.0, "skin_drag": 0.0,
@@ -127,7 +127,8 @@ def _library_preset():
         fraccloth.SPRING_DAMPING_FRACTIONAL, fraccloth.SPRING_DAMPING_FRACTIONAL_STRAIN)
     return {
         "stretch_stiffness": d.stretch_stiffness, "shear_stiffness": d.shear_stiffness,
-        "bend_stiffness": d.bend_stiffness, "damping_mode": modes[d.spring_damping_mode],
+        "bend_stiffness": d.bend_stiffness, "bend_spacing": d.bend_reference_spacing,
+        "damping_mode": modes[d.spring_damping_mode],
         "spring_damping": d.spring_damping,
         # The library's per-particle drags are 0 in this preset; per area, to the panel's 1 cm^2.
         "history_drag": d.history_drag_per_area * 1e-4, "viscous_drag": d.viscous_drag_per_area * 1e-4,
@@ -172,6 +173,7 @@ class FracclothSettings(bpy.types.PropertyGroup):
     stretch_stiffness: bpy.props.FloatProperty(name="Stretch", description="How hard the cloth resists stretching (spring constant, N/m)", default=10.0, min=0.0, soft_max=200.0, update=_edited)
     shear_stiffness: bpy.props.FloatProperty(name="Shear", description="How hard it resists shearing (N/m)", default=2.0, min=0.0, soft_max=50.0, update=_edited)
     bend_stiffness: bpy.props.FloatProperty(name="Bend", description="How hard it resists bending (N/m); low values give fine folds", default=0.5, min=0.0, soft_max=20.0, update=_edited)
+    bend_spacing: bpy.props.FloatProperty(name="Bend measured at", description="The mesh spacing the Bend value holds at, m: a finer or coarser mesh gets its bend springs scaled so it bends alike (0: the same spring constant at any spacing, as in the paper)", default=0.01, min=0.0, soft_max=0.1, precision=3, update=_edited)
     damping_mode: bpy.props.EnumProperty(name="Spring damping", items=DAMPING_ITEMS, default="VELOCITY", update=_edited)
     spring_damping: bpy.props.FloatProperty(name="Damping", description="How much the springs damp their own motion (N s^1/2/m fractional, N s/m ordinary)", default=0.003, min=0.0, soft_max=1.0, precision=4, update=_edited)
     history_drag: bpy.props.FloatProperty(name="History drag", description="Water's memory drag per 1 cm^2 of cloth (N s^1/2/m)", default=0.0, min=0.0, soft_max=0.05, precision=5, update=_edited)
@@ -408,6 +410,7 @@ def describe(s, scene=None):
     desc.stretch_stiffness = s.stretch_stiffness
     desc.shear_stiffness = s.shear_stiffness
     desc.bend_stiffness = s.bend_stiffness
+    desc.bend_reference_spacing = s.bend_spacing
     desc.spring_damping = s.spring_damping
     desc.spring_damping_mode = {
         "FRACTIONAL": fraccloth.SPRING_DAMPING_FRACTIONAL,
@@ -778,7 +781,7 @@ class FRACCLOTH_PT_panel(bpy.types.Panel):
         layout.prop(s, "pin_group")
         for title, names in (
             ("Cloth", ("mass_per_area", "cloth_density", "stretch_stiffness", "shear_stiffness", "bend_stiffness",
-                       "damping_mode", "spring_damping")),
+                       "bend_spacing", "damping_mode", "spring_damping")),
             ("Water", ("water_density", "entrained_mass", "added_mass", "form_drag", "form_drag_scale", "skin_drag", "history_drag",
                        "viscous_drag", "normal_drag", "current")),
             ("Colliders", ("collider_shape", "friction", "collision_margin", "self_collision", "self_friction")),

@@ -186,7 +186,7 @@ def test_the_underwater_preset_is_the_librarys(addon, tmp_path):
     s.preset = "UNDERWATER"
     got = addon.describe(s)
     want = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
-    for field in ("stretch_stiffness", "shear_stiffness", "bend_stiffness", "spring_damping", "spring_damping_mode",
+    for field in ("stretch_stiffness", "shear_stiffness", "bend_stiffness", "bend_reference_spacing", "spring_damping", "spring_damping_mode",
                   "entrained_mass", "added_mass", "form_drag", "form_drag_scale", "skin_drag", "cloth_density", "water_density",
                   "integrator", "viscous_drag", "history_drag", "normal_drag", "viscous_drag_per_area",
                   "history_drag_per_area", "normal_drag_per_area"):

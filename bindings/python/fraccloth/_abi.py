@@ -50,6 +50,7 @@ DESC_FIELDS = [
     ('self_collision_thickness', ctypes.c_double, 'Self-collision: the distance the cloth keeps from itself, m (0 = off, the default). Points nearer than 2.2 times this at rest (neighbours) are not tested: a few millimetres for a cloth of 1-2 cm spacing. No vertex moves more than half of it in one substep (a faster one is slowed to that). See docs/collisions.md.'),
     ('self_collision_friction', ctypes.c_double, 'Coulomb friction coefficient of the cloth against itself (>= 0). Default 0.'),
     ('form_drag_scale', ctypes.c_double, "Length over which the form drag smooths the normal velocity before it acts, m (>= 0; 0 = each particle's own). Ripples much shorter than it shed little drag, so a brisk swing keeps its short bumps while the sheet's motion at large is damped in full. Default 0 (`FC_PRESET_UNDERWATER`: see docs/underwater.md)."),
+    ('bend_reference_spacing', ctypes.c_double, "Spacing at which `bend_stiffness` holds, m (>= 0; 0 = the paper's spring constant at any spacing). With a reference, a cloth of spacing h (a grid's `spacing`; for a mesh the side of a square of two of its triangles' mean area) takes `bend_stiffness * (reference / h)^2`, so its bending, and the look, do not change with the resolution. Default 0 (`FC_PRESET_UNDERWATER`: 0.01, see docs/underwater.md)."),
 ]
 
 # Every FC_* enum value of the header.
