@@ -9,7 +9,7 @@
 //! `current=X,Y,Z` (m/s; with `amp=0`, how far the tip leans and flutters), `integrator=symplectic|implicit|explicit|symplectic2|implicit2` [symplectic], `dt` [2 ms
 //! explicit, 1/30 s implicit], `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
 //! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag), `scale=` (its smoothing length, m),
-//! `skin=` (N s/m^3), `damping=` (spring damping), `bend=` (the bend springs' stiffness, times the
+//! `skin=` (N s/m^3), `damping=` (spring damping), `dscale=S,H,B` (its multiple per family: stretch, shear, bend), `bend=` (the bend springs' stiffness, times the
 //! preset's), `mode=velocity|fractional|strain|none` (what the
 //! springs damp), `history=` (history drag per area, N s^1/2/m^3; the SOE history is kept).
 
@@ -57,6 +57,13 @@ fn main() {
     w_.form_drag_scale = num("scale", w_.form_drag_scale);
     w_.skin_drag = num("skin", w_.skin_drag);
     model.spring_damping = num("damping", model.spring_damping);
+    if let Some(d) = get("dscale") {
+        let v: Vec<f64> = d
+            .split(',')
+            .map(|x| x.parse().expect("STRETCH,SHEAR,BEND"))
+            .collect();
+        model.spring_damping_scale = [v[0], v[1], v[2]];
+    }
     // Bending stiffness as a multiple of the preset's (its bend springs' k).
     model.bend_stiffness *= num("bend", 1.0);
     model.water.history_drag = num("history", model.water.history_drag);

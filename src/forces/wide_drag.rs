@@ -52,6 +52,14 @@ const LANES: usize = 8;
 /// sums its row's entries in the row's order and then adds `0 x -0.0 = -0.0`, which leaves any
 /// sum as it is, a zero's sign included: the bits of the rows summed one by one, in a shape the
 /// vector unit takes whole.
+///
+/// **Shifted blocks.** A block whose rows are one row shifted (row `first + l` has entries at
+/// columns `first + l + d_k` with weights `w_k`, the same `d_k` and `w_k` bit for bit in every
+/// lane: a regular grid's rows away from its border) stores no entries: it names its shape in
+/// `shapes` and reads `u` as plain slices, no column loads, no gathers. A 1001 x 1001 grid's
+/// matrix then shrinks from 84 bytes a row to four, which is what a pass streamed from memory
+/// once the cloth leaves the cache (`docs/benchmarks.md`). Same entries in the same order: the
+/// same bits.
 #[derive(Clone, Debug, Default)]
 struct Blocks {
     /// Rows.
@@ -59,6 +67,47 @@ struct Blocks {
     starts: Vec<u32>,
     cols: Vec<u32>,
     weights: Vec<f64>,
+    /// Per block: the index of its shape in `shapes`, or [`STORED`] when its entries are stored.
+    shape: Vec<u32>,
+    /// The distinct shapes of shifted blocks.
+    shapes: Vec<Shape>,
+}
+
+/// [`Blocks::shape`] of a block whose entries are stored.
+const STORED: u32 = u32::MAX;
+
+/// The entries every row of a shifted block has: column offsets from the row and weights.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Shape {
+    offsets: Vec<isize>,
+    weights: Vec<f64>,
+}
+
+impl Shape {
+    /// The shape rows `rows` of `s` share, if they are one row shifted (a full block).
+    fn of(s: &Stencil, rows: std::ops::Range<usize>) -> Option<Self> {
+        if rows.len() != LANES {
+            return None;
+        }
+        let entries = |i: usize| s.offsets[i] as usize..s.offsets[i + 1] as usize;
+        let first = rows.start;
+        let shape = Self {
+            offsets: entries(first)
+                .map(|e| s.cols[e] as isize - first as isize)
+                .collect(),
+            weights: entries(first).map(|e| s.weights[e]).collect(),
+        };
+        let same = |i: usize| {
+            entries(i).len() == shape.offsets.len()
+                && entries(i)
+                    .zip(&shape.offsets)
+                    .zip(&shape.weights)
+                    .all(|((e, &d), w)| {
+                        s.cols[e] as isize - i as isize == d && s.weights[e].to_bits() == w.to_bits()
+                    })
+        };
+        rows.skip(1).all(same).then_some(shape)
+    }
 }
 
 impl Blocks {
@@ -72,6 +121,19 @@ impl Blocks {
         };
         for first in (0..n).step_by(LANES) {
             let rows = first..(first + LANES).min(n);
+            if let Some(shape) = Shape::of(s, rows.clone()) {
+                let k = match b.shapes.iter().position(|q| *q == shape) {
+                    Some(k) => k,
+                    None => {
+                        b.shapes.push(shape);
+                        b.shapes.len() - 1
+                    }
+                };
+                b.shape.push(k as u32);
+                b.starts.push((b.cols.len() / LANES) as u32);
+                continue;
+            }
+            b.shape.push(STORED);
             let width = rows.clone().map(|i| row(i).len()).max().unwrap_or(0);
             let at = b.cols.len();
             b.cols.resize(at + width * LANES, n as u32);
@@ -84,6 +146,8 @@ impl Blocks {
             }
             b.starts.push((b.cols.len() / LANES) as u32);
         }
+        b.cols.shrink_to_fit();
+        b.weights.shrink_to_fit();
         b
     }
 }
@@ -99,6 +163,20 @@ fn apply_blocks(b: &Blocks, first: usize, u: &[f64], out: &mut [f64]) {
     let u = &u[..=mask];
     for (k, o) in out.chunks_mut(LANES).enumerate() {
         let block = first / LANES + k;
+        if let Some(shape) = b.shapes.get(b.shape[block] as usize) {
+            // A shifted block (full, so every lane's column is a row's entry, below `rows`).
+            let row0 = first + k * LANES;
+            let mut acc = [-0.0f64; LANES];
+            for (&d, &w) in shape.offsets.iter().zip(&shape.weights) {
+                let at = row0.wrapping_add_signed(d);
+                let v: &[f64; LANES] = u[at..at + LANES].try_into().expect("a block's columns");
+                for l in 0..LANES {
+                    acc[l] += w * v[l];
+                }
+            }
+            o.copy_from_slice(&acc);
+            continue;
+        }
         let (lo, hi) = (b.starts[block] as usize, b.starts[block + 1] as usize);
         let cols = &b.cols[lo * LANES..hi * LANES];
         let weights = &b.weights[lo * LANES..hi * LANES];
@@ -239,7 +317,39 @@ fn one_pass(t: &Topology) -> Stencil {
             row
         })
         .collect();
-    Stencil::from_rows(rows)
+    Stencil::from_rows(shared_rounding(rows))
+}
+
+/// Relative difference below which two rows' weights are the same weights rounded differently.
+const ROUNDING: f64 = 1e-12;
+
+/// Rows that are one row shifted up to rounding (the same column offsets from the row, weights
+/// within [`ROUNDING`]: a regular grid's interior, whose face areas round differently at
+/// different coordinates) take the first such row's weights bit for bit, so [`Blocks`] can
+/// store them once. Weights move by rounding only (1e-16 relative); an irregular mesh's rows,
+/// whose weights differ by more, keep theirs.
+fn shared_rounding(mut rows: Vec<Vec<(u32, f64)>>) -> Vec<Vec<(u32, f64)>> {
+    let mut seen: std::collections::HashMap<Vec<i64>, Vec<f64>> = std::collections::HashMap::new();
+    for (i, row) in rows.iter_mut().enumerate() {
+        let offsets: Vec<i64> = row.iter().map(|&(j, _)| i64::from(j) - i as i64).collect();
+        match seen.get(&offsets) {
+            Some(w)
+                if row
+                    .iter()
+                    .zip(w)
+                    .all(|(&(_, a), &b)| (a - b).abs() <= ROUNDING * b.abs()) =>
+            {
+                for ((_, a), &b) in row.iter_mut().zip(w) {
+                    *a = b;
+                }
+            }
+            Some(_) => {}
+            None => {
+                seen.insert(offsets, row.iter().map(|&(_, w)| w).collect());
+            }
+        }
+    }
+    rows
 }
 
 /// Mean square distance, m^2, over which one pass spreads a vertex's value:
@@ -276,12 +386,16 @@ fn apply(w: &RestWeights, transpose: bool, u: &mut Vec<f64>, b: &mut Vec<f64>) {
     b.resize(padded, -0.0);
     b[n..].fill(-0.0);
     let one = if transpose { &w.backward } else { &w.forward };
+    let par = crate::parallel::worth_it(n);
     let partial = |u: &mut Vec<f64>, b: &mut Vec<f64>| {
         if w.partial > 0.0 {
             one.apply(u, &mut b[..n]);
-            for (ui, bi) in u[..n].iter_mut().zip(&b[..n]) {
-                *ui += w.partial * (bi - *ui);
-            }
+            let b = &b[..n];
+            crate::parallel::chunks(par, &mut u[..n], crate::parallel::CHUNK, |first, u| {
+                for (ui, bi) in u.iter_mut().zip(&b[first..]) {
+                    *ui += w.partial * (bi - *ui);
+                }
+            });
         }
     };
     if transpose {
@@ -322,17 +436,29 @@ pub fn add_wide_form_drag(
         Some(w) if w.length == length && w.forward.rows == normals.len() => w,
         _ => rest.insert(RestWeights::new(t, length)),
     };
-    a.clear();
-    a.extend(normals.iter().zip(v).map(|(n, v)| n.dot(v)));
+    // The element-wise loops run in chunks over the pool on a large cloth (same bits).
+    let (par, chunk) = (crate::parallel::worth_it(normals.len()), crate::parallel::CHUNK);
+    a.resize(normals.len(), 0.0);
+    crate::parallel::chunks(par, a, chunk, |first, a| {
+        for ((u, n), v) in a.iter_mut().zip(&normals[first..]).zip(&v[first..]) {
+            *u = n.dot(v);
+        }
+    });
     apply(w, false, a, b);
     let c = 0.5 * m.water_density * m.water.form_drag;
-    for (g, area) in a.iter_mut().zip(&t.areas) {
-        *g *= c * area * g.abs();
-    }
+    let areas = &t.areas;
+    crate::parallel::chunks(par, a, chunk, |first, a| {
+        for (g, area) in a.iter_mut().zip(&areas[first..]) {
+            *g *= c * area * g.abs();
+        }
+    });
     apply(w, true, a, b);
-    for ((o, n), g) in out.iter_mut().zip(normals.iter()).zip(a.iter()) {
-        *o -= *g * n;
-    }
+    let g = &a[..];
+    crate::parallel::chunks(par, out, chunk, |first, out| {
+        for ((o, n), g) in out.iter_mut().zip(&normals[first..]).zip(&g[first..]) {
+            *o -= *g * n;
+        }
+    });
 }
 
 #[cfg(test)]
@@ -412,7 +538,101 @@ mod tests {
                 widths.iter().any(|&w| w != widths[0]),
                 "blocks of mixed widths: {widths:?}"
             );
+            // The grid's interior blocks are shifted rows (one shape), the rest stored; the fan
+            // has no shifted block.
+            let shifted = blocks.shape.iter().filter(|&&k| k != STORED).count();
+            let expected = if n == 13 * 9 { (4, 1) } else { (0, 0) };
+            assert_eq!((shifted, blocks.shapes.len()), expected);
         }
+    }
+
+    /// A regular grid's interior rows share their weights bit for bit after `shared_rounding`,
+    /// which moves none by more than rounding; a jittered mesh's rows keep theirs.
+    #[test]
+    fn rows_that_differ_by_rounding_share_their_weights() {
+        let raw = |t: &Topology| {
+            let rows: Vec<Vec<(u32, f64)>> = {
+                let s = one_pass(t);
+                (0..t.vertex_count())
+                    .map(|i| {
+                        let r = s.offsets[i] as usize..s.offsets[i + 1] as usize;
+                        r.map(|e| (s.cols[e], s.weights[e])).collect()
+                    })
+                    .collect()
+            };
+            rows
+        };
+        // A grid far from the origin: its face areas round differently from cell to cell.
+        let mut t = grid(20, 6, 0.0137);
+        for x in &mut t.rest_positions {
+            *x += Vec3::new(3.1, -7.3, 0.7);
+        }
+        let shared = raw(&t);
+        let interior = |i: usize| (i % 20 > 0 && i % 20 < 19 && i / 20 > 0 && i / 20 < 5).then_some(i);
+        let first = (0..120).find_map(interior).expect("an interior row");
+        for i in (0..120).filter_map(interior) {
+            let (a, b) = (&shared[i], &shared[first]);
+            assert_eq!(a.len(), b.len());
+            for (&(ja, wa), &(jb, wb)) in a.iter().zip(b) {
+                assert_eq!(ja as i64 - i as i64, jb as i64 - first as i64);
+                assert_eq!(wa.to_bits(), wb.to_bits(), "row {i}");
+            }
+        }
+        // Before sharing, the same rows differ in their last bits somewhere, by rounding only.
+        let x = &t.rest_positions;
+        let area = |tri: &[u32; 3]| {
+            let [a, b, c] = tri.map(|i| i as usize);
+            0.5 * (x[b] - x[a]).cross(&(x[c] - x[a])).norm()
+        };
+        let areas: Vec<f64> = t.triangles.iter().map(area).collect();
+        assert!(
+            areas.iter().any(|a| a.to_bits() != areas[0].to_bits()),
+            "areas round alike"
+        );
+        let spread = areas
+            .iter()
+            .fold(0.0f64, |m, a| m.max((a - areas[0]).abs() / areas[0]));
+        assert!(spread < 1e-13, "{spread}");
+        // A jittered mesh's rows are not moved.
+        let mut j = grid(9, 7, 0.01);
+        for (k, x) in j.rest_positions.iter_mut().enumerate() {
+            let h = (k as u64)
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            x.x += 0.002 * ((h >> 40) as f64 / (1u64 << 24) as f64 - 0.5);
+            x.y += 0.002 * ((h >> 16 & 0xff_ffff) as f64 / (1u64 << 24) as f64 - 0.5);
+        }
+        let unique = one_pass(&j);
+        let mut plain = unique.clone();
+        plain.weights.clear();
+        for i in 0..j.vertex_count() {
+            let faces = j.vertex_triangles.row(i);
+            let total: f64 = faces.iter().map(|&f| area_of(&j, f)).sum();
+            let mut row: Vec<(u32, f64)> = Vec::new();
+            for &f in faces {
+                let w = area_of(&j, f) / total / 3.0;
+                for &v in &j.triangles[f as usize] {
+                    match row.iter_mut().find(|(k, _)| *k == v) {
+                        Some((_, acc)) => *acc += w,
+                        None => row.push((v, w)),
+                    }
+                }
+            }
+            row.sort_by_key(|&(v, _)| v);
+            plain.weights.extend(row.iter().map(|&(_, w)| w));
+        }
+        let moved = unique
+            .weights
+            .iter()
+            .zip(&plain.weights)
+            .filter(|(a, b)| a.to_bits() != b.to_bits());
+        assert_eq!(moved.count(), 0);
+    }
+
+    fn area_of(t: &Topology, f: u32) -> f64 {
+        let x = &t.rest_positions;
+        let [a, b, c] = t.triangles[f as usize].map(|i| i as usize);
+        0.5 * (x[b] - x[a]).cross(&(x[c] - x[a])).norm()
     }
 
     #[test]
