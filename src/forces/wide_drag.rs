@@ -285,8 +285,14 @@ impl RestWeights {
 }
 
 /// One smoothing pass as vertex rows: each face takes the mean of its corners, each vertex the
-/// rest-area weighted mean of its faces (a vertex with no face area keeps its value).
+/// rest-area weighted mean of its faces (a vertex with no face area keeps its value); rows
+/// equal to within rounding share their weights ([`shared_rounding`]).
 fn one_pass(t: &Topology) -> Stencil {
+    Stencil::from_rows(shared_rounding(pass_rows(t)))
+}
+
+/// [`one_pass`]'s rows, each vertex's `(column, weight)` in ascending columns, as computed.
+fn pass_rows(t: &Topology) -> Vec<Vec<(u32, f64)>> {
     let x = &t.rest_positions;
     let face_area: Vec<f64> = t
         .triangles
@@ -296,7 +302,7 @@ fn one_pass(t: &Topology) -> Stencil {
             0.5 * (x[b] - x[a]).cross(&(x[c] - x[a])).norm()
         })
         .collect();
-    let rows = (0..x.len())
+    (0..x.len())
         .map(|i| {
             let faces = t.vertex_triangles.row(i);
             let total: f64 = faces.iter().map(|&f| face_area[f as usize]).sum();
@@ -316,8 +322,7 @@ fn one_pass(t: &Topology) -> Stencil {
             row.sort_by_key(|&(j, _)| j);
             row
         })
-        .collect();
-    Stencil::from_rows(shared_rounding(rows))
+        .collect()
 }
 
 /// Relative difference below which two rows' weights are the same weights rounded differently.
@@ -550,49 +555,34 @@ mod tests {
     /// which moves none by more than rounding; a jittered mesh's rows keep theirs.
     #[test]
     fn rows_that_differ_by_rounding_share_their_weights() {
-        let raw = |t: &Topology| {
-            let rows: Vec<Vec<(u32, f64)>> = {
-                let s = one_pass(t);
-                (0..t.vertex_count())
-                    .map(|i| {
-                        let r = s.offsets[i] as usize..s.offsets[i + 1] as usize;
-                        r.map(|e| (s.cols[e], s.weights[e])).collect()
-                    })
-                    .collect()
-            };
-            rows
-        };
+        let bits = |r: &[(u32, f64)]| r.iter().map(|&(j, w)| (j, w.to_bits())).collect::<Vec<_>>();
         // A grid far from the origin: its face areas round differently from cell to cell.
         let mut t = grid(20, 6, 0.0137);
         for x in &mut t.rest_positions {
             *x += Vec3::new(3.1, -7.3, 0.7);
         }
-        let shared = raw(&t);
-        let interior = |i: usize| (i % 20 > 0 && i % 20 < 19 && i / 20 > 0 && i / 20 < 5).then_some(i);
-        let first = (0..120).find_map(interior).expect("an interior row");
-        for i in (0..120).filter_map(interior) {
-            let (a, b) = (&shared[i], &shared[first]);
-            assert_eq!(a.len(), b.len());
-            for (&(ja, wa), &(jb, wb)) in a.iter().zip(b) {
-                assert_eq!(ja as i64 - i as i64, jb as i64 - first as i64);
-                assert_eq!(wa.to_bits(), wb.to_bits(), "row {i}");
-            }
-        }
-        // Before sharing, the same rows differ in their last bits somewhere, by rounding only.
-        let x = &t.rest_positions;
-        let area = |tri: &[u32; 3]| {
-            let [a, b, c] = tri.map(|i| i as usize);
-            0.5 * (x[b] - x[a]).cross(&(x[c] - x[a])).norm()
+        let computed = pass_rows(&t);
+        let shared = shared_rounding(computed.clone());
+        let interior: Vec<usize> = (0..120)
+            .filter(|i| i % 20 > 0 && i % 20 < 19 && i / 20 > 0 && i / 20 < 5)
+            .collect();
+        let shifted = |r: &[(u32, f64)], i: usize| -> Vec<(i64, u64)> {
+            r.iter()
+                .map(|&(j, w)| (i64::from(j) - i as i64, w.to_bits()))
+                .collect()
         };
-        let areas: Vec<f64> = t.triangles.iter().map(area).collect();
-        assert!(
-            areas.iter().any(|a| a.to_bits() != areas[0].to_bits()),
-            "areas round alike"
-        );
-        let spread = areas
+        let first = interior[0];
+        for &i in &interior {
+            assert_eq!(shifted(&shared[i], i), shifted(&shared[first], first), "row {i}");
+        }
+        // As computed, the same rows differ in their last bits, by rounding only.
+        assert!(interior
             .iter()
-            .fold(0.0f64, |m, a| m.max((a - areas[0]).abs() / areas[0]));
-        assert!(spread < 1e-13, "{spread}");
+            .any(|&i| shifted(&computed[i], i) != shifted(&computed[first], first)));
+        for (a, b) in computed.iter().flatten().zip(shared.iter().flatten()) {
+            assert_eq!(a.0, b.0);
+            assert!((a.1 - b.1).abs() <= ROUNDING * b.1, "{} against {}", a.1, b.1);
+        }
         // A jittered mesh's rows are not moved.
         let mut j = grid(9, 7, 0.01);
         for (k, x) in j.rest_positions.iter_mut().enumerate() {
@@ -602,37 +592,11 @@ mod tests {
             x.x += 0.002 * ((h >> 40) as f64 / (1u64 << 24) as f64 - 0.5);
             x.y += 0.002 * ((h >> 16 & 0xff_ffff) as f64 / (1u64 << 24) as f64 - 0.5);
         }
-        let unique = one_pass(&j);
-        let mut plain = unique.clone();
-        plain.weights.clear();
-        for i in 0..j.vertex_count() {
-            let faces = j.vertex_triangles.row(i);
-            let total: f64 = faces.iter().map(|&f| area_of(&j, f)).sum();
-            let mut row: Vec<(u32, f64)> = Vec::new();
-            for &f in faces {
-                let w = area_of(&j, f) / total / 3.0;
-                for &v in &j.triangles[f as usize] {
-                    match row.iter_mut().find(|(k, _)| *k == v) {
-                        Some((_, acc)) => *acc += w,
-                        None => row.push((v, w)),
-                    }
-                }
-            }
-            row.sort_by_key(|&(v, _)| v);
-            plain.weights.extend(row.iter().map(|&(_, w)| w));
+        let computed = pass_rows(&j);
+        let shared = shared_rounding(computed.clone());
+        for (a, b) in computed.iter().zip(&shared) {
+            assert_eq!(bits(a), bits(b));
         }
-        let moved = unique
-            .weights
-            .iter()
-            .zip(&plain.weights)
-            .filter(|(a, b)| a.to_bits() != b.to_bits());
-        assert_eq!(moved.count(), 0);
-    }
-
-    fn area_of(t: &Topology, f: u32) -> f64 {
-        let x = &t.rest_positions;
-        let [a, b, c] = t.triangles[f as usize].map(|i| i as usize);
-        0.5 * (x[b] - x[a]).cross(&(x[c] - x[a])).norm()
     }
 
     #[test]
