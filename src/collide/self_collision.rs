@@ -547,6 +547,82 @@ impl SelfCollision {
 mod tests {
     use super::*;
 
+    /// The look finds exactly the pairs a test of every pair finds, sides included: on a sheet
+    /// folded onto itself (many pairs within reach) with vertices moved at random, and with a
+    /// vertex that belongs to no triangle lying on the sheet.
+    #[test]
+    fn the_look_finds_what_testing_every_pair_finds() {
+        let (cols, rows) = (12u32, 9u32);
+        let h = 0.01;
+        let mut r = crate::testing::numbers(11);
+        // Folded along the row in the middle: the lower half comes back 3 mm under the upper.
+        let mut x: Vec<Vec3> = Vec::new();
+        let mut rest: Vec<Vec3> = Vec::new();
+        for j in 0..rows {
+            for i in 0..cols {
+                rest.push(Vec3::new(f64::from(i) * h, -f64::from(j) * h, 0.0));
+                let fold = f64::from(rows - 1) / 2.0;
+                let (y, z) = if f64::from(j) <= fold {
+                    (-f64::from(j) * h, 0.0)
+                } else {
+                    (-(2.0 * fold - f64::from(j)) * h, 0.003)
+                };
+                x.push(Vec3::new(f64::from(i) * h, y, z) + 0.002 * Vec3::new(r(), r(), r()));
+            }
+        }
+        // A lone vertex over the sheet, in no triangle.
+        rest.push(Vec3::new(0.5, 0.5, 0.5));
+        x.push(Vec3::new(0.055, -0.02, 0.0015));
+        let at = |i: u32, j: u32| j * cols + i;
+        let mut triangles = Vec::new();
+        for j in 0..rows - 1 {
+            for i in 0..cols - 1 {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                triangles.push([a, b, c]);
+                triangles.push([a, c, d]);
+            }
+        }
+        let (thickness, reach) = (0.004, 0.008);
+        let mut sc = SelfCollision::new(&triangles);
+        sc.look(&x, &rest, &triangles, reach, EXCLUDED * thickness);
+        assert!(sc.vertex_triangle.len() > 50 && sc.edge_edge.len() > 50, "a fold has pairs");
+        let excluded = Exclusions::new(&rest, &triangles, &sc.edges, EXCLUDED * thickness);
+        let mut vt = Vec::new();
+        for p in 0..x.len() as u32 {
+            for (t, tri) in triangles.iter().enumerate() {
+                if tri.contains(&p) || excluded.vertex_excludes(p, t as u32) {
+                    continue;
+                }
+                let (d, w, r) = vertex_triangle(&x, p, tri);
+                if d < reach {
+                    let [a, b, c] = tri.map(|i| x[i as usize]);
+                    let s = if w.iter().all(|&wk| wk > 0.0) {
+                        side(r.dot(&(b - a).cross(&(c - a))))
+                    } else {
+                        0
+                    };
+                    vt.push((p, t as u32, s));
+                }
+            }
+        }
+        let mut ee = Vec::new();
+        for (e, edge) in sc.edges.iter().enumerate() {
+            for (f, other) in sc.edges.iter().enumerate().skip(e + 1) {
+                if edge.iter().any(|v| other.contains(v)) || excluded.edge_excludes(e as u32, f as u32) {
+                    continue;
+                }
+                let (d, a, b, r, n) = edge_edge(&x, edge, other);
+                if d < reach {
+                    let interior = a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0;
+                    ee.push((e as u32, f as u32, if interior { side(r.dot(&n)) } else { 0 }));
+                }
+            }
+        }
+        assert!(vt.iter().any(|q| q.0 == x.len() as u32 - 1), "the lone vertex has pairs");
+        assert_eq!(sc.vertex_triangle, vt);
+        assert_eq!(sc.edge_edge, ee);
+    }
+
     /// Two parallel squares 3 mm apart: pairs are found across them, none within one square,
     /// and each vertex is pushed away from the other square.
     #[test]
