@@ -585,7 +585,10 @@ mod tests {
         let (thickness, reach) = (0.004, 0.008);
         let mut sc = SelfCollision::new(&triangles);
         sc.look(&x, &rest, &triangles, reach, EXCLUDED * thickness);
-        assert!(sc.vertex_triangle.len() > 50 && sc.edge_edge.len() > 50, "a fold has pairs");
+        assert!(
+            sc.vertex_triangle.len() > 50 && sc.edge_edge.len() > 50,
+            "a fold has pairs"
+        );
         let excluded = Exclusions::new(&rest, &triangles, &sc.edges, EXCLUDED * thickness);
         let mut vt = Vec::new();
         for p in 0..x.len() as u32 {
@@ -618,7 +621,10 @@ mod tests {
                 }
             }
         }
-        assert!(vt.iter().any(|q| q.0 == x.len() as u32 - 1), "the lone vertex has pairs");
+        assert!(
+            vt.iter().any(|q| q.0 == x.len() as u32 - 1),
+            "the lone vertex has pairs"
+        );
         assert_eq!(sc.vertex_triangle, vt);
         assert_eq!(sc.edge_edge, ee);
     }
