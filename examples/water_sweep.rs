@@ -62,7 +62,7 @@ fn main() {
             .split(',')
             .map(|x| x.parse().expect("STRETCH,SHEAR,BEND"))
             .collect();
-        model.spring_damping_scale = [v[0], v[1], v[2]];
+        model.spring_damping_scale = v.try_into().expect("dscale=STRETCH,SHEAR,BEND: three numbers");
     }
     // Bending stiffness as a multiple of the preset's (its bend springs' k).
     model.bend_stiffness *= num("bend", 1.0);
