@@ -141,15 +141,15 @@ pub fn effective_forces(
     }
 }
 
-/// Scratch of [`turning_forces`]: per face its normal times twice its area (then the sum of
-/// its vertices' weights) and that normal's rate; per vertex its weight.
+/// Scratch of [`turning_forces`]: per vertex the sums of its faces' area vectors and of their
+/// rates, and its weight; and how the pool's path splits the cloth.
 #[derive(Clone, Debug, Default)]
 pub struct TurningScratch {
     faces: Vec<Vec3>,
     rates: Vec<Vec3>,
     patches: Vec<Vec3>,
-    /// Each face's gradients at its corners b and c (a's is minus their sum).
-    gradients: Vec<[Vec3; 2]>,
+    /// How the pool's path splits the cloth.
+    split: TurningSplit,
 }
 
 /// The unit normal of every vertex and how much of its patch's rest area faces along it.
@@ -218,6 +218,11 @@ pub fn turning_forces(
     }
 }
 
+/// The four passes on one thread, each face's sums scattered to its corners instead of each
+/// vertex gathering its faces'. A vertex's faces are listed in ascending order
+/// ([`crate::topology::Adjacency`]) and the faces are visited in that order, so every vertex
+/// receives the same terms in the same order as [`turning_parallel`] sums them: the same
+/// bits, without the per-face arrays and the corner tests of the gather.
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 fn turning_serial(
     ma: f64,
@@ -229,45 +234,108 @@ fn turning_serial(
     normals: &mut [Vec3],
     out: &mut [Vec3],
 ) {
-    let (areas, triangles, vertex_triangles) = (&t.areas, &t.triangles, &t.vertex_triangles);
+    let (areas, triangles) = (&t.areas, &t.triangles);
+    let n = x.len();
     let TurningScratch {
-        faces,
+        faces: sums,
         rates,
         patches,
-        gradients,
+        ..
     } = scratch;
-    faces.clear();
-    rates.clear();
+    // Each vertex's sums of its faces' area vectors and of their rates.
+    for buf in [&mut *sums, &mut *rates] {
+        buf.clear();
+        buf.resize(n, Vec3::zeros());
+    }
     for tri in triangles {
         let (f, r) = face_and_rate(x, v, tri);
-        faces.push(f);
-        rates.push(r);
+        for &i in tri {
+            sums[i as usize] += f;
+            rates[i as usize] += r;
+        }
     }
     patches.clear();
-    for (i, o) in out.iter_mut().enumerate() {
-        let k = ma * areas[i];
-        let w = patch_turning(
-            faces,
-            rates,
-            vertex_triangles.row(i),
+    patches.extend((0..n).map(|i| {
+        patch_turning(
+            sums[i],
+            rates[i],
             t.patch_scale[i],
-            k,
+            ma * areas[i],
             &v[i],
-            o,
+            &mut out[i],
             &mut projected[i],
             &mut normals[i],
-        );
-        patches.push(w);
-    }
-    // W of every face and its gradients at its corners once, then each vertex gathers its
-    // faces' (no scatter).
-    gradients.clear();
-    gradients.extend(triangles.iter().map(|tri| face_gradients(x, patches, tri)));
-    for (i, o) in out.iter_mut().enumerate() {
-        gather_gradients(triangles, gradients, vertex_triangles.row(i), i, o);
+        )
+    }));
+    // W of every face and its gradients at its corners, added to the corners' forces.
+    for tri in triangles {
+        let [gb, gc] = face_gradients(x, patches, tri);
+        let [a, b, c] = tri.map(|i| i as usize);
+        out[a] += -(gb + gc);
+        out[b] += gb;
+        out[c] += gc;
     }
 }
 
+/// How the pool's path splits a cloth: chunks of `chunk` vertices, each with the faces whose
+/// three corners lie in it (ascending), and which vertices have a face reaching into another
+/// chunk (those gather their faces' terms in their own order, the others take them scattered).
+#[derive(Clone, Debug, Default)]
+pub struct TurningSplit {
+    chunk: usize,
+    /// The vertex and face counts it was made for.
+    sizes: (usize, usize),
+    /// Chunk k's faces: `inner[inner_start[k]..inner_start[k + 1]]`.
+    inner_start: Vec<u32>,
+    inner: Vec<u32>,
+    border: Vec<bool>,
+}
+
+impl TurningSplit {
+    fn new(n: usize, triangles: &[[u32; 3]], chunk: usize) -> Self {
+        let chunks = n.div_ceil(chunk);
+        let mut border = vec![false; n];
+        let mut count = vec![0u32; chunks + 1];
+        let home = |tri: &[u32; 3]| {
+            let k = tri[0] as usize / chunk;
+            tri.iter().all(|&i| i as usize / chunk == k).then_some(k)
+        };
+        for tri in triangles {
+            match home(tri) {
+                Some(k) => count[k + 1] += 1,
+                None => tri.iter().for_each(|&i| border[i as usize] = true),
+            }
+        }
+        for k in 0..chunks {
+            count[k + 1] += count[k];
+        }
+        let mut fill = count.clone();
+        let mut inner = vec![0u32; count[chunks] as usize];
+        for (f, tri) in triangles.iter().enumerate() {
+            if let Some(k) = home(tri) {
+                inner[fill[k] as usize] = f as u32;
+                fill[k] += 1;
+            }
+        }
+        TurningSplit {
+            chunk,
+            sizes: (n, triangles.len()),
+            inner_start: count,
+            inner,
+            border,
+        }
+    }
+
+    fn inner(&self, k: usize) -> &[u32] {
+        &self.inner[self.inner_start[k] as usize..self.inner_start[k + 1] as usize]
+    }
+}
+
+/// The four passes on the pool, in chunks of vertices: each chunk scatters the faces that lie
+/// in it to their corners, as [`turning_serial`] does, and a vertex with a face in another
+/// chunk gathers its faces' terms in its own (ascending) order instead, computing them again.
+/// Every vertex so receives the same terms in the same order as on one thread: the same bits
+/// on any number of threads.
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 fn turning_parallel(
     ma: f64,
@@ -281,50 +349,97 @@ fn turning_parallel(
 ) {
     use rayon::prelude::*;
     let (areas, triangles, vertex_triangles) = (&t.areas, &t.triangles, &t.vertex_triangles);
+    let n = x.len();
+    // Four chunks a thread, so that the pool can even out uneven chunks.
+    let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
     let TurningScratch {
-        faces,
+        faces: sums,
         rates,
         patches,
-        gradients,
+        split,
+        ..
     } = scratch;
-    faces.resize(triangles.len(), Vec3::zeros());
-    rates.resize(triangles.len(), Vec3::zeros());
-    (faces.par_iter_mut(), rates.par_iter_mut(), triangles.par_iter())
-        .into_par_iter()
-        .for_each(|(f, r, tri)| (*f, *r) = face_and_rate(x, v, tri));
-    let (faces, rates) = (&*faces, &*rates);
-    patches.resize(x.len(), Vec3::zeros());
+    if split.chunk != chunk || split.sizes != (n, triangles.len()) {
+        *split = TurningSplit::new(n, triangles, chunk);
+    }
+    let split = &*split;
+    for buf in [&mut *sums, &mut *rates, &mut *patches] {
+        buf.resize(n, Vec3::zeros());
+    }
     (
-        patches.par_iter_mut(),
-        out.par_iter_mut(),
-        projected.par_iter_mut(),
-        normals.par_iter_mut(),
+        sums.par_chunks_mut(chunk),
+        rates.par_chunks_mut(chunk),
+        patches.par_chunks_mut(chunk),
+        out.par_chunks_mut(chunk),
+        projected.par_chunks_mut(chunk),
+        normals.par_chunks_mut(chunk),
     )
         .into_par_iter()
         .enumerate()
-        .for_each(|(i, (w, o, p, n))| {
-            let k = ma * areas[i];
-            *w = patch_turning(
-                faces,
-                rates,
-                vertex_triangles.row(i),
-                t.patch_scale[i],
-                k,
-                &v[i],
-                o,
-                p,
-                n,
-            );
+        .for_each(|(k, (sums, rates, w, out, projected, normals))| {
+            let lo = k * chunk;
+            sums.fill(Vec3::zeros());
+            rates.fill(Vec3::zeros());
+            for &f in split.inner(k) {
+                let tri = &triangles[f as usize];
+                let (c, r) = face_and_rate(x, v, tri);
+                for &i in tri {
+                    let i = i as usize;
+                    if !split.border[i] {
+                        sums[i - lo] += c;
+                        rates[i - lo] += r;
+                    }
+                }
+            }
+            for (j, w) in w.iter_mut().enumerate() {
+                let i = lo + j;
+                let (big_n, big_ndot) = if split.border[i] {
+                    let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
+                    for &f in vertex_triangles.row(i) {
+                        let (c, r) = face_and_rate(x, v, &triangles[f as usize]);
+                        big_n += c;
+                        big_ndot += r;
+                    }
+                    (big_n, big_ndot)
+                } else {
+                    (sums[j], rates[j])
+                };
+                *w = patch_turning(
+                    big_n,
+                    big_ndot,
+                    t.patch_scale[i],
+                    ma * areas[i],
+                    &v[i],
+                    &mut out[j],
+                    &mut projected[j],
+                    &mut normals[j],
+                );
+            }
         });
     let patches = &*patches;
-    gradients.resize(triangles.len(), [Vec3::zeros(); 2]);
-    (gradients.par_iter_mut(), triangles.par_iter())
-        .into_par_iter()
-        .for_each(|(g, tri)| *g = face_gradients(x, patches, tri));
-    let gradients = &*gradients;
-    out.par_iter_mut()
-        .enumerate()
-        .for_each(|(i, o)| gather_gradients(triangles, gradients, vertex_triangles.row(i), i, o));
+    out.par_chunks_mut(chunk).enumerate().for_each(|(k, out)| {
+        let lo = k * chunk;
+        for &f in split.inner(k) {
+            let tri = &triangles[f as usize];
+            let [gb, gc] = face_gradients(x, patches, tri);
+            for (&i, g) in tri.iter().zip([-(gb + gc), gb, gc]) {
+                let i = i as usize;
+                if !split.border[i] {
+                    out[i - lo] += g;
+                }
+            }
+        }
+        for (j, o) in out.iter_mut().enumerate() {
+            let i = lo + j;
+            if split.border[i] {
+                for &f in vertex_triangles.row(i) {
+                    let tri = &triangles[f as usize];
+                    let [gb, gc] = face_gradients(x, patches, tri);
+                    *o += corner_term(tri, i, gb, gc);
+                }
+            }
+        }
+    });
 }
 
 /// A face's area vector `e1 x e2` and its rate of change.
@@ -335,14 +450,14 @@ fn face_and_rate(x: &[Vec3], v: &[Vec3], t: &[u32; 3]) -> (Vec3, Vec3) {
     (e1.cross(&e2), (v[b] - v[a]).cross(&e2) + e1.cross(&(v[c] - v[a])))
 }
 
-/// At one vertex (its faces `row`, `k = m_a A`): subtracts the force of the patch's turning from
-/// `o`, writes the projected-area ratio and the unit normal, and returns the vertex's `w`.
+/// At one vertex (`big_n` and `big_ndot` the sums of its faces' area vectors and of their
+/// rates, `k = m_a A`): subtracts the force of the patch's turning from `o`, writes the
+/// projected-area ratio and the unit normal, and returns the vertex's `w`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn patch_turning(
-    faces: &[Vec3],
-    rates: &[Vec3],
-    row: &[u32],
+    big_n: Vec3,
+    big_ndot: Vec3,
     scale: f64,
     k: f64,
     v: &Vec3,
@@ -350,11 +465,6 @@ fn patch_turning(
     projected: &mut f64,
     normal: &mut Vec3,
 ) -> Vec3 {
-    let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
-    for &t in row {
-        big_n += faces[t as usize];
-        big_ndot += rates[t as usize];
-    }
     let len = big_n.norm();
     *normal = if len > 0.0 { big_n / len } else { big_n };
     let (a, adot) = (scale * big_n, scale * big_ndot);
@@ -373,19 +483,16 @@ fn face_gradients(x: &[Vec3], w: &[Vec3], t: &[u32; 3]) -> [Vec3; 2] {
     [e2.cross(&sum), sum.cross(&e1)]
 }
 
-/// Adds to vertex `i`'s force the gradients of its faces (`row`) at it.
+/// Face `tri`'s term at its corner `i`, from its gradients at b and c (`gb`, `gc`; a's is minus
+/// their sum).
 #[inline(always)]
-fn gather_gradients(triangles: &[[u32; 3]], gradients: &[[Vec3; 2]], row: &[u32], i: usize, o: &mut Vec3) {
-    for &t in row {
-        let [_, b, c] = triangles[t as usize];
-        let [gb, gc] = gradients[t as usize];
-        *o += if i == b as usize {
-            gb
-        } else if i == c as usize {
-            gc
-        } else {
-            -(gb + gc)
-        };
+fn corner_term(tri: &[u32; 3], i: usize, gb: Vec3, gc: Vec3) -> Vec3 {
+    if i == tri[1] as usize {
+        gb
+    } else if i == tri[2] as usize {
+        gc
+    } else {
+        -(gb + gc)
     }
 }
 
