@@ -145,7 +145,7 @@ pub fn effective_forces(
 /// rates, and its weight; and how the pool's path splits the cloth.
 #[derive(Clone, Debug, Default)]
 pub struct TurningScratch {
-    faces: Vec<Vec3>,
+    sums: Vec<Vec3>,
     rates: Vec<Vec3>,
     patches: Vec<Vec3>,
     /// How the pool's path splits the cloth.
@@ -209,8 +209,10 @@ pub fn turning_forces(
     if ma == 0.0 {
         return;
     }
-    // Four passes, faces and vertices in turn; each element is computed alone (by the
-    // functions below), so a large cloth spreads them over the pool with the same bits.
+    // Faces, vertices and faces again; both paths give every vertex the same terms in the same
+    // order, so a large cloth spreads them over the pool with the same bits. (One path would
+    // do: the pool's with one chunk. Measured at 61 x 41, its chunk lists and border tests
+    // cost 9.06 G instructions against 8.12 G, 55 against 47.5 ns a particle-step.)
     if crate::parallel::worth_it(x.len()) {
         turning_parallel(ma, t, x, v, scratch, projected, normals, out);
     } else {
@@ -218,11 +220,12 @@ pub fn turning_forces(
     }
 }
 
-/// The four passes on one thread, each face's sums scattered to its corners instead of each
+/// The passes on one thread, each face's sums scattered to its corners instead of each
 /// vertex gathering its faces'. A vertex's faces are listed in ascending order
 /// ([`crate::topology::Adjacency`]) and the faces are visited in that order, so every vertex
 /// receives the same terms in the same order as [`turning_parallel`] sums them: the same
-/// bits, without the per-face arrays and the corner tests of the gather.
+/// bits, without the per-face arrays and the corner tests of the gather. (A face's corners are
+/// distinct: a mesh with a repeated corner is refused when built.)
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 fn turning_serial(
     ma: f64,
@@ -237,10 +240,7 @@ fn turning_serial(
     let (areas, triangles) = (&t.areas, &t.triangles);
     let n = x.len();
     let TurningScratch {
-        faces: sums,
-        rates,
-        patches,
-        ..
+        sums, rates, patches, ..
     } = scratch;
     // Each vertex's sums of its faces' area vectors and of their rates.
     for buf in [&mut *sums, &mut *rates] {
@@ -331,7 +331,7 @@ impl TurningSplit {
     }
 }
 
-/// The four passes on the pool, in chunks of vertices: each chunk scatters the faces that lie
+/// The passes on the pool, in chunks of vertices: each chunk scatters the faces that lie
 /// in it to their corners, as [`turning_serial`] does, and a vertex with a face in another
 /// chunk gathers its faces' terms in its own (ascending) order instead, computing them again.
 /// Every vertex so receives the same terms in the same order as on one thread: the same bits
@@ -353,7 +353,7 @@ fn turning_parallel(
     // Four chunks a thread, so that the pool can even out uneven chunks.
     let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
     let TurningScratch {
-        faces: sums,
+        sums,
         rates,
         patches,
         split,
