@@ -25,6 +25,7 @@ use nalgebra::Matrix3;
 
 use crate::math::Vec3;
 use crate::model::Model;
+use crate::parallel;
 use crate::topology::Topology;
 
 /// The inertia of one particle: `M = (mass + entrained) I + normal_mass n n^T`.
@@ -211,10 +212,15 @@ pub fn turning_forces(
     }
     // Faces, vertices and faces again; both paths give every vertex the same terms in the same
     // order, so a large cloth spreads them over the pool with the same bits. (One path would
-    // do: the pool's with one chunk. Measured at 61 x 41, its chunk lists and border tests
-    // cost 9.06 G instructions against 8.12 G, 55 against 47.5 ns a particle-step.)
-    if crate::parallel::worth_it(x.len()) {
-        turning_parallel(ma, t, x, v, scratch, projected, normals, out);
+    // do: the pool's with one chunk. Measured, its chunk lists, wavefront marks and border
+    // tests cost more than they save on one thread: at 61 x 41 9.06 G instructions against
+    // 8.12 G (the pool's path before the wavefront), at 201 x 201 the turning forces 1.69 G
+    // against 1.47 G, and no faster at 1001 x 1001.)
+    let n = x.len();
+    if parallel::worth_it(n) {
+        // Four chunks a thread, so that the pool can even out uneven chunks.
+        let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
+        turning_chunked(ma, t, x, v, scratch, chunk, true, projected, normals, out);
     } else {
         turning_serial(ma, t, x, v, scratch, projected, normals, out);
     }
@@ -277,9 +283,11 @@ fn turning_serial(
     }
 }
 
-/// How the pool's path splits a cloth: chunks of `chunk` vertices, each with the faces whose
+/// How the chunked path splits a cloth: chunks of `chunk` vertices, each with the faces whose
 /// three corners lie in it (ascending), and which vertices have a face reaching into another
 /// chunk (those gather their faces' terms in their own order, the others take them scattered).
+/// With it, the order in which a chunk's passes may interleave (a wavefront, see
+/// [`turning_chunk`]).
 #[derive(Clone, Debug, Default)]
 pub struct TurningSplit {
     chunk: usize,
@@ -288,7 +296,16 @@ pub struct TurningSplit {
     /// Chunk k's faces: `inner[inner_start[k]..inner_start[k + 1]]`.
     inner_start: Vec<u32>,
     inner: Vec<u32>,
+    /// Beside each of `inner`: the highest corner of it and of the chunk's faces before it.
+    reach: Vec<u32>,
+    /// Per vertex: how many of its chunk's faces must have been summed before it and every
+    /// vertex of the chunk before it have all their faces' sums (0 for a chunk's border
+    /// vertices that lead it: they sum their own).
+    ready: Vec<u32>,
     border: Vec<bool>,
+    /// Chunk k's border vertices: `borders[border_start[k]..border_start[k + 1]]`.
+    border_start: Vec<u32>,
+    borders: Vec<u32>,
 }
 
 impl TurningSplit {
@@ -317,41 +334,77 @@ impl TurningSplit {
                 fill[k] += 1;
             }
         }
+        // The wavefront's marks, chunk by chunk: how far the faces reach, and after how many
+        // faces each vertex (and all before it) is complete.
+        let (mut reach, mut ready) = (vec![0u32; inner.len()], vec![0u32; n]);
+        for k in 0..chunks {
+            let (lo, hi) = (k * chunk, ((k + 1) * chunk).min(n));
+            let (a, b) = (count[k] as usize, count[k + 1] as usize);
+            let mut top = lo as u32;
+            for q in a..b {
+                let tri = &triangles[inner[q] as usize];
+                top = top.max(tri[0]).max(tri[1]).max(tri[2]);
+                reach[q] = top;
+                for &i in tri {
+                    ready[i as usize] = (q - a + 1) as u32;
+                }
+            }
+            for i in lo + 1..hi {
+                ready[i] = ready[i].max(ready[i - 1]);
+            }
+        }
+        let borders: Vec<u32> = (0..n as u32).filter(|&i| border[i as usize]).collect();
+        let border_start = (0..=chunks)
+            .map(|k| borders.partition_point(|&i| (i as usize) < k * chunk) as u32)
+            .collect();
         TurningSplit {
             chunk,
             sizes: (n, triangles.len()),
             inner_start: count,
             inner,
+            reach,
+            ready,
             border,
+            border_start,
+            borders,
         }
     }
 
-    fn inner(&self, k: usize) -> &[u32] {
-        &self.inner[self.inner_start[k] as usize..self.inner_start[k + 1] as usize]
+    /// Chunk k's faces and, beside each, how far they reach.
+    fn inner(&self, k: usize) -> (&[u32], &[u32]) {
+        let r = self.inner_start[k] as usize..self.inner_start[k + 1] as usize;
+        (&self.inner[r.clone()], &self.reach[r])
+    }
+
+    fn borders(&self, k: usize) -> &[u32] {
+        &self.borders[self.border_start[k] as usize..self.border_start[k + 1] as usize]
     }
 }
 
-/// The passes on the pool, in chunks of vertices: each chunk scatters the faces that lie
-/// in it to their corners, as [`turning_serial`] does, and a vertex with a face in another
-/// chunk gathers its faces' terms in its own (ascending) order instead, computing them again.
-/// Every vertex so receives the same terms in the same order as on one thread: the same bits
-/// on any number of threads.
+/// Faces summed between checks of the wavefront.
+const WAVE: usize = 32;
+
+/// The passes in chunks of vertices, on the pool when `par`: each chunk scatters the faces
+/// that lie in it to their corners, as [`turning_serial`] does, and a vertex with a face in
+/// another chunk gathers its faces' terms in its own (ascending) order instead, computing them
+/// again. Every vertex so receives the same terms in the same order as on one thread: the same
+/// bits for any chunk size and any number of threads. Within a chunk the three passes run as
+/// a wavefront ([`turning_chunk`]), so a large cloth streams its arrays once.
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
-fn turning_parallel(
+fn turning_chunked(
     ma: f64,
     t: &Topology,
     x: &[Vec3],
     v: &[Vec3],
     scratch: &mut TurningScratch,
+    chunk: usize,
+    par: bool,
     projected: &mut [f64],
     normals: &mut [Vec3],
     out: &mut [Vec3],
 ) {
-    use rayon::prelude::*;
-    let (areas, triangles, vertex_triangles) = (&t.areas, &t.triangles, &t.vertex_triangles);
+    let (triangles, vertex_triangles) = (&t.triangles, &t.vertex_triangles);
     let n = x.len();
-    // Four chunks a thread, so that the pool can even out uneven chunks.
-    let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
     let TurningScratch {
         sums,
         rates,
@@ -366,80 +419,169 @@ fn turning_parallel(
     for buf in [&mut *sums, &mut *rates, &mut *patches] {
         buf.resize(n, Vec3::zeros());
     }
-    (
-        sums.par_chunks_mut(chunk),
-        rates.par_chunks_mut(chunk),
-        patches.par_chunks_mut(chunk),
-        out.par_chunks_mut(chunk),
-        projected.par_chunks_mut(chunk),
-        normals.par_chunks_mut(chunk),
-    )
-        .into_par_iter()
-        .enumerate()
-        .for_each(|(k, (sums, rates, w, out, projected, normals))| {
-            let lo = k * chunk;
-            sums.fill(Vec3::zeros());
-            rates.fill(Vec3::zeros());
-            for &f in split.inner(k) {
-                let tri = &triangles[f as usize];
-                let (c, r) = face_and_rate(x, v, tri);
-                for &i in tri {
-                    let i = i as usize;
-                    if !split.border[i] {
-                        sums[i - lo] += c;
-                        rates[i - lo] += r;
-                    }
-                }
-            }
-            for (j, w) in w.iter_mut().enumerate() {
-                let i = lo + j;
-                let (big_n, big_ndot) = if split.border[i] {
-                    let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
-                    for &f in vertex_triangles.row(i) {
-                        let (c, r) = face_and_rate(x, v, &triangles[f as usize]);
-                        big_n += c;
-                        big_ndot += r;
-                    }
-                    (big_n, big_ndot)
-                } else {
-                    (sums[j], rates[j])
-                };
-                *w = patch_turning(
-                    big_n,
-                    big_ndot,
-                    t.patch_scale[i],
-                    ma * areas[i],
-                    &v[i],
-                    &mut out[j],
-                    &mut projected[j],
-                    &mut normals[j],
-                );
+    {
+        let d = [
+            &mut sums[..],
+            &mut rates[..],
+            &mut patches[..],
+            normals,
+            &mut *out,
+        ]
+        .map(parallel::Disjoint::new);
+        let projected = parallel::Disjoint::new(projected);
+        parallel::for_chunks(par, n, chunk, |lo, len| {
+            let r = lo..lo + len;
+            // SAFETY: every task borrows only its own chunk `r` of each array.
+            let [sums, rates, w, normals, out] = d.each_ref().map(|a| unsafe { a.range(r.clone()) });
+            // SAFETY: as above.
+            let projected = unsafe { projected.range(r) };
+            let chunk = Chunk {
+                lo,
+                sums,
+                rates,
+                w,
+                out,
+                projected,
+                normals,
+            };
+            let k = lo / split.chunk;
+            if split.borders(k).is_empty() {
+                turning_chunk::<false>(ma, t, x, v, split, k, chunk);
+            } else {
+                turning_chunk::<true>(ma, t, x, v, split, k, chunk);
             }
         });
+    }
+    if split.borders.is_empty() {
+        return;
+    }
+    // The border vertices' faces' gradients, which read `w` of other chunks' vertices.
     let patches = &*patches;
-    out.par_chunks_mut(chunk).enumerate().for_each(|(k, out)| {
-        let lo = k * chunk;
-        for &f in split.inner(k) {
-            let tri = &triangles[f as usize];
-            let [gb, gc] = face_gradients(x, patches, tri);
-            for (&i, g) in tri.iter().zip([-(gb + gc), gb, gc]) {
-                let i = i as usize;
-                if !split.border[i] {
-                    out[i - lo] += g;
-                }
-            }
-        }
-        for (j, o) in out.iter_mut().enumerate() {
-            let i = lo + j;
-            if split.border[i] {
-                for &f in vertex_triangles.row(i) {
-                    let tri = &triangles[f as usize];
-                    let [gb, gc] = face_gradients(x, patches, tri);
-                    *o += corner_term(tri, i, gb, gc);
-                }
+    let d = parallel::Disjoint::new(out);
+    parallel::for_chunks(par, n, chunk, |lo, len| {
+        // SAFETY: every task borrows only its own chunk of `out`.
+        let out = unsafe { d.range(lo..lo + len) };
+        for &i in split.borders(lo / split.chunk) {
+            let i = i as usize;
+            for &f in vertex_triangles.row(i) {
+                let tri = &triangles[f as usize];
+                let [gb, gc] = face_gradients(x, patches, tri);
+                out[i - lo] += corner_term(tri, i, gb, gc);
             }
         }
     });
+}
+
+/// One chunk's arrays (`lo` its first vertex).
+struct Chunk<'a> {
+    lo: usize,
+    sums: &'a mut [Vec3],
+    rates: &'a mut [Vec3],
+    w: &'a mut [Vec3],
+    out: &'a mut [Vec3],
+    projected: &'a mut [f64],
+    normals: &'a mut [Vec3],
+}
+
+/// Chunk `k`'s three passes, interleaved: its faces are summed into their corners a few at a
+/// time ([`WAVE`]); each vertex whose faces are all summed (and every vertex before it) takes
+/// its patch's terms and its `w`; each face whose corners all have their `w` scatters its
+/// gradients. Every vertex still receives its terms in the order of the passes one after the
+/// other (its patch's term before its faces' gradients, those in ascending face order), so
+/// the bits are theirs, but a large chunk's sums are read back while they are in cache. The
+/// border vertices' faces' gradients are left to the caller. `BORDER`: whether the chunk has
+/// border vertices (a chunk without skips the tests).
+fn turning_chunk<const BORDER: bool>(
+    ma: f64,
+    t: &Topology,
+    x: &[Vec3],
+    v: &[Vec3],
+    split: &TurningSplit,
+    k: usize,
+    c: Chunk<'_>,
+) {
+    let (areas, triangles, vertex_triangles) = (&t.areas, &t.triangles, &t.vertex_triangles);
+    let Chunk {
+        lo,
+        sums,
+        rates,
+        w,
+        out,
+        projected,
+        normals,
+    } = c;
+    let hi = lo + w.len();
+    let (faces, reach) = split.inner(k);
+    let (border, ready) = (&split.border, &split.ready);
+    // Sums zeroed below `zeroed`, faces summed below `summed`, vertices done below `done`,
+    // faces' gradients scattered below `scattered`.
+    let (mut zeroed, mut summed, mut done, mut scattered) = (lo, 0, lo, 0);
+    loop {
+        let end = (summed + WAVE).min(faces.len());
+        let top = if end == faces.len() {
+            hi
+        } else {
+            reach[end - 1] as usize + 1
+        };
+        if zeroed < top {
+            sums[zeroed - lo..top - lo].fill(Vec3::zeros());
+            rates[zeroed - lo..top - lo].fill(Vec3::zeros());
+            zeroed = top;
+        }
+        for &f in &faces[summed..end] {
+            let tri = &triangles[f as usize];
+            let (c, r) = face_and_rate(x, v, tri);
+            for &i in tri {
+                let i = i as usize;
+                if !(BORDER && border[i]) {
+                    sums[i - lo] += c;
+                    rates[i - lo] += r;
+                }
+            }
+        }
+        summed = end;
+        let last = summed == faces.len();
+        while done < hi && (last || ready[done] as usize <= summed) {
+            let (i, j) = (done, done - lo);
+            let (big_n, big_ndot) = if BORDER && border[i] {
+                let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
+                for &f in vertex_triangles.row(i) {
+                    let (c, r) = face_and_rate(x, v, &triangles[f as usize]);
+                    big_n += c;
+                    big_ndot += r;
+                }
+                (big_n, big_ndot)
+            } else {
+                (sums[j], rates[j])
+            };
+            w[j] = patch_turning(
+                big_n,
+                big_ndot,
+                t.patch_scale[i],
+                ma * areas[i],
+                &v[i],
+                &mut out[j],
+                &mut projected[j],
+                &mut normals[j],
+            );
+            done += 1;
+        }
+        while scattered < summed && (reach[scattered] as usize) < done {
+            let tri = &triangles[faces[scattered] as usize];
+            let [gb, gc] = face_gradients_at(x, w, lo, tri);
+            for (&i, g) in tri.iter().zip([-(gb + gc), gb, gc]) {
+                let i = i as usize;
+                if !(BORDER && border[i]) {
+                    out[i - lo] += g;
+                }
+            }
+            scattered += 1;
+        }
+        if last {
+            debug_assert!(scattered == faces.len() && done == hi);
+            return;
+        }
+    }
 }
 
 /// A face's area vector `e1 x e2` and its rate of change.
@@ -478,6 +620,15 @@ fn patch_turning(
 #[inline(always)]
 fn face_gradients(x: &[Vec3], w: &[Vec3], t: &[u32; 3]) -> [Vec3; 2] {
     let sum: Vec3 = t.iter().map(|&i| w[i as usize]).sum();
+    let [a, b, c] = t.map(|i| i as usize);
+    let (e1, e2) = (x[b] - x[a], x[c] - x[a]);
+    [e2.cross(&sum), sum.cross(&e1)]
+}
+
+/// As [`face_gradients`], with `w` holding the vertices from `lo` on.
+#[inline(always)]
+fn face_gradients_at(x: &[Vec3], w: &[Vec3], lo: usize, t: &[u32; 3]) -> [Vec3; 2] {
+    let sum: Vec3 = t.iter().map(|&i| w[i as usize - lo]).sum();
     let [a, b, c] = t.map(|i| i as usize);
     let (e1, e2) = (x[b] - x[a], x[c] - x[a]);
     [e2.cross(&sum), sum.cross(&e1)]
@@ -603,6 +754,95 @@ mod tests {
             &mut none,
         );
         assert!(none.iter().all(|f| *f == Vec3::zeros()));
+    }
+
+    /// A `w x h` sheet as a triangle mesh with random diagonals, its vertices in the grid's
+    /// order or scrambled, crumpled and moving.
+    fn mesh(w: u32, h: u32, scrambled: bool) -> (Topology, Vec<Vec3>, Vec<Vec3>) {
+        let n = (w * h) as usize;
+        let order: Vec<u32> = (0..n as u32)
+            .map(|k| if scrambled { (k * 37) % n as u32 } else { k })
+            .collect();
+        let mut r = crate::testing::numbers(11);
+        let mut rest = vec![Vec3::zeros(); n];
+        for j in 0..h {
+            for i in 0..w {
+                rest[order[(j * w + i) as usize] as usize] =
+                    Vec3::new(0.01 * i as f64, -0.01 * j as f64, 0.0);
+            }
+        }
+        let mut indices = Vec::new();
+        for j in 0..h - 1 {
+            for i in 0..w - 1 {
+                let at = |i: u32, j: u32| order[(j * w + i) as usize];
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                if r() < 0.0 {
+                    indices.extend([a, d, b, b, d, c]);
+                } else {
+                    indices.extend([a, d, c, a, c, b]);
+                }
+            }
+        }
+        let t = crate::topology::MeshSpec {
+            positions: &rest,
+            indices: &indices,
+            face_size: 3,
+            mass: crate::topology::MeshMass::ArealDensity(1.0),
+        }
+        .build()
+        .expect("a valid mesh");
+        let x = rest
+            .iter()
+            .map(|p| p + 0.004 * Vec3::new(r(), r(), 2.0 * r()))
+            .collect();
+        let v = (0..n).map(|_| Vec3::new(r(), r(), r())).collect();
+        (t, x, v)
+    }
+
+    /// The chunked wavefront gives the one-thread passes' bits for every chunk size, on one
+    /// thread and on the pool, whatever the vertex order (border vertices, far corners).
+    #[test]
+    fn chunks_and_wavefront_keep_the_bits() {
+        for (w, h, scrambled) in [(23, 17, false), (23, 17, true), (5, 4, false)] {
+            let (t, x, v) = mesh(w, h, scrambled);
+            let n = x.len();
+            let prior: Vec<Vec3> = (0..n).map(|i| Vec3::new(i as f64, -0.5, 0.25)).collect();
+            let run = |chunk: Option<(usize, bool)>| {
+                let mut s = TurningScratch::default();
+                let (mut p, mut nr, mut out) = (vec![0.0; n], vec![Vec3::zeros(); n], prior.clone());
+                for _ in 0..2 {
+                    out.clone_from(&prior);
+                    match chunk {
+                        None => turning_serial(8.0, &t, &x, &v, &mut s, &mut p, &mut nr, &mut out),
+                        Some((c, par)) => {
+                            turning_chunked(8.0, &t, &x, &v, &mut s, c, par, &mut p, &mut nr, &mut out)
+                        }
+                    }
+                }
+                (out, p, nr)
+            };
+            let want = run(None);
+            assert!(want.0.iter().zip(&prior).all(|(a, b)| a != b));
+            for chunk in [n, n / 3 + 1, 50, 7, 1] {
+                for par in [false, true] {
+                    let got = run(Some((chunk, par)));
+                    let same = |a: &[Vec3], b: &[Vec3]| {
+                        a.iter()
+                            .zip(b)
+                            .all(|(a, b)| (0..3).all(|k| a[k].to_bits() == b[k].to_bits()))
+                    };
+                    assert!(same(&got.0, &want.0), "forces, {w}x{h} {scrambled} chunk {chunk}");
+                    assert!(
+                        same(&got.2, &want.2),
+                        "normals, {w}x{h} {scrambled} chunk {chunk}"
+                    );
+                    assert!(
+                        got.1.iter().zip(&want.1).all(|(a, b)| a.to_bits() == b.to_bits()),
+                        "ratios, {w}x{h} {scrambled} chunk {chunk}"
+                    );
+                }
+            }
+        }
     }
 
     fn inertia() -> Inertia {
