@@ -503,15 +503,8 @@ fn turning_chunk<const BORDER: bool>(
     c: Chunk<'_>,
 ) {
     let (areas, triangles, vertex_triangles) = (&t.areas, &t.triangles, &t.vertex_triangles);
-    let Chunk {
-        lo,
-        sums,
-        rates,
-        w,
-        out,
-        projected,
-        normals,
-    } = c;
+    let (lo, sums, rates, w) = (c.lo, c.sums, c.rates, c.w);
+    let (out, projected, normals) = (c.out, c.projected, c.normals);
     let hi = lo + w.len();
     let (faces, reach) = split.inner(k);
     let (border, ready) = (&split.border, &split.ready);
