@@ -622,10 +622,7 @@ fn patch_turning(
 /// The gradients of `W . c` at a face's corners b and c (`W` the sum of its corners' `w`).
 #[inline(always)]
 fn face_gradients(x: &[Vec3], w: &[Vec3], t: &[u32; 3]) -> [Vec3; 2] {
-    let sum: Vec3 = t.iter().map(|&i| w[i as usize]).sum();
-    let [a, b, c] = t.map(|i| i as usize);
-    let (e1, e2) = (x[b] - x[a], x[c] - x[a]);
-    [e2.cross(&sum), sum.cross(&e1)]
+    face_gradients_at(x, w, 0, t)
 }
 
 /// As [`face_gradients`], with `w` holding the vertices from `lo` on.
