@@ -212,8 +212,13 @@ impl Cloth {
         let mut limited = 0;
         for i in 0..self.x.len() {
             let d = s.x_new[i] - self.x[i];
-            let len = d.norm();
-            if self.pinned[i] || len <= limit || len.is_nan() {
+            // Squared first: the square root only for a vertex over the limit.
+            let len2 = d.norm_squared();
+            if self.pinned[i] || len2 <= limit * limit || len2.is_nan() {
+                continue;
+            }
+            let len = len2.sqrt();
+            if len <= limit {
                 continue;
             }
             let scale = limit / len;

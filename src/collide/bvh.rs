@@ -36,15 +36,16 @@ impl Aabb {
     }
 
     pub fn grow(&mut self, p: &Vec3) {
-        self.min = self.min.inf(p);
-        self.max = self.max.sup(p);
+        // Component by component (the generic `inf` / `sup` cost several times as much).
+        self.min = Vec3::new(self.min.x.min(p.x), self.min.y.min(p.y), self.min.z.min(p.z));
+        self.max = Vec3::new(self.max.x.max(p.x), self.max.y.max(p.y), self.max.z.max(p.z));
     }
 
     pub fn join(&self, o: &Aabb) -> Aabb {
-        Aabb {
-            min: self.min.inf(&o.min),
-            max: self.max.sup(&o.max),
-        }
+        let mut b = *self;
+        b.grow(&o.min);
+        b.grow(&o.max);
+        b
     }
 
     /// The box grown by `r` on every side.
@@ -56,16 +57,22 @@ impl Aabb {
     }
 
     pub fn overlaps(&self, o: &Aabb) -> bool {
-        self.min.x <= o.max.x
-            && o.min.x <= self.max.x
-            && self.min.y <= o.max.y
-            && o.min.y <= self.max.y
-            && self.min.z <= o.max.z
-            && o.min.z <= self.max.z
+        // Every comparison made, none skipped: one branch, not six hard to predict.
+        (self.min.x <= o.max.x)
+            & (o.min.x <= self.max.x)
+            & (self.min.y <= o.max.y)
+            & (o.min.y <= self.max.y)
+            & (self.min.z <= o.max.z)
+            & (o.min.z <= self.max.z)
     }
 
     pub fn contains(&self, p: &Vec3) -> bool {
-        (0..3).all(|c| self.min[c] <= p[c] && p[c] <= self.max[c])
+        (self.min.x <= p.x)
+            & (p.x <= self.max.x)
+            & (self.min.y <= p.y)
+            & (p.y <= self.max.y)
+            & (self.min.z <= p.z)
+            & (p.z <= self.max.z)
     }
 
     /// Squared distance from `p` to the box (0 inside).

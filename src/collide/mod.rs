@@ -8,6 +8,8 @@
 //! | `bvh.rs` | a bounding-volume hierarchy over boxes, refitted as things move |
 //! | `contact.rs` | the contact element: force, Jacobian blocks, friction |
 //! | `mesh.rs` | triangle-mesh colliders |
+//! | `neighbours.rs` | self-collision's pairs as the rest shape tells them: excluded, and rest-near |
+//! | `ownership.rs` | which triangle owns each vertex and edge (pair walks meet each pair once) |
 //! | `self_collision.rs` | the cloth against itself |
 //! | `shapes.rs` | closed meshes of simple solids (scenes and tests) |
 
@@ -16,6 +18,8 @@ pub mod contact;
 pub mod geometry;
 pub mod intersections;
 pub mod mesh;
+mod neighbours;
+pub mod ownership;
 pub mod self_collision;
 pub mod shapes;
 

@@ -1,9 +1,13 @@
 //! Self-collision: the cloth keeps `thickness` from itself, as [`Contact`] elements between a
 //! vertex and a triangle, and between two edges, that are not neighbours.
 //!
-//! **Pairs** are found with two [`Bvh`]s (the cloth's triangles and edges, refitted, never
-//! rebuilt: a query per vertex into the triangles' tree, the edges' tree walked against
-//! itself, and cheap ball tests before the exact distances) and kept in a list while they are within `thickness + skin` of each other; the
+//! **Pairs** are found with one [`Bvh`] over the cloth's triangles (refitted, never rebuilt),
+//! walked against itself: each vertex and each edge is *owned* by one of its triangles
+//! ([`Ownership`]), so a pair of overlapping triangle boxes yields each vertex-triangle and
+//! edge-edge pair once. Triangles near each other at rest (mostly neighbours) are left out of
+//! the walk: their few pairs that are not neighbours are listed once (`neighbours.rs`) and
+//! tested directly. Box and ball tests come before the exact distances. Pairs within
+//! `thickness + skin` of each other are kept in a list; the
 //! list is looked up again once some vertex has moved `skin / 2` since the last look (a Verlet
 //! list, `skin = thickness`). No pair outside the list can come within the thickness before
 //! the next look. Pairs nearer than 2.2 thicknesses at rest (neighbours of a fine mesh)
@@ -26,6 +30,8 @@
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
 use super::geometry::{closest_on_segments, edges_of, offset_from_triangle};
+use super::neighbours::{Exclusions, NearPairs};
+use super::ownership::Ownership;
 use crate::math::Vec3;
 
 /// The skin of the pair list, in thicknesses: pairs within `(1 + SKIN)` thicknesses are kept,
@@ -57,8 +63,11 @@ pub struct SelfCollision {
     edges: Vec<[u32; 2]>,
     tri_boxes: Vec<Aabb>,
     edge_boxes: Vec<Aabb>,
+    /// The triangles' boxes grown by half the reach, in the tree.
+    tree_boxes: Vec<Aabb>,
     tri_bvh: Bvh,
-    edge_bvh: Bvh,
+    /// Which triangle owns each vertex and edge (the walk meets each pair once).
+    owners: Ownership,
     /// Positions at the last look; empty before the first.
     looked_at: Vec<Vec3>,
     /// Vertex-triangle and edge-edge pairs, sorted, with their sides.
@@ -69,90 +78,13 @@ pub struct SelfCollision {
     /// Pairs never tested: nearer than 2.2 thicknesses at rest (neighbours), per vertex and
     /// per edge, for the thickness they were found at.
     excluded: Exclusions,
-}
-
-/// Each vertex's (edge's) excluded triangles (edges), sorted, as compressed rows.
-#[derive(Clone, Debug, Default)]
-struct Exclusions {
-    radius: f64,
-    vt_start: Vec<u32>,
-    vt: Vec<u32>,
-    ee_start: Vec<u32>,
-    ee: Vec<u32>,
-}
-
-impl Exclusions {
-    /// The pairs nearer than `radius` at the rest positions `rest`.
-    fn new(rest: &[Vec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], radius: f64) -> Exclusions {
-        let boxes: Vec<Aabb> = triangles
-            .iter()
-            .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize])).inflated(radius))
-            .collect();
-        let bvh = Bvh::build(&boxes);
-        let (mut vt_start, mut vt) = (vec![0u32], Vec::new());
-        for p in 0..rest.len() as u32 {
-            let first = vt.len();
-            let q = Aabb {
-                min: rest[p as usize],
-                max: rest[p as usize],
-            };
-            bvh.overlapping(&q, |t| {
-                let tri = &triangles[t as usize];
-                if tri.contains(&p) || vertex_triangle(rest, p, tri).0 < radius {
-                    vt.push(t);
-                }
-            });
-            vt[first..].sort_unstable();
-            vt_start.push(vt.len() as u32);
-        }
-        let boxes: Vec<Aabb> = edges
-            .iter()
-            .map(|e| Aabb::of(e.iter().map(|&i| &rest[i as usize])).inflated(0.5 * radius))
-            .collect();
-        let bvh = Bvh::build(&boxes);
-        let (mut ee_start, mut ee) = (vec![0u32], Vec::new());
-        for (e, edge) in edges.iter().enumerate() {
-            let first = ee.len();
-            bvh.overlapping(&boxes[e], |f| {
-                let other = &edges[f as usize];
-                if f as usize > e
-                    && (edge.iter().any(|v| other.contains(v)) || edge_edge(rest, edge, other).0 < radius)
-                {
-                    ee.push(f);
-                }
-            });
-            ee[first..].sort_unstable();
-            ee_start.push(ee.len() as u32);
-        }
-        Exclusions {
-            radius,
-            vt_start,
-            vt,
-            ee_start,
-            ee,
-        }
-    }
-
-    fn vertex_excludes(&self, p: u32, t: u32) -> bool {
-        let (a, b) = (
-            self.vt_start[p as usize] as usize,
-            self.vt_start[p as usize + 1] as usize,
-        );
-        self.vt[a..b].binary_search(&t).is_ok()
-    }
-
-    fn edge_excludes(&self, e: u32, f: u32) -> bool {
-        let (a, b) = (
-            self.ee_start[e as usize] as usize,
-            self.ee_start[e as usize + 1] as usize,
-        );
-        self.ee[a..b].binary_search(&f).is_ok()
-    }
+    /// The pairs of triangles near each other at rest, tested directly.
+    near: NearPairs,
 }
 
 /// Distance between vertex `p` and triangle `t` of positions `x`, with the weights and the
 /// vector from the triangle's closest point to `p`.
-fn vertex_triangle(x: &[Vec3], p: u32, t: &[u32; 3]) -> (f64, [f64; 3], Vec3) {
+pub(super) fn vertex_triangle(x: &[Vec3], p: u32, t: &[u32; 3]) -> (f64, [f64; 3], Vec3) {
     let [a, b, c] = t.map(|i| x[i as usize]);
     let q = x[p as usize];
     let (w, r) = offset_from_triangle(&q, &a, &b, &c);
@@ -161,7 +93,7 @@ fn vertex_triangle(x: &[Vec3], p: u32, t: &[u32; 3]) -> (f64, [f64; 3], Vec3) {
 
 /// Distance between edges `e` and `f` of positions `x`, the parameters, the vector from the
 /// second's closest point to the first's and the (unnormalised) normal `e x f`.
-fn edge_edge(x: &[Vec3], e: &[u32; 2], f: &[u32; 2]) -> (f64, f64, f64, Vec3, Vec3) {
+pub(super) fn edge_edge(x: &[Vec3], e: &[u32; 2], f: &[u32; 2]) -> (f64, f64, f64, Vec3, Vec3) {
     let (p0, p1, q0, q1) = (
         x[e[0] as usize],
         x[e[1] as usize],
@@ -217,6 +149,133 @@ fn side(v: f64) -> i8 {
         -1
     } else {
         1
+    }
+}
+
+/// How many listed near pairs a task tests.
+const NEAR_CHUNK: usize = 4096;
+
+/// Pairs found by part of a look.
+#[derive(Default)]
+struct Found {
+    vt: Vec<Pair>,
+    ee: Vec<Pair>,
+}
+
+/// What a look's tests read: the positions, the boxes, the neighbours and the old list.
+struct Search<'a> {
+    x: &'a [Vec3],
+    triangles: &'a [[u32; 3]],
+    edges: &'a [[u32; 2]],
+    reach: f64,
+    /// Each triangle's box grown by the reach, each edge's by half the reach.
+    tri_boxes: &'a [Aabb],
+    edge_boxes: &'a [Aabb],
+    owners: &'a Ownership,
+    excluded: &'a Exclusions,
+    old_vt: &'a [Pair],
+    old_ee: &'a [Pair],
+}
+
+/// The side remembered for pair `(a, b)` in the sorted list `old`.
+fn remembered(old: &[Pair], a: u32, b: u32) -> Option<i8> {
+    old.binary_search_by(|q| (q.0, q.1).cmp(&(a, b)))
+        .ok()
+        .map(|k| old[k].2)
+}
+
+impl Search<'_> {
+    /// Vertex `p` and triangle `t`, not sharing a vertex (and, unless `check`, known not to be
+    /// neighbours): kept if within reach, with the remembered side or the side it is on now.
+    /// Cheap rejections first: the box, the triangle's enclosing ball, the neighbours.
+    fn vertex_near(&self, p: u32, t: u32, check: bool, out: &mut Vec<Pair>) {
+        let (x, tri) = (self.x, &self.triangles[t as usize]);
+        if !self.tri_boxes[t as usize].contains(&x[p as usize])
+            || ball_apart(x, p, tri, self.reach)
+            || (check && self.excluded.vertex_excludes(p, t))
+        {
+            return;
+        }
+        let (d, w, r) = vertex_triangle(x, p, tri);
+        if d >= self.reach {
+            return;
+        }
+        let s = remembered(self.old_vt, p, t).unwrap_or_else(|| {
+            // Known only where the vertex is over the face (beside it, the plane's side says
+            // nothing): else 0, set when it first comes over the face.
+            let [a, b, c] = tri.map(|i| x[i as usize]);
+            if w.iter().all(|&wk| wk > 0.0) {
+                side(r.dot(&(b - a).cross(&(c - a))))
+            } else {
+                0
+            }
+        });
+        out.push((p, t, s));
+    }
+
+    /// Any vertex and triangle: its own triangles and neighbours out.
+    fn vertex_pair(&self, p: u32, t: u32, out: &mut Vec<Pair>) {
+        if !self.triangles[t as usize].contains(&p) {
+            self.vertex_near(p, t, true, out);
+        }
+    }
+
+    /// Edges `e` < `f`, not sharing a vertex (and, unless `check`, known not to be
+    /// neighbours): likewise.
+    fn edge_near(&self, e: u32, f: u32, check: bool, out: &mut Vec<Pair>) {
+        let (x, edge, other) = (self.x, &self.edges[e as usize], &self.edges[f as usize]);
+        if !self.edge_boxes[e as usize].overlaps(&self.edge_boxes[f as usize])
+            || balls_apart(x, edge, other, self.reach)
+            || (check && self.excluded.edge_excludes(e, f))
+        {
+            return;
+        }
+        let (d, a, b, r, n) = edge_edge(x, edge, other);
+        if d >= self.reach {
+            return;
+        }
+        let interior = a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0;
+        let s = remembered(self.old_ee, e, f).unwrap_or(if interior { side(r.dot(&n)) } else { 0 });
+        out.push((e, f, s));
+    }
+
+    /// Any two edges `e` < `f`: edges sharing a vertex and neighbours out.
+    fn edge_pair(&self, e: u32, f: u32, out: &mut Vec<Pair>) {
+        let (edge, other) = (&self.edges[e as usize], &self.edges[f as usize]);
+        if !edge.iter().any(|v| other.contains(v)) {
+            self.edge_near(e, f, true, out);
+        }
+    }
+
+    /// Triangles `i` and `j`, not near each other at rest, whose tree boxes overlap: each
+    /// vertex of one against the other triangle, each edge of one against each of the other's,
+    /// through their owners (so each pair once). Kept out of line: the walk's other calls
+    /// return at once.
+    #[inline(never)]
+    fn far_triangles(&self, i: u32, j: u32, found: &mut Found) {
+        for (a, b) in [(i, j), (j, i)] {
+            for &p in self.owners.vertices(a) {
+                self.vertex_pair(p, b, &mut found.vt);
+            }
+        }
+        for &e in self.owners.edges(i) {
+            for &f in self.owners.edges(j) {
+                self.edge_pair(e.min(f), e.max(f), &mut found.ee);
+            }
+        }
+    }
+
+    /// Chunk `k` of the near pairs' lists.
+    fn near_chunk(&self, near: &NearPairs, k: usize) -> Found {
+        let mut found = Found::default();
+        let part = |len: usize| (k * NEAR_CHUNK).min(len)..((k + 1) * NEAR_CHUNK).min(len);
+        for &(p, t) in &near.vertex_triangle[part(near.vertex_triangle.len())] {
+            self.vertex_near(p, t, false, &mut found.vt);
+        }
+        for &(e, f) in &near.edge_edge[part(near.edge_edge.len())] {
+            self.edge_near(e, f, false, &mut found.ee);
+        }
+        found
     }
 }
 
@@ -379,128 +438,124 @@ impl SelfCollision {
         }
         let c = 0.5 * (b.min + b.max);
         let limit = 0.25 * skin * skin;
+        // No displacement is further from the box's centre than its half diagonal: while that
+        // is within the limit, no vertex need be looked at.
+        if 0.25 * (b.max - b.min).norm_squared() <= limit {
+            return false;
+        }
         x.iter()
             .zip(&self.looked_at)
             .any(|(p, q)| (p - q - c).norm_squared() > limit)
     }
 
     /// Looks the pairs up again at positions `x`: every pair within `reach`, not neighbours
-    /// ([`Exclusions`]: nearer than `reach` at rest), with its side from the old list
+    /// ([`Exclusions`]: nearer than `excluded_within` at rest), with its side from the old list
     /// or, when new, from where it is now.
     fn look(&mut self, x: &[Vec3], rest: &[Vec3], triangles: &[[u32; 3]], reach: f64, excluded_within: f64) {
         self.looks += 1;
         self.looked_at.clear();
         self.looked_at.extend_from_slice(x);
+        // A vertex is a candidate for a triangle within `reach` of the triangle's box, two
+        // edges for each other when their boxes grown by half the reach overlap. The
+        // triangles' tree holds their boxes grown by half the reach: a vertex (an edge) of one
+        // triangle near another triangle (an edge of it) puts the two triangles' tree boxes
+        // over each other.
         self.tri_boxes.clear();
-        self.tri_boxes.extend(
-            triangles
-                .iter()
-                .map(|t| Aabb::of(t.iter().map(|&i| &x[i as usize])).inflated(reach)),
-        );
+        self.tree_boxes.clear();
+        for t in triangles {
+            let b = Aabb::of(t.iter().map(|&i| &x[i as usize]));
+            self.tri_boxes.push(b.inflated(reach));
+            self.tree_boxes.push(b.inflated(0.5 * reach));
+        }
         self.edge_boxes.clear();
         self.edge_boxes.extend(
             self.edges
                 .iter()
                 .map(|e| Aabb::of(e.iter().map(|&i| &x[i as usize])).inflated(0.5 * reach)),
         );
-        if self.tri_bvh.len() == triangles.len() && self.edge_bvh.len() == self.edges.len() {
-            self.tri_bvh.refit(&self.tri_boxes);
-            self.edge_bvh.refit(&self.edge_boxes);
+        if self.tri_bvh.len() == triangles.len() {
+            self.tri_bvh.refit(&self.tree_boxes);
         } else {
-            self.tri_bvh = Bvh::build(&self.tri_boxes);
-            self.edge_bvh = Bvh::build(&self.edge_boxes);
+            self.tri_bvh = Bvh::build(&self.tree_boxes);
+        }
+        if !self.owners.fits(x.len(), triangles.len()) {
+            self.owners = Ownership::new(x.len(), triangles, &self.edges);
         }
         if self.excluded.radius != excluded_within || self.excluded.vt_start.len() != x.len() + 1 {
             self.excluded = Exclusions::new(rest, triangles, &self.edges, excluded_within);
+            self.near = NearPairs::new(rest, triangles, &self.edges, &self.owners, &self.excluded);
         }
-        let excluded = &self.excluded;
         let old_vt = std::mem::take(&mut self.vertex_triangle);
         let old_ee = std::mem::take(&mut self.edge_edge);
-        let remembered = |old: &[Pair], a: u32, b: u32| {
-            old.binary_search_by(|q| (q.0, q.1).cmp(&(a, b)))
-                .ok()
-                .map(|k| old[k].2)
+        let search = Search {
+            x,
+            triangles,
+            edges: &self.edges,
+            reach,
+            tri_boxes: &self.tri_boxes,
+            edge_boxes: &self.edge_boxes,
+            owners: &self.owners,
+            excluded: &self.excluded,
+            old_vt: &old_vt,
+            old_ee: &old_ee,
         };
-        // Vertex by vertex and edge by edge, in parallel chunks, in order.
+        // The triangles' tree walked against itself (each overlapping pair of boxes once), in
+        // tasks for the pool on a large cloth; triangles near each other at rest are left out
+        // of it, their pairs listed (`NearPairs`) and tested in chunks.
         use rayon::prelude::*;
         let par = crate::parallel::worth_it_heavy(x.len());
-        let chunk = 256usize;
-        let tri_bvh = &self.tri_bvh;
-        let vertex_pairs = |lo: usize| -> Vec<Pair> {
-            let mut out = Vec::new();
-            for p in lo as u32..(lo + chunk).min(x.len()) as u32 {
-                let q = Aabb {
-                    min: x[p as usize],
-                    max: x[p as usize],
-                };
-                tri_bvh.overlapping(&q, |t| {
-                    let tri = &triangles[t as usize];
-                    // Cheap rejections first: its own triangles (always excluded), then
-                    // triangles whose enclosing ball is beyond reach.
-                    if tri.contains(&p) || ball_apart(x, p, tri, reach) || excluded.vertex_excludes(p, t) {
-                        return;
-                    }
-                    let (d, w, r) = vertex_triangle(x, p, tri);
-                    if d >= reach {
-                        return;
-                    }
-                    let s = remembered(&old_vt, p, t).unwrap_or_else(|| {
-                        // Known only where the vertex is over the face (beside it, the plane's
-                        // side says nothing): else 0, set when it first comes over the face.
-                        let [a, b, c] = tri.map(|i| x[i as usize]);
-                        if w.iter().all(|&wk| wk > 0.0) {
-                            side(r.dot(&(b - a).cross(&(c - a))))
-                        } else {
-                            0
-                        }
-                    });
-                    out.push((p, t, s));
-                });
-            }
-            out
-        };
-        let starts: Vec<usize> = (0..x.len()).step_by(chunk).collect();
-        let mut vt: Vec<Pair> = if par {
-            starts.par_iter().flat_map_iter(|&lo| vertex_pairs(lo)).collect()
-        } else {
-            starts.iter().flat_map(|&lo| vertex_pairs(lo)).collect()
-        };
-        vt.sort_unstable();
-        // Edge pairs from the edge tree walked against itself (each overlapping pair of boxes
-        // once), split into tasks for the pool on a large cloth.
-        let (edges, edge_bvh) = (&self.edges, &self.edge_bvh);
-        let edge_pairs = |task: &(u32, u32)| -> Vec<Pair> {
-            let mut out = Vec::new();
-            edge_bvh.self_overlapping(*task, |i, j| {
-                let (e, f) = (i.min(j), i.max(j));
-                let (edge, other) = (&edges[e as usize], &edges[f as usize]);
-                // Cheap rejections first: edges sharing a vertex (always excluded), then
-                // edges whose enclosing balls are beyond reach.
-                if edge.iter().any(|v| other.contains(v)) || balls_apart(x, edge, other, reach) {
-                    return;
+        let (tri_bvh, near) = (&self.tri_bvh, &self.near);
+        let walk = |task: &(u32, u32)| -> Found {
+            let mut found = Found::default();
+            tri_bvh.self_overlapping(*task, |i, j| {
+                if !near.rest_near(i, j) {
+                    search.far_triangles(i, j, &mut found);
                 }
-                if excluded.edge_excludes(e, f) {
-                    return;
-                }
-                let (d, a, b, r, n) = edge_edge(x, edge, other);
-                if d >= reach {
-                    return;
-                }
-                let interior = a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0;
-                let s = remembered(&old_ee, e, f).unwrap_or(if interior { side(r.dot(&n)) } else { 0 });
-                out.push((e, f, s));
             });
-            out
+            found
         };
-        let tasks = edge_bvh.self_tasks(if par { 64 } else { 1 });
-        let mut ee: Vec<Pair> = if par {
-            tasks.par_iter().flat_map_iter(edge_pairs).collect()
+        let near_chunks = near
+            .vertex_triangle
+            .len()
+            .max(near.edge_edge.len())
+            .div_ceil(NEAR_CHUNK);
+        let tasks = tri_bvh.self_tasks(if par { 64 } else { 1 });
+        let found: Vec<Found> = if par {
+            let mut found: Vec<_> = tasks.par_iter().map(walk).collect();
+            found.par_extend(
+                (0..near_chunks)
+                    .into_par_iter()
+                    .map(|k| search.near_chunk(near, k)),
+            );
+            found
         } else {
-            tasks.iter().flat_map(edge_pairs).collect()
+            tasks
+                .iter()
+                .map(walk)
+                .chain((0..near_chunks).map(|k| search.near_chunk(near, k)))
+                .collect()
         };
-        ee.sort_unstable();
-        self.vertex_triangle = vt;
-        self.edge_edge = ee;
+        let mut all = Found {
+            vt: Vec::with_capacity(found.iter().map(|f| f.vt.len()).sum()),
+            ee: Vec::with_capacity(found.iter().map(|f| f.ee.len()).sum()),
+        };
+        for f in found {
+            all.vt.extend(f.vt);
+            all.ee.extend(f.ee);
+        }
+        // Vertices in no triangle, one query each.
+        for &p in self.owners.orphans() {
+            let q = Aabb {
+                min: x[p as usize],
+                max: x[p as usize],
+            }
+            .inflated(0.5 * reach);
+            tri_bvh.overlapping(&q, |t| search.vertex_pair(p, t, &mut all.vt));
+        }
+        all.vt.sort_unstable();
+        all.ee.sort_unstable();
+        self.vertex_triangle = all.vt;
+        self.edge_edge = all.ee;
     }
 
     /// Forgets the positions of the last look (the next step looks again; sides are kept).

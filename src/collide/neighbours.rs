@@ -1,0 +1,159 @@
+//! What the cloth's rest shape says about self-collision's pairs, worked out once:
+//!
+//! - [`Exclusions`]: pairs nearer than a radius at rest (neighbours of a fine mesh), never
+//!   tested;
+//! - [`NearPairs`]: the pairs of triangles whose rest boxes lie within that radius of each
+//!   other, and what is left of their vertex-triangle and edge-edge pairs once the excluded
+//!   ones and the ones sharing a vertex are taken out. A look tests these few directly and
+//!   leaves such triangle pairs out of its tree walk: the walk meets mostly neighbours, and
+//!   this way it drops each in one box test.
+
+use super::bvh::{Aabb, Bvh};
+use super::ownership::Ownership;
+use super::self_collision::{edge_edge, vertex_triangle};
+use crate::math::Vec3;
+
+/// Each vertex's (edge's) excluded triangles (edges), sorted, as compressed rows.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Exclusions {
+    pub(super) radius: f64,
+    pub(super) vt_start: Vec<u32>,
+    vt: Vec<u32>,
+    ee_start: Vec<u32>,
+    ee: Vec<u32>,
+}
+
+impl Exclusions {
+    /// The pairs nearer than `radius` at the rest positions `rest`.
+    pub(super) fn new(rest: &[Vec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], radius: f64) -> Exclusions {
+        let boxes: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize])).inflated(radius))
+            .collect();
+        let bvh = Bvh::build(&boxes);
+        let (mut vt_start, mut vt) = (vec![0u32], Vec::new());
+        for p in 0..rest.len() as u32 {
+            let first = vt.len();
+            let q = Aabb {
+                min: rest[p as usize],
+                max: rest[p as usize],
+            };
+            bvh.overlapping(&q, |t| {
+                let tri = &triangles[t as usize];
+                if tri.contains(&p) || vertex_triangle(rest, p, tri).0 < radius {
+                    vt.push(t);
+                }
+            });
+            vt[first..].sort_unstable();
+            vt_start.push(vt.len() as u32);
+        }
+        let boxes: Vec<Aabb> = edges
+            .iter()
+            .map(|e| Aabb::of(e.iter().map(|&i| &rest[i as usize])).inflated(0.5 * radius))
+            .collect();
+        let bvh = Bvh::build(&boxes);
+        let (mut ee_start, mut ee) = (vec![0u32], Vec::new());
+        for (e, edge) in edges.iter().enumerate() {
+            let first = ee.len();
+            bvh.overlapping(&boxes[e], |f| {
+                let other = &edges[f as usize];
+                if f as usize > e
+                    && (edge.iter().any(|v| other.contains(v)) || edge_edge(rest, edge, other).0 < radius)
+                {
+                    ee.push(f);
+                }
+            });
+            ee[first..].sort_unstable();
+            ee_start.push(ee.len() as u32);
+        }
+        Exclusions {
+            radius,
+            vt_start,
+            vt,
+            ee_start,
+            ee,
+        }
+    }
+
+    pub(super) fn vertex_excludes(&self, p: u32, t: u32) -> bool {
+        let (a, b) = (
+            self.vt_start[p as usize] as usize,
+            self.vt_start[p as usize + 1] as usize,
+        );
+        self.vt[a..b].binary_search(&t).is_ok()
+    }
+
+    pub(super) fn edge_excludes(&self, e: u32, f: u32) -> bool {
+        let (a, b) = (
+            self.ee_start[e as usize] as usize,
+            self.ee_start[e as usize + 1] as usize,
+        );
+        self.ee[a..b].binary_search(&f).is_ok()
+    }
+}
+
+/// The rest-near triangle pairs' vertex-triangle and edge-edge pairs that are neither excluded
+/// nor share a vertex, with the triangles' rest boxes that tell rest-near pairs.
+#[derive(Clone, Debug, Default)]
+pub(super) struct NearPairs {
+    /// The triangles' rest boxes grown by half the radius: two triangles are rest-near when
+    /// theirs overlap.
+    rest_boxes: Vec<Aabb>,
+    /// `(vertex, triangle)`, the vertex owned by a triangle rest-near the other.
+    pub(super) vertex_triangle: Vec<(u32, u32)>,
+    /// `(e, f)`, e < f, owned by two rest-near triangles.
+    pub(super) edge_edge: Vec<(u32, u32)>,
+}
+
+impl NearPairs {
+    /// The near pairs of the cloth at rest positions `rest` for the exclusions `excluded`
+    /// (their radius is the one that tells rest-near triangles).
+    pub(super) fn new(
+        rest: &[Vec3],
+        triangles: &[[u32; 3]],
+        edges: &[[u32; 2]],
+        owners: &Ownership,
+        excluded: &Exclusions,
+    ) -> NearPairs {
+        let rest_boxes: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize])).inflated(0.5 * excluded.radius))
+            .collect();
+        let bvh = Bvh::build(&rest_boxes);
+        let (mut vt, mut ee) = (Vec::new(), Vec::new());
+        for task in bvh.self_tasks(1) {
+            bvh.self_overlapping(task, |i, j| {
+                for (a, b) in [(i, j), (j, i)] {
+                    let tri = &triangles[b as usize];
+                    for &p in owners.vertices(a) {
+                        if !tri.contains(&p) && !excluded.vertex_excludes(p, b) {
+                            vt.push((p, b));
+                        }
+                    }
+                }
+                for &e in owners.edges(i) {
+                    for &f in owners.edges(j) {
+                        let (e, f) = (e.min(f), e.max(f));
+                        let (edge, other) = (&edges[e as usize], &edges[f as usize]);
+                        if !edge.iter().any(|v| other.contains(v)) && !excluded.edge_excludes(e, f) {
+                            ee.push((e, f));
+                        }
+                    }
+                }
+            });
+        }
+        NearPairs {
+            rest_boxes,
+            vertex_triangle: vt,
+            edge_edge: ee,
+        }
+    }
+
+    /// Whether triangles `i` and `j` are rest-near (their pairs are listed here). Those that
+    /// are not are more than the radius apart at rest in some axis, so none of their vertex
+    /// and triangle, or edge and edge, is excluded or shares a vertex.
+    #[inline]
+    pub(super) fn rest_near(&self, i: u32, j: u32) -> bool {
+        self.rest_boxes[i as usize].overlaps(&self.rest_boxes[j as usize])
+    }
+}
