@@ -101,7 +101,8 @@ pub struct Bvh {
     nodes: Vec<Node>,
     /// Item indices, leaf by leaf.
     order: Vec<u32>,
-    /// Each item's box.
+    /// The items' boxes in the same order (`boxes[k]` is item `order[k]`'s), so a leaf's
+    /// boxes lie together.
     boxes: Vec<Aabb>,
 }
 
@@ -111,7 +112,7 @@ impl Bvh {
         let mut bvh = Bvh {
             nodes: Vec::with_capacity(2 * boxes.len() / LEAF + 1),
             order: (0..boxes.len() as u32).collect(),
-            boxes: boxes.to_vec(),
+            boxes: Vec::new(),
         };
         if boxes.is_empty() {
             return bvh;
@@ -153,6 +154,7 @@ impl Bvh {
             todo.push((child, lo, half));
             todo.push((child + 1, lo + half, n - half));
         }
+        bvh.boxes = bvh.order.iter().map(|&i| boxes[i as usize]).collect();
         bvh
     }
 
@@ -168,14 +170,16 @@ impl Bvh {
     /// New boxes for the same items: the tree is kept, its bounds recomputed.
     pub fn refit(&mut self, boxes: &[Aabb]) {
         debug_assert_eq!(boxes.len(), self.order.len());
-        self.boxes.copy_from_slice(boxes);
+        for (b, &i) in self.boxes.iter_mut().zip(&self.order) {
+            *b = boxes[i as usize];
+        }
         for k in (0..self.nodes.len()).rev() {
             let Node { first, count, .. } = self.nodes[k];
             let (first, count) = (first as usize, count as usize);
             self.nodes[k].bounds = if count > 0 {
-                self.order[first..first + count]
+                self.boxes[first..first + count]
                     .iter()
-                    .fold(Aabb::empty(), |b, &i| b.join(&boxes[i as usize]))
+                    .fold(Aabb::empty(), |b, o| b.join(o))
             } else {
                 self.nodes[first].bounds.join(&self.nodes[first + 1].bounds)
             };
@@ -244,34 +248,33 @@ impl Bvh {
     /// from the root for each and meets each pair twice.
     pub fn self_overlapping(&self, task: (u32, u32), mut f: impl FnMut(u32, u32)) {
         let mut stack = vec![task];
-        let mut next = Vec::with_capacity(4);
         while let Some((a, b)) = stack.pop() {
             let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
             let leaves = na.count > 0 && nb.count > 0;
             if !leaves {
-                next.clear();
-                self.expand(a, b, &mut next);
-                stack.extend_from_slice(&next);
+                // Never a leaf with itself: `expand` only pushes children.
+                self.expand(a, b, &mut stack);
                 continue;
             }
-            let items = |n: &Node| &self.order[n.first as usize..(n.first + n.count) as usize];
+            // A leaf's items and their boxes, side by side.
+            let range = |n: &Node| n.first as usize..(n.first + n.count) as usize;
+            let (ia, ib) = (&self.order[range(na)], &self.order[range(nb)]);
+            let (ba, bb) = (&self.boxes[range(na)], &self.boxes[range(nb)]);
             if a == b {
-                let items = items(na);
-                for (k, &i) in items.iter().enumerate() {
-                    for &j in &items[k + 1..] {
-                        if self.boxes[i as usize].overlaps(&self.boxes[j as usize]) {
+                for (k, (&i, bi)) in ia.iter().zip(ba).enumerate() {
+                    for (&j, bj) in ia[k + 1..].iter().zip(&ba[k + 1..]) {
+                        if bi.overlaps(bj) {
                             f(i, j);
                         }
                     }
                 }
             } else if na.bounds.overlaps(&nb.bounds) {
-                for &i in items(na) {
-                    let bi = &self.boxes[i as usize];
+                for (&i, bi) in ia.iter().zip(ba) {
                     if !bi.overlaps(&nb.bounds) {
                         continue;
                     }
-                    for &j in items(nb) {
-                        if bi.overlaps(&self.boxes[j as usize]) {
+                    for (&j, bj) in ib.iter().zip(bb) {
+                        if bi.overlaps(bj) {
                             f(i, j);
                         }
                     }
@@ -295,8 +298,9 @@ impl Bvh {
             }
             let first = node.first as usize;
             if node.count > 0 {
-                for &i in &self.order[first..first + node.count as usize] {
-                    if self.boxes[i as usize].overlaps(q) {
+                let range = first..first + node.count as usize;
+                for (&i, b) in self.order[range.clone()].iter().zip(&self.boxes[range]) {
+                    if b.overlaps(q) {
                         f(i);
                     }
                 }

@@ -142,6 +142,9 @@ impl NearPairs {
                 }
             });
         }
+        // In order, so that a vertex's (an edge's) pairs come together.
+        vt.sort_unstable();
+        ee.sort_unstable();
         NearPairs {
             rest_boxes,
             vertex_triangle: vt,

@@ -188,6 +188,7 @@ impl Search<'_> {
     /// Vertex `p` and triangle `t`, not sharing a vertex (and, unless `check`, known not to be
     /// neighbours): kept if within reach, with the remembered side or the side it is on now.
     /// Cheap rejections first: the box, the triangle's enclosing ball, the neighbours.
+    #[inline(always)]
     fn vertex_near(&self, p: u32, t: u32, check: bool, out: &mut Vec<Pair>) {
         let (x, tri) = (self.x, &self.triangles[t as usize]);
         if !self.tri_boxes[t as usize].contains(&x[p as usize])
@@ -222,6 +223,7 @@ impl Search<'_> {
 
     /// Edges `e` < `f`, not sharing a vertex (and, unless `check`, known not to be
     /// neighbours): likewise.
+    #[inline(always)]
     fn edge_near(&self, e: u32, f: u32, check: bool, out: &mut Vec<Pair>) {
         let (x, edge, other) = (self.x, &self.edges[e as usize], &self.edges[f as usize]);
         if !self.edge_boxes[e as usize].overlaps(&self.edge_boxes[f as usize])
