@@ -5,7 +5,7 @@
 //! walked against itself: each vertex and each edge is *owned* by one of its triangles
 //! ([`Ownership`]), so a pair of overlapping triangle boxes yields each vertex-triangle and
 //! edge-edge pair once. Triangles near each other at rest (mostly neighbours) are left out of
-//! the walk: their few pairs that are not neighbours are listed once (`neighbours.rs`) and
+//! the walk: their pairs that are not neighbours are listed once (`neighbours.rs`) and
 //! tested directly. Box and ball tests come before the exact distances. Pairs within
 //! `thickness + skin` of each other are kept in a list; the
 //! list is looked up again once some vertex has moved `skin / 2` since the last look (a Verlet
@@ -604,15 +604,12 @@ impl SelfCollision {
 mod tests {
     use super::*;
 
-    /// The look finds exactly the pairs a test of every pair finds, sides included: on a sheet
-    /// folded onto itself (many pairs within reach) with vertices moved at random, and with a
-    /// vertex that belongs to no triangle lying on the sheet.
-    #[test]
-    fn the_look_finds_what_testing_every_pair_finds() {
-        let (cols, rows) = (12u32, 9u32);
+    /// A sheet of `cols` x `rows` vertices 1 cm apart folded along its middle row, the lower
+    /// half 3 mm under the upper, vertices moved at random by up to 2 mm, and a vertex in no
+    /// triangle lying on it: (positions, rest positions, triangles).
+    fn folded_sheet(cols: u32, rows: u32) -> (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>) {
         let h = 0.01;
         let mut r = crate::testing::numbers(11);
-        // Folded along the row in the middle: the lower half comes back 3 mm under the upper.
         let mut x: Vec<Vec3> = Vec::new();
         let mut rest: Vec<Vec3> = Vec::new();
         for j in 0..rows {
@@ -639,21 +636,27 @@ mod tests {
                 triangles.push([a, c, d]);
             }
         }
-        let (thickness, reach) = (0.004, 0.008);
-        let mut sc = SelfCollision::new(&triangles);
-        sc.look(&x, &rest, &triangles, reach, EXCLUDED * thickness);
-        assert!(
-            sc.vertex_triangle.len() > 50 && sc.edge_edge.len() > 50,
-            "a fold has pairs"
-        );
-        let excluded = Exclusions::new(&rest, &triangles, &sc.edges, EXCLUDED * thickness);
+        (x, rest, triangles)
+    }
+
+    /// Every pair within `reach` at `x` that is not excluded at `rest`, with its side, by
+    /// testing every pair.
+    fn every_pair(
+        x: &[Vec3],
+        rest: &[Vec3],
+        triangles: &[[u32; 3]],
+        edges: &[[u32; 2]],
+        reach: f64,
+        excluded_within: f64,
+    ) -> (Vec<Pair>, Vec<Pair>) {
+        let excluded = Exclusions::new(rest, triangles, edges, excluded_within);
         let mut vt = Vec::new();
         for p in 0..x.len() as u32 {
             for (t, tri) in triangles.iter().enumerate() {
                 if tri.contains(&p) || excluded.vertex_excludes(p, t as u32) {
                     continue;
                 }
-                let (d, w, r) = vertex_triangle(&x, p, tri);
+                let (d, w, r) = vertex_triangle(x, p, tri);
                 if d < reach {
                     let [a, b, c] = tri.map(|i| x[i as usize]);
                     let s = if w.iter().all(|&wk| wk > 0.0) {
@@ -666,24 +669,69 @@ mod tests {
             }
         }
         let mut ee = Vec::new();
-        for (e, edge) in sc.edges.iter().enumerate() {
-            for (f, other) in sc.edges.iter().enumerate().skip(e + 1) {
+        for (e, edge) in edges.iter().enumerate() {
+            for (f, other) in edges.iter().enumerate().skip(e + 1) {
                 if edge.iter().any(|v| other.contains(v)) || excluded.edge_excludes(e as u32, f as u32) {
                     continue;
                 }
-                let (d, a, b, r, n) = edge_edge(&x, edge, other);
+                let (d, a, b, r, n) = edge_edge(x, edge, other);
                 if d < reach {
                     let interior = a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0;
                     ee.push((e as u32, f as u32, if interior { side(r.dot(&n)) } else { 0 }));
                 }
             }
         }
+        (vt, ee)
+    }
+
+    /// The look finds exactly the pairs a test of every pair finds, sides included: on a sheet
+    /// folded onto itself (many pairs within reach, between triangles near and far at rest)
+    /// with vertices moved at random, and with a vertex that belongs to no triangle lying on
+    /// the sheet.
+    #[test]
+    fn the_look_finds_what_testing_every_pair_finds() {
+        let (x, rest, triangles) = folded_sheet(12, 9);
+        let (thickness, reach) = (0.004, 0.008);
+        let mut sc = SelfCollision::new(&triangles);
+        sc.look(&x, &rest, &triangles, reach, EXCLUDED * thickness);
+        assert!(
+            sc.vertex_triangle.len() > 50 && sc.edge_edge.len() > 50,
+            "a fold has pairs"
+        );
+        let (vt, ee) = every_pair(&x, &rest, &triangles, &sc.edges, reach, EXCLUDED * thickness);
         assert!(
             vt.iter().any(|q| q.0 == x.len() as u32 - 1),
             "the lone vertex has pairs"
         );
         assert_eq!(sc.vertex_triangle, vt);
         assert_eq!(sc.edge_edge, ee);
+    }
+
+    /// On a sheet large enough for the pool (its walk split into tasks and the near pairs into
+    /// chunks), the look finds the same pairs on two threads as on one, and as testing every
+    /// pair.
+    #[test]
+    fn the_look_finds_the_same_pairs_on_two_threads() {
+        let (x, rest, triangles) = folded_sheet(40, 31);
+        assert!(x.len() >= 1024, "large enough for the pool");
+        let (thickness, reach) = (0.004, 0.008);
+        let look = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            pool.install(|| {
+                let mut sc = SelfCollision::new(&triangles);
+                sc.look(&x, &rest, &triangles, reach, EXCLUDED * thickness);
+                (sc.vertex_triangle, sc.edge_edge, sc.edges)
+            })
+        };
+        let (vt1, ee1, edges) = look(1);
+        let (vt2, ee2, _) = look(2);
+        assert!(vt1.len() > 500 && ee1.len() > 500, "a fold has pairs");
+        assert_eq!((&vt1, &ee1), (&vt2, &ee2));
+        let (vt, ee) = every_pair(&x, &rest, &triangles, &edges, reach, EXCLUDED * thickness);
+        assert_eq!((vt1, ee1), (vt, ee));
     }
 
     /// Two parallel squares 3 mm apart: pairs are found across them, none within one square,
