@@ -4,7 +4,7 @@
 //!   tested;
 //! - [`NearPairs`]: the pairs of triangles whose rest boxes lie within that radius of each
 //!   other, and what is left of their vertex-triangle and edge-edge pairs once the excluded
-//!   ones and the ones sharing a vertex are taken out. A look tests these few directly and
+//!   ones and the ones sharing a vertex are taken out. A look tests these directly and
 //!   leaves such triangle pairs out of its tree walk: the walk meets mostly neighbours, and
 //!   this way it drops each in one box test.
 

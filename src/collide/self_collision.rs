@@ -480,10 +480,12 @@ impl SelfCollision {
         } else {
             self.tri_bvh = Bvh::build(&self.tree_boxes);
         }
-        if !self.owners.fits(x.len(), triangles.len()) {
+        let new_mesh = !self.owners.fits(x.len(), triangles.len());
+        if new_mesh {
             self.owners = Ownership::new(x.len(), triangles, &self.edges);
         }
-        if self.excluded.radius != excluded_within || self.excluded.vt_start.len() != x.len() + 1 {
+        if new_mesh || self.excluded.radius != excluded_within || self.excluded.vt_start.len() != x.len() + 1
+        {
             self.excluded = Exclusions::new(rest, triangles, &self.edges, excluded_within);
             self.near = NearPairs::new(rest, triangles, &self.edges, &self.owners, &self.excluded);
         }
