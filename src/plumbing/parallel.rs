@@ -32,12 +32,6 @@ pub fn worth_it(n: usize) -> bool {
     n >= MIN_PARALLEL && !ON_CALLER.with(Cell::get) && rayon::current_num_threads() > 1
 }
 
-/// Whether `n` items of heavy work each (microseconds, not nanoseconds: a collision search)
-/// should spread over the pool: from 1024 items, when the cloth may use the pool.
-pub fn worth_it_heavy(n: usize) -> bool {
-    n >= 1024 && !ON_CALLER.with(Cell::get) && rayon::current_num_threads() > 1
-}
-
 thread_local! {
     /// Set while a step of a [`Threads::Caller`] cloth runs on this thread.
     static ON_CALLER: Cell<bool> = const { Cell::new(false) };
