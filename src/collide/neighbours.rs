@@ -123,23 +123,21 @@ impl NearPairs {
         let (mut vt, mut ee) = (Vec::new(), Vec::new());
         for task in bvh.self_tasks(1) {
             bvh.self_overlapping(task, |i, j| {
-                for (a, b) in [(i, j), (j, i)] {
-                    let tri = &triangles[b as usize];
-                    for &p in owners.vertices(a) {
-                        if !tri.contains(&p) && !excluded.vertex_excludes(p, b) {
-                            vt.push((p, b));
+                owners.pairs_of(
+                    i,
+                    j,
+                    |p, t| {
+                        if !triangles[t as usize].contains(&p) && !excluded.vertex_excludes(p, t) {
+                            vt.push((p, t));
                         }
-                    }
-                }
-                for &e in owners.edges(i) {
-                    for &f in owners.edges(j) {
-                        let (e, f) = (e.min(f), e.max(f));
+                    },
+                    |e, f| {
                         let (edge, other) = (&edges[e as usize], &edges[f as usize]);
                         if !edge.iter().any(|v| other.contains(v)) && !excluded.edge_excludes(e, f) {
                             ee.push((e, f));
                         }
-                    }
-                }
+                    },
+                );
             });
         }
         // In order, so that a vertex's (an edge's) pairs come together.

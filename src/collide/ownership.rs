@@ -93,6 +93,23 @@ impl Ownership {
     pub fn orphans(&self) -> &[u32] {
         &self.orphans
     }
+
+    /// The pairs triangles `i` and `j` meet through their owners: `vertex(p, t)` for each vertex
+    /// of one against the other triangle, then `edge(e, f)` (e < f) for each edge of `i`
+    /// against each of `j`.
+    #[inline]
+    pub fn pairs_of(&self, i: u32, j: u32, mut vertex: impl FnMut(u32, u32), mut edge: impl FnMut(u32, u32)) {
+        for (a, b) in [(i, j), (j, i)] {
+            for &p in self.vertices(a) {
+                vertex(p, b);
+            }
+        }
+        for &e in self.edges(i) {
+            for &f in self.edges(j) {
+                edge(e.min(f), e.max(f));
+            }
+        }
+    }
 }
 
 #[cfg(test)]

@@ -61,6 +61,7 @@ pub struct SavedMemory {
 pub struct SelfCollision {
     /// Every edge of the triangles once, `[i, j]` with i < j.
     edges: Vec<[u32; 2]>,
+    /// Each triangle's box grown by the reach and each edge's by half of it, at the last look.
     tri_boxes: Vec<Aabb>,
     edge_boxes: Vec<Aabb>,
     /// The triangles' boxes grown by half the reach, in the tree.
@@ -255,16 +256,13 @@ impl Search<'_> {
     /// return at once.
     #[inline(never)]
     fn far_triangles(&self, i: u32, j: u32, found: &mut Found) {
-        for (a, b) in [(i, j), (j, i)] {
-            for &p in self.owners.vertices(a) {
-                self.vertex_pair(p, b, &mut found.vt);
-            }
-        }
-        for &e in self.owners.edges(i) {
-            for &f in self.owners.edges(j) {
-                self.edge_pair(e.min(f), e.max(f), &mut found.ee);
-            }
-        }
+        let (vt, ee) = (&mut found.vt, &mut found.ee);
+        self.owners.pairs_of(
+            i,
+            j,
+            |p, t| self.vertex_pair(p, t, vt),
+            |e, f| self.edge_pair(e, f, ee),
+        );
     }
 
     /// Chunk `k` of the near pairs' lists.
