@@ -117,6 +117,15 @@ int main(void) {
     printf("no_such_id %d\n", (int)fc_cloth_set_mesh_collider(cloth, id + 5, box, 8, NULL));
     printf("removed %d\n", (int)fc_cloth_remove_collider(cloth, id));
     printf("after_remove %d\n", (int)fc_cloth_get_mesh_collider(cloth, id, &verts, &tris));
+    /* A thickness of ten spacings: refused at create and when set on a cloth, which keeps
+     * stepping with its own. */
+    FcClothDesc thick = desc;
+    thick.self_collision_thickness = 0.2;
+    FcCloth *refused = NULL;
+    printf("thick_create %d\n", (int)fc_cloth_create_grid(&thick, &refused));
+    printf("thick_create_output %s\n", refused == NULL ? "none" : "written");
+    printf("thick_set_desc %d\n", (int)fc_cloth_set_desc(cloth, &thick));
+    printf("step_after %d\n", (int)fc_cloth_step(cloth, 1.0 / 30.0));
     free(xyz);
     fc_cloth_destroy(cloth);
     return 0;

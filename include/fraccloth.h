@@ -398,7 +398,9 @@ typedef struct {
    * Points nearer than 2.2 times this at rest (neighbours) are not tested: a few millimetres
    * for a cloth of 1-2 cm spacing.
    * No vertex moves more than half of it in one substep (a faster one is slowed to that).
-   * See docs/collisions.md.
+   * At most about 1.5 times the mesh's mean edge length: a larger one would list too many
+   * neighbour pairs and is refused (`FC_ERROR_INVALID_ARGUMENT`, the message says how large
+   * a one the mesh takes). See docs/collisions.md.
    */
   double self_collision_thickness;
   /**

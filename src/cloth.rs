@@ -196,6 +196,12 @@ impl Cloth {
             (n as u64).saturating_mul(crate::memory::STATE_BYTES_PER_PARTICLE + 2 * history_bytes),
             &format!("a cloth of {n} particles"),
         )?;
+        let mut self_collision = SelfCollision::new(&topology.triangles);
+        self_collision.prepare(
+            &topology.rest_positions,
+            &topology.triangles,
+            config.model.self_collision_thickness,
+        )?;
         let x = topology.rest_positions.clone();
         Ok(Self {
             v: vec![Vec3::zeros(); n],
@@ -208,7 +214,7 @@ impl Cloth {
             colliders: Vec::new(),
             friction: Vec::new(),
             mesh_slots: Vec::new(),
-            self_collision: SelfCollision::new(&topology.triangles),
+            self_collision,
             histories: Histories::new(&config.model, config.scheme, &topology)?,
             time: 0.0,
             steps: 0,
@@ -246,6 +252,14 @@ impl Cloth {
             return Err(Error::invalid(
                 "the model's fractional terms (history drag, fractional springs) must be on or off as when the cloth was created: the history it keeps was sized then; create a new cloth, or set a coefficient to a tiny value instead of 0",
             ));
+        }
+        let thickness = config.model.self_collision_thickness;
+        let old_thickness = old.model.self_collision_thickness;
+        self.self_collision
+            .prepare(&self.topology.rest_positions, &self.topology.triangles, thickness)?;
+        if thickness != old_thickness {
+            // The pair list was found for the old reach.
+            self.self_collision.look_again();
         }
         self.config = config;
         Ok(())

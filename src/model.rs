@@ -70,7 +70,8 @@ pub struct Model {
     pub collision_margin: f64,
     /// Self-collision: the distance the cloth keeps from itself, m (0 = off, and costs
     /// nothing). Pairs nearer than 2.2 times this at rest (neighbours) are not tested
-    /// (`collide/self_collision.rs`).
+    /// (`collide/self_collision.rs`). A cloth refuses one past about 1.5 of its mean edge
+    /// lengths (`collide::self_collision::PAIRS_PER_VERTEX`).
     pub self_collision_thickness: f64,
     /// Coulomb friction coefficient of the cloth against itself (>= 0).
     pub self_collision_friction: f64,

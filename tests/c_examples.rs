@@ -191,6 +191,13 @@ fn mesh_collider_example_keeps_the_towel_outside_the_box() {
         FcStatus::FC_ERROR_INVALID_ARGUMENT as i32
     );
     assert_eq!(status("no_such_id"), FcStatus::FC_ERROR_OUT_OF_RANGE as i32);
+    assert_eq!(status("thick_create"), FcStatus::FC_ERROR_INVALID_ARGUMENT as i32);
+    assert_eq!(field(&out, "thick_create_output"), vec!["none"]);
+    assert_eq!(
+        status("thick_set_desc"),
+        FcStatus::FC_ERROR_INVALID_ARGUMENT as i32
+    );
+    assert_eq!(status("step_after"), FcStatus::FC_OK as i32);
     assert_eq!(status("removed"), FcStatus::FC_OK as i32);
     assert_eq!(status("after_remove"), FcStatus::FC_ERROR_OUT_OF_RANGE as i32);
 }

@@ -518,3 +518,50 @@ fn a_towel_against_a_fine_ball_bakes_without_a_refused_frame() {
         "refused frames (frame, retries, substeps): {refused:?}"
     );
 }
+
+/// A thickness of ten spacings would list hundreds of thousands of neighbour pairs on a towel
+/// (growing as the square of thickness / spacing): it is refused at create and on reconfigure
+/// with a message that names a thickness the mesh takes, which is then accepted; a refused
+/// reconfigure leaves the bake as if it had not been tried.
+#[test]
+fn a_thickness_too_large_for_the_mesh_is_refused_with_one_that_works() {
+    let towel = |thickness: f64| {
+        collision_towel(
+            21,
+            31,
+            0.02,
+            0.1,
+            TowelPose::Wavy,
+            thickness,
+            Integrator::SymplecticEuler,
+        )
+    };
+    let e = towel(0.2).unwrap_err();
+    assert_eq!(e.kind, fraccloth::ErrorKind::InvalidArgument);
+    assert!(e.message.contains("self_collision_thickness"), "{}", e.message);
+    let suggested: f64 = e
+        .message
+        .split("at most about ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no thickness suggested: {}", e.message));
+    assert!(suggested > 0.005 && suggested < 0.2, "{suggested}");
+    towel(suggested).unwrap_or_else(|e| panic!("the suggested {suggested} m: {}", e.message));
+
+    let bake = |try_thick: bool| {
+        let mut cloth = towel(0.005).unwrap();
+        for frame in 0..20 {
+            if try_thick && frame == 10 {
+                let mut config = cloth.config().clone();
+                config.model.self_collision_thickness = 0.2;
+                let e = cloth.reconfigure(config).unwrap_err();
+                assert_eq!(e.kind, fraccloth::ErrorKind::InvalidArgument);
+                assert_eq!(cloth.config().model.self_collision_thickness, 0.005);
+            }
+            cloth.step(1.0 / FPS).unwrap();
+        }
+        cloth.positions().to_vec()
+    };
+    assert_eq!(bake(true), bake(false), "a refused reconfigure changed the bake");
+}

@@ -13,6 +13,76 @@ use super::ownership::Ownership;
 use super::self_collision::{edge_edge, vertex_triangle};
 use crate::math::Vec3;
 
+/// Room for the lists worked out from the rest shape, in entries: every push counts against
+/// it and grows its list fallibly. A thickness large against the mesh's spacing makes the
+/// lists grow as (thickness / spacing)^2 a vertex; past the room they are refused with an
+/// error at create (or reconfigure), not left to exhaust memory, or to overflow the lists'
+/// 32-bit offsets, in the middle of a bake.
+#[derive(Debug)]
+pub(super) struct Room {
+    left: usize,
+    /// Why a push was refused, once one was: nothing more is pushed after it.
+    pub(super) full: Option<Full>,
+}
+
+/// Why the room ran out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Full {
+    /// More entries than the room allows.
+    Entries,
+    /// The allocator refused.
+    Memory,
+}
+
+impl Room {
+    pub(super) fn new(entries: usize) -> Room {
+        Room {
+            left: entries.min(u32::MAX as usize - 1),
+            full: None,
+        }
+    }
+
+    /// Pushes `item` onto `list` if there is room; false (and nothing pushed) when not.
+    pub(super) fn push<T>(&mut self, list: &mut Vec<T>, item: T) -> bool {
+        if self.full.is_some() {
+            return false;
+        }
+        if self.left == 0 {
+            self.full = Some(Full::Entries);
+            return false;
+        }
+        if list.len() == list.capacity() && list.try_reserve(list.len().max(64)).is_err() {
+            self.full = Some(Full::Memory);
+            return false;
+        }
+        self.left -= 1;
+        list.push(item);
+        true
+    }
+
+    /// Makes space for `k` more entries in `list` (fallibly); false when it cannot.
+    pub(super) fn reserve<T>(&mut self, list: &mut Vec<T>, k: usize) -> bool {
+        if self.full.is_some() {
+            return false;
+        }
+        if list.capacity() - list.len() < k && list.try_reserve(list.len().max(64).max(k)).is_err() {
+            self.full = Some(Full::Memory);
+            return false;
+        }
+        true
+    }
+
+    /// Counts `k` entries pushed after a [`Room::reserve`] against the room.
+    pub(super) fn spend(&mut self, k: usize) {
+        if k > self.left {
+            self.left = 0;
+            self.full = Some(Full::Entries);
+        } else {
+            self.left -= k;
+        }
+    }
+}
+
 /// Each vertex's (edge's) excluded triangles (edges), sorted, as compressed rows.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Exclusions {
@@ -24,8 +94,15 @@ pub(super) struct Exclusions {
 }
 
 impl Exclusions {
-    /// The pairs nearer than `radius` at the rest positions `rest`.
-    pub(super) fn new(rest: &[Vec3], triangles: &[[u32; 3]], edges: &[[u32; 2]], radius: f64) -> Exclusions {
+    /// The pairs nearer than `radius` at the rest positions `rest`; `None` when `room` ran out
+    /// (it says why).
+    pub(super) fn new(
+        rest: &[Vec3],
+        triangles: &[[u32; 3]],
+        edges: &[[u32; 2]],
+        radius: f64,
+        room: &mut Room,
+    ) -> Option<Exclusions> {
         let boxes: Vec<Aabb> = triangles
             .iter()
             .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize])).inflated(radius))
@@ -41,9 +118,12 @@ impl Exclusions {
             bvh.overlapping(&q, |t| {
                 let tri = &triangles[t as usize];
                 if tri.contains(&p) || vertex_triangle(rest, p, tri).0 < radius {
-                    vt.push(t);
+                    room.push(&mut vt, t);
                 }
             });
+            if room.full.is_some() {
+                return None;
+            }
             vt[first..].sort_unstable();
             vt_start.push(vt.len() as u32);
         }
@@ -60,19 +140,22 @@ impl Exclusions {
                 if f as usize > e
                     && (edge.iter().any(|v| other.contains(v)) || edge_edge(rest, edge, other).0 < radius)
                 {
-                    ee.push(f);
+                    room.push(&mut ee, f);
                 }
             });
+            if room.full.is_some() {
+                return None;
+            }
             ee[first..].sort_unstable();
             ee_start.push(ee.len() as u32);
         }
-        Exclusions {
+        Some(Exclusions {
             radius,
             vt_start,
             vt,
             ee_start,
             ee,
-        }
+        })
     }
 
     pub(super) fn vertex_excludes(&self, p: u32, t: u32) -> bool {
@@ -107,14 +190,15 @@ pub(super) struct NearPairs {
 
 impl NearPairs {
     /// The near pairs of the cloth at rest positions `rest` for the exclusions `excluded`
-    /// (their radius is the one that tells rest-near triangles).
+    /// (their radius is the one that tells rest-near triangles); `None` when `room` ran out.
     pub(super) fn new(
         rest: &[Vec3],
         triangles: &[[u32; 3]],
         edges: &[[u32; 2]],
         owners: &Ownership,
         excluded: &Exclusions,
-    ) -> NearPairs {
+        room: &mut Room,
+    ) -> Option<NearPairs> {
         let rest_boxes: Vec<Aabb> = triangles
             .iter()
             .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize])).inflated(0.5 * excluded.radius))
@@ -123,6 +207,11 @@ impl NearPairs {
         let (mut vt, mut ee) = (Vec::new(), Vec::new());
         for task in bvh.self_tasks(1) {
             bvh.self_overlapping(task, |i, j| {
+                // A triangle pair yields at most 6 vertex-triangle and 9 edge-edge pairs.
+                if !room.reserve(&mut vt, 6) || !room.reserve(&mut ee, 9) {
+                    return;
+                }
+                let before = vt.len() + ee.len();
                 owners.pairs_of(
                     i,
                     j,
@@ -138,16 +227,20 @@ impl NearPairs {
                         }
                     },
                 );
+                room.spend(vt.len() + ee.len() - before);
             });
+        }
+        if room.full.is_some() {
+            return None;
         }
         // In order, so that a vertex's (an edge's) pairs come together.
         vt.sort_unstable();
         ee.sort_unstable();
-        NearPairs {
+        Some(NearPairs {
             rest_boxes,
             vertex_triangle: vt,
             edge_edge: ee,
-        }
+        })
     }
 
     /// Whether triangles `i` and `j` are rest-near (their pairs are listed here). Those that
@@ -156,5 +249,30 @@ impl NearPairs {
     #[inline]
     pub(super) fn rest_near(&self, i: u32, j: u32) -> bool {
         self.rest_boxes[i as usize].overlaps(&self.rest_boxes[j as usize])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_room_refuses_past_its_entries_and_keeps_refusing() {
+        let mut room = Room::new(3);
+        let mut a = Vec::new();
+        assert!(room.push(&mut a, 1u32) && room.push(&mut a, 2));
+        assert!(room.reserve(&mut a, 9));
+        a.push(3);
+        room.spend(1);
+        assert_eq!(room.full, None);
+        assert!(!room.push(&mut a, 4), "a fourth entry in a room of three");
+        assert_eq!(room.full, Some(Full::Entries));
+        assert_eq!(a, [1, 2, 3]);
+        assert!(!room.reserve(&mut a, 1), "nothing more once full");
+        // Spending more than is left fills it too; the room never exceeds u32 offsets.
+        let mut room = Room::new(2);
+        room.spend(3);
+        assert_eq!(room.full, Some(Full::Entries));
+        assert_eq!(Room::new(usize::MAX).left, u32::MAX as usize - 1);
     }
 }

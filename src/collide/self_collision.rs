@@ -30,8 +30,9 @@
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
 use super::geometry::{closest_on_segments, edges_of, offset_from_triangle};
-use super::neighbours::{Exclusions, NearPairs};
+use super::neighbours::{Exclusions, Full, NearPairs, Room};
 use super::ownership::Ownership;
+use crate::error::Error;
 use crate::math::Vec3;
 
 /// The skin of the pair list, in thicknesses: pairs within `(1 + SKIN)` thicknesses are kept,
@@ -42,6 +43,13 @@ pub const SKIN: f64 = 1.0;
 const PARALLEL_SINE: f64 = 0.05;
 /// Pairs nearer than this many thicknesses at rest are never tested (neighbours).
 pub const EXCLUDED: f64 = 2.2;
+/// At most this many pairs a vertex, on average, in the lists worked out from the rest shape
+/// (the neighbours left out and the rest-near pairs listed). A 61 x 61 grid of 1 cm spacing
+/// has 55 a vertex at a thickness of 4 mm, 294 at 1 cm and 700 at 2 cm: they grow about as
+/// the square of thickness / spacing (a little slower on a grid this small, whose border
+/// has fewer neighbours), and so do the memory and the time of every look. Past it
+/// [`SelfCollision::prepare`] refuses the thickness.
+pub const PAIRS_PER_VERTEX: usize = 1024;
 
 /// A remembered pair: the two elements and the side, +1 or -1 (0: not known yet, until the
 /// vertex first comes over the triangle's face, or the edges' closest points first lie inside
@@ -109,6 +117,15 @@ pub(super) fn edge_edge(x: &[Vec3], e: &[u32; 2], f: &[u32; 2]) -> (f64, f64, f6
 /// Whether vertex `p` and triangle `t` of positions `x` are surely further than `reach` apart:
 /// the vertex's distance from the triangle's centroid less the farthest corner's is.
 #[inline]
+/// The mean length of the edges `edges` at positions `x` (0 with no edge).
+fn mean_edge(x: &[Vec3], edges: &[[u32; 2]]) -> f64 {
+    let total: f64 = edges
+        .iter()
+        .map(|e| (x[e[1] as usize] - x[e[0] as usize]).norm())
+        .sum();
+    total / edges.len().max(1) as f64
+}
+
 fn ball_apart(x: &[Vec3], p: u32, t: &[u32; 3], reach: f64) -> bool {
     let [a, b, c] = t.map(|i| x[i as usize]);
     let centre = (a + b + c) / 3.0;
@@ -285,6 +302,65 @@ impl SelfCollision {
         SelfCollision {
             edges: edges_of(triangles),
             ..SelfCollision::default()
+        }
+    }
+
+    /// Whether the lists worked out from the rest shape are there for `n` vertices and
+    /// exclusion radius `radius`.
+    fn prepared(&self, n: usize, triangle_count: usize, radius: f64) -> bool {
+        self.owners.fits(n, triangle_count)
+            && self.excluded.radius == radius
+            && self.excluded.vt_start.len() == n + 1
+    }
+
+    /// Works out what the rest shape `rest` says for self-collision at `thickness` (which
+    /// pairs are neighbours, never tested; which are listed to be tested directly), unless
+    /// done already. Fails, with nothing changed, when the lists would hold more than
+    /// [`PAIRS_PER_VERTEX`] entries a vertex (a thickness large against the mesh's spacing:
+    /// the message says how large a one the mesh takes) or memory runs out.
+    pub(crate) fn prepare(
+        &mut self,
+        rest: &[Vec3],
+        triangles: &[[u32; 3]],
+        thickness: f64,
+    ) -> Result<(), Error> {
+        if thickness <= 0.0 || self.prepared(rest.len(), triangles.len(), EXCLUDED * thickness) {
+            return Ok(());
+        }
+        self.prepare_within(rest, triangles, EXCLUDED * thickness)
+    }
+
+    fn prepare_within(&mut self, rest: &[Vec3], triangles: &[[u32; 3]], radius: f64) -> Result<(), Error> {
+        let entries = PAIRS_PER_VERTEX.saturating_mul(rest.len()).saturating_add(4096);
+        let mut room = Room::new(entries);
+        let owners = Ownership::new(rest.len(), triangles, &self.edges);
+        let lists = Exclusions::new(rest, triangles, &self.edges, radius, &mut room).and_then(|excluded| {
+            NearPairs::new(rest, triangles, &self.edges, &owners, &excluded, &mut room)
+                .map(|near| (excluded, near))
+        });
+        match (lists, room.full) {
+            (Some((excluded, near)), _) => {
+                self.owners = owners;
+                self.excluded = excluded;
+                self.near = near;
+                Ok(())
+            }
+            (None, Some(Full::Memory)) => Err(Error::out_of_memory(format!(
+                "self-collision at a thickness of {} m: its lists of neighbours cannot be allocated",
+                radius / EXCLUDED
+            ))),
+            (None, _) => {
+                let mean = mean_edge(rest, &self.edges);
+                Err(Error::invalid(format!(
+                    "self_collision_thickness {:.4} m is too large for this mesh, whose edges are {:.4} m long on average: \
+                     the neighbours it would leave out or list pass {} a vertex; use a thickness of at most about {:.4} m \
+                     (1.5 mean edge lengths), or a coarser mesh",
+                    radius / EXCLUDED,
+                    mean,
+                    PAIRS_PER_VERTEX,
+                    1.5 * mean
+                )))
+            }
         }
     }
 
@@ -478,14 +554,14 @@ impl SelfCollision {
         } else {
             self.tri_bvh = Bvh::build(&self.tree_boxes);
         }
-        let new_mesh = !self.owners.fits(x.len(), triangles.len());
-        if new_mesh {
-            self.owners = Ownership::new(x.len(), triangles, &self.edges);
-        }
-        if new_mesh || self.excluded.radius != excluded_within || self.excluded.vt_start.len() != x.len() + 1
-        {
-            self.excluded = Exclusions::new(rest, triangles, &self.edges, excluded_within);
-            self.near = NearPairs::new(rest, triangles, &self.edges, &self.owners, &self.excluded);
+        if !self.prepared(x.len(), triangles.len(), excluded_within) {
+            // Unreachable through a cloth (it prepares at create and on a new model); a
+            // direct caller that did not prepare gets the default room and, past it, no pairs.
+            if self.prepare_within(rest, triangles, excluded_within).is_err() {
+                self.vertex_triangle.clear();
+                self.edge_edge.clear();
+                return;
+            }
         }
         let old_vt = std::mem::take(&mut self.vertex_triangle);
         let old_ee = std::mem::take(&mut self.edge_edge);
@@ -564,7 +640,6 @@ impl SelfCollision {
     }
 
     /// Forgets the positions of the last look (the next step looks again; sides are kept).
-    #[cfg(test)]
     pub(crate) fn look_again(&mut self) {
         self.looked_at.clear();
     }
@@ -652,7 +727,14 @@ mod tests {
         reach: f64,
         excluded_within: f64,
     ) -> (Vec<Pair>, Vec<Pair>) {
-        let excluded = Exclusions::new(rest, triangles, edges, excluded_within);
+        let excluded = Exclusions::new(
+            rest,
+            triangles,
+            edges,
+            excluded_within,
+            &mut Room::new(usize::MAX),
+        )
+        .expect("room for a test mesh");
         let mut vt = Vec::new();
         for p in 0..x.len() as u32 {
             for (t, tri) in triangles.iter().enumerate() {
