@@ -112,6 +112,11 @@ fn main() {
                 }),
             },
             scheme: fraccloth::history::Scheme::DEFAULT,
+            max_substep: if get("auto").is_some() {
+                fraccloth::cloth::AUTO
+            } else {
+                0.0
+            },
             ..SceneSpec::paper(kind, Variant::Underwater)
         };
         let spec = SceneSpec {

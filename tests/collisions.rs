@@ -565,3 +565,45 @@ fn a_thickness_too_large_for_the_mesh_is_refused_with_one_that_works() {
     };
     assert_eq!(bake(true), bake(false), "a refused reconfigure changed the bake");
 }
+
+/// A margin of a metre on a mesh of 6144 triangles would make every vertex of the towel keep
+/// every triangle (3.8 M entries): the step is refused with a message that names the collider
+/// and its margin, at the automatic step and at a fixed one, and the cloth is left as it was;
+/// with a sane margin again it steps on.
+#[test]
+fn a_margin_that_reaches_the_whole_mesh_is_refused_not_a_memory_blow_up() {
+    let (tx, tt) = torus(Vec3::zeros(), 0.12, 0.05, 96, 32);
+    let mut cloth = collision_towel(
+        25,
+        25,
+        0.016,
+        0.08,
+        TowelPose::Flat,
+        0.0,
+        Integrator::SymplecticEuler,
+    )
+    .unwrap();
+    let id = cloth.add_mesh_collider(&tx, &tt, None).unwrap();
+    cloth.step(1.0 / FPS).unwrap();
+    for fixed in [false, true] {
+        if fixed {
+            let mut config = cloth.config().clone();
+            config.max_substep = 1e-3;
+            cloth.reconfigure(config).unwrap();
+        }
+        cloth.set_collider_margin(id, 1.0).unwrap();
+        let (x, t) = (cloth.positions().to_vec(), cloth.time());
+        let e = cloth.step(1.0 / FPS).unwrap_err();
+        println!("{}", e.message);
+        assert_eq!(e.kind, fraccloth::ErrorKind::InvalidArgument, "{}", e.message);
+        assert!(
+            e.message.contains(&format!("mesh collider {id}")) && e.message.contains("margin of 1 m"),
+            "{}",
+            e.message
+        );
+        assert_eq!(cloth.positions(), &x[..], "a refused step moved the cloth");
+        assert_eq!(cloth.time(), t);
+        cloth.set_collider_margin(id, 0.01).unwrap();
+        cloth.step(1.0 / FPS).unwrap();
+    }
+}

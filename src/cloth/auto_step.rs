@@ -107,7 +107,7 @@ impl Cloth {
     /// Advances by `dt` with the automatic step (module docs).
     pub(super) fn step_auto(&mut self, dt: f64) -> Result<(), crate::error::Error> {
         use crate::error::ErrorKind;
-        self.measure_contact_weights();
+        self.measure_contact_weights()?;
         let h = self.auto_substep(dt);
         let limit = f64::from(super::MAX_SUBSTEPS);
         let mut n = if h > 0.0 {

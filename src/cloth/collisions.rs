@@ -4,6 +4,7 @@
 
 use super::Cloth;
 use crate::bytes::{ByteReader, ByteWriter};
+use crate::collide::mesh::{TooMany, CANDIDATES_PER_VERTEX};
 use crate::collide::self_collision::Pair;
 use crate::collide::{contact, Contact, MeshCollider};
 use crate::error::Error;
@@ -72,6 +73,23 @@ impl Cloth {
         self.self_collision.looks
     }
 
+    /// The error of mesh collider `id` whose candidate lists were refused (`why`) at margin
+    /// `margin`.
+    fn too_many_candidates(id: usize, mesh: &MeshCollider, margin: f64, why: TooMany) -> Error {
+        match why {
+            TooMany::Memory => Error::out_of_memory(format!(
+                "mesh collider {id}: the lists of its triangles near the cloth cannot be allocated; state left unchanged"
+            )),
+            TooMany::Room(entries) => Error::invalid(format!(
+                "mesh collider {id}: its margin of {margin} m reaches so many of its triangles from the cloth ({entries} entries, \
+                 more than {CANDIDATES_PER_VERTEX} a cloth vertex) that the step would fill memory; its triangles' edges are \
+                 {:.4} m long on average: give it a margin of a few of them at most (fc_cloth_set_collider_margin), or a coarser mesh; \
+                 state left unchanged",
+                mesh.mean_edge()
+            )),
+        }
+    }
+
     /// A mesh collider's margin (its own or the model's) and the skin its candidates reach
     /// beyond it.
     fn mesh_reach(model_margin: f64, mesh: &MeshCollider) -> (f64, f64) {
@@ -87,12 +105,13 @@ impl Cloth {
     /// contact that begins within the call is not foreseen, nor are self-collision's (a
     /// crumpled cloth's many pairs would make the bound far smaller than the step it needs,
     /// measured): a frame they make unstable is retried with more substeps.
-    pub(super) fn measure_contact_weights(&mut self) {
+    pub(super) fn measure_contact_weights(&mut self) -> Result<(), Error> {
         let s = &mut self.scratch;
         s.contact_weight.clear();
         s.start_contacts.clear();
         let model_margin = self.config.model.collision_margin;
-        for mesh in self.mesh_slots.iter_mut().flatten() {
+        for (id, slot) in self.mesh_slots.iter_mut().enumerate() {
+            let Some(mesh) = slot else { continue };
             let (margin, skin) = Self::mesh_reach(model_margin, mesh);
             mesh.refresh(margin + skin);
             mesh.contacts(
@@ -103,10 +122,11 @@ impl Cloth {
                 skin,
                 MESH_MAX_DEPTH_MARGINS * margin,
                 &mut s.start_contacts,
-            );
+            )
+            .map_err(|why| Self::too_many_candidates(id, mesh, margin, why))?;
         }
         if s.start_contacts.is_empty() {
-            return;
+            return Ok(());
         }
         s.contact_weight.resize(self.x.len(), 0.0);
         for e in &s.start_contacts {
@@ -117,6 +137,7 @@ impl Cloth {
                 }
             }
         }
+        Ok(())
     }
 
     /// A step call of `dt` seconds begins: each mesh collider's velocities and swept boxes.
@@ -138,12 +159,13 @@ impl Cloth {
     /// The collision pass: contact elements with the mesh colliders (at `fraction` of the call,
     /// the end of this step) and of the cloth with itself, their forces added to the forces
     /// before the force pass. Nothing without meshes or self-collision.
-    pub(super) fn collisions(&mut self, fraction: Option<f64>) {
+    pub(super) fn collisions(&mut self, fraction: Option<f64>) -> Result<(), Error> {
         let s = &mut self.scratch;
         s.contacts.clear();
         let m = &self.config.model;
         let f = fraction.unwrap_or(1.0);
-        for mesh in self.mesh_slots.iter_mut().flatten() {
+        for (id, slot) in self.mesh_slots.iter_mut().enumerate() {
+            let Some(mesh) = slot else { continue };
             let (margin, skin) = Self::mesh_reach(m.collision_margin, mesh);
             // A step outside a call (a snapshot's trial step) finds the boxes made here.
             mesh.refresh(margin + skin);
@@ -155,7 +177,8 @@ impl Cloth {
                 skin,
                 MESH_MAX_DEPTH_MARGINS * margin,
                 &mut s.contacts,
-            );
+            )
+            .map_err(|why| Self::too_many_candidates(id, mesh, margin, why))?;
         }
         if m.self_collision_thickness > 0.0 {
             self.self_collision.contacts(
@@ -168,7 +191,7 @@ impl Cloth {
             );
         }
         if s.contacts.is_empty() {
-            return;
+            return Ok(());
         }
         if s.prior_forces.is_empty() {
             s.prior_forces.resize(self.x.len(), Vec3::zeros());
@@ -180,6 +203,7 @@ impl Cloth {
             &s.v_step,
             &mut s.prior_forces,
         );
+        Ok(())
     }
 
     /// Friction of the contact elements after the step; says whether any applied.

@@ -179,7 +179,7 @@ impl Cloth {
         self.element_forces(&mut weights);
         self.water_turning();
         self.wide_form_drag();
-        self.collisions(plan.fraction);
+        self.collisions(plan.fraction)?;
         let integrated_sound = match Route::of(self.config.integrator) {
             Route::ExplicitTiles(step) => self.forces_and_explicit_step(h, weights, step),
             Route::Implicit => self.forces_and_implicit_step(h, weights)?,

@@ -115,6 +115,42 @@ struct Candidates {
     touched: Vec<u32>,
     /// Every list must be looked up again (the mesh moved, or the cloth changed).
     stale: bool,
+    /// Entries in all the lists together.
+    total: usize,
+}
+
+/// Room for a mesh collider's candidate lists: this many entries a cloth vertex (vertex,
+/// triangle and edge lists together) above [`CANDIDATES_FLOOR`]. A cloth near a mesh has a few
+/// a vertex (a towel on the 10k-triangle ball: under 10); a margin many times the mesh's
+/// triangles across makes every cloth vertex keep every triangle within it, and past this room
+/// the step is refused with an error instead of filling memory.
+pub const CANDIDATES_PER_VERTEX: usize = 256;
+/// Room every cloth has, whatever its size (4 MB of entries).
+pub const CANDIDATES_FLOOR: usize = 1 << 20;
+
+/// Why a mesh collider's candidate lists were refused (the step is then refused too).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum TooMany {
+    /// Past the room ([`CANDIDATES_PER_VERTEX`]); the entries the lists held when it ran out.
+    Room(usize),
+    /// The allocator refused.
+    Memory,
+}
+
+/// Pushes `t` onto `list` unless the lists' `total` (with `list` counted in) would pass `room`
+/// or memory runs out; then `refused` says why and nothing more is pushed.
+#[inline]
+fn push_within(list: &mut Vec<u32>, t: u32, total: usize, room: usize, refused: &mut Option<TooMany>) {
+    if refused.is_some() {
+        return;
+    }
+    if total + list.len() >= room {
+        *refused = Some(TooMany::Room(total + list.len()));
+    } else if list.len() == list.capacity() && list.try_reserve(list.len().max(8)).is_err() {
+        *refused = Some(TooMany::Memory);
+    } else {
+        list.push(t);
+    }
 }
 
 /// Updates `with` (ascending indices of non-empty `lists`) after the lists of `changed` were
@@ -277,6 +313,20 @@ impl MeshCollider {
     /// The velocities the host gave, if it gave them.
     pub fn given_velocities(&self) -> Option<&[Vec3]> {
         (!self.given_velocity.is_empty()).then_some(&self.given_velocity[..])
+    }
+
+    /// The mean length of its triangles' edges where the host last put it, m (0 with none).
+    pub fn mean_edge(&self) -> f64 {
+        let x = &self.target;
+        let total: f64 = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| x[i as usize]);
+                (b - a).norm() + (c - b).norm() + (a - c).norm()
+            })
+            .sum();
+        total / (3 * self.triangles.len()).max(1) as f64
     }
 
     /// Whether every edge joins exactly two triangles (then inside and outside are told apart).
@@ -452,8 +502,8 @@ impl MeshCollider {
         skin: f64,
         max_depth: f64,
         out: &mut Vec<Contact>,
-    ) {
-        self.refresh_candidates(x, cloth_triangles, margin, skin);
+    ) -> Result<(), TooMany> {
+        self.refresh_candidates(x, cloth_triangles, margin, skin)?;
         let c = &mut self.cache;
         c.nearest.resize(x.len(), NONE);
         for &i in &c.touched {
@@ -579,15 +629,41 @@ impl MeshCollider {
                 });
             }
         }
+        Ok(())
     }
 
     /// Looks up again the candidates of every cloth vertex that moved more than `skin / 2`
     /// since it last looked, and of its triangles and edges (all of them after the mesh moved).
     /// A triangle's (edge's) vertices have then moved at most `skin` since it looked (each
     /// at most `skin / 2` since its own look, which was no later), which its query's `skin` and
-    /// the mesh's boxes' `reach` cover.
-    fn refresh_candidates(&mut self, x: &[Vec3], cloth_triangles: &[[u32; 3]], margin: f64, skin: f64) {
+    /// the mesh's boxes' `reach` cover. Refused past the lists' room ([`CANDIDATES_PER_VERTEX`]),
+    /// every list then to be looked up again at the next call.
+    fn refresh_candidates(
+        &mut self,
+        x: &[Vec3],
+        cloth_triangles: &[[u32; 3]],
+        margin: f64,
+        skin: f64,
+    ) -> Result<(), TooMany> {
+        let result = self.refresh_within(x, cloth_triangles, margin, skin);
+        if result.is_err() {
+            self.cache.stale = true;
+        }
+        result
+    }
+
+    fn refresh_within(
+        &mut self,
+        x: &[Vec3],
+        cloth_triangles: &[[u32; 3]],
+        margin: f64,
+        skin: f64,
+    ) -> Result<(), TooMany> {
         let reach = margin + skin;
+        let room = CANDIDATES_PER_VERTEX
+            .saturating_mul(x.len())
+            .saturating_add(CANDIDATES_FLOOR);
+        let mut refused = None;
         let c = &mut self.cache;
         let resized = c.vertex.len() != x.len() || c.triangle.len() != cloth_triangles.len();
         if resized || c.cloth_edges.is_empty() {
@@ -602,6 +678,10 @@ impl MeshCollider {
             c.vertex_at.resize(x.len(), Vec3::zeros());
             c.triangle.resize_with(cloth_triangles.len(), Vec::new);
             c.edge.resize_with(c.cloth_edges.len(), Vec::new);
+            for list in c.vertex.iter_mut().chain(&mut c.triangle).chain(&mut c.edge) {
+                list.clear();
+            }
+            c.total = 0;
             c.stale = false;
         }
         let moved = |at: &Vec3, p: &Vec3| (p - at).norm_squared() > 0.25 * skin * skin;
@@ -616,9 +696,16 @@ impl MeshCollider {
             let p = x[i];
             c.vertex_at[i] = p;
             let list = &mut c.vertex[i];
+            c.total -= list.len();
             list.clear();
             let q = Aabb { min: p, max: p }.inflated(reach);
-            self.tri_bvh.overlapping(&q, |t| list.push(t));
+            let total = c.total;
+            self.tri_bvh
+                .overlapping(&q, |t| push_within(list, t, total, room, &mut refused));
+            c.total += list.len();
+            if let Some(why) = refused {
+                return Err(why);
+            }
             if list.is_empty() && self.closed && bounds.contains(&p) {
                 // Possibly deep inside: the nearest triangle of the whole mesh decides.
                 let (tris, target) = (&self.triangles, &self.target);
@@ -626,7 +713,11 @@ impl MeshCollider {
                     closest_at(target, &tris[t as usize], &p).1.norm_squared()
                 });
                 if let Some((t, _)) = nearest {
-                    list.push(t);
+                    push_within(list, t, c.total, room, &mut refused);
+                    if let Some(why) = refused {
+                        return Err(why);
+                    }
+                    c.total += 1;
                     // Inside, the nearest of the whole mesh changes with every move: looked up
                     // again at the next substep (outside, it is beyond reach: no contact).
                     let (w, r) = closest_at(target, &tris[t as usize], &p);
@@ -661,19 +752,33 @@ impl MeshCollider {
         for &t in &c.dirty_triangles {
             let tri = &cloth_triangles[t as usize];
             let list = &mut c.triangle[t as usize];
+            c.total -= list.len();
             list.clear();
             // The vertices' boxes hold `reach` already; the triangle's grows by the skin its
             // vertices may move before it looks again.
             let q = Aabb::of(tri.iter().map(|&i| &x[i as usize])).inflated(skin);
-            self.vert_bvh.overlapping(&q, |m| list.push(m));
+            let total = c.total;
+            self.vert_bvh
+                .overlapping(&q, |m| push_within(list, m, total, room, &mut refused));
+            c.total += list.len();
+            if let Some(why) = refused {
+                return Err(why);
+            }
         }
         for &e in &c.dirty_edges {
             let [i0, i1] = c.cloth_edges[e as usize];
             let list = &mut c.edge[e as usize];
+            c.total -= list.len();
             list.clear();
             // The mesh edges' boxes hold `reach` already.
             let q = Aabb::of([&x[i0 as usize], &x[i1 as usize]]).inflated(skin);
-            self.edge_bvh.overlapping(&q, |m| list.push(m));
+            let total = c.total;
+            self.edge_bvh
+                .overlapping(&q, |m| push_within(list, m, total, room, &mut refused));
+            c.total += list.len();
+            if let Some(why) = refused {
+                return Err(why);
+            }
         }
         if all {
             c.with_vertex.clear();
@@ -684,6 +789,7 @@ impl MeshCollider {
         update_with(&mut c.with_vertex, &c.vertex, &c.looked);
         update_with(&mut c.with_triangle, &c.triangle, &c.dirty_triangles);
         update_with(&mut c.with_edge, &c.edge, &c.dirty_edges);
+        Ok(())
     }
 }
 
@@ -809,7 +915,8 @@ mod tests {
             Vec3::new(-0.49, 0.0, 0.0),
         ];
         let mut out = Vec::new();
-        m.contacts(&probes, &cloth_tris, 1.0, 0.05, 0.02, 10.0, &mut out);
+        m.contacts(&probes, &cloth_tris, 1.0, 0.05, 0.02, 10.0, &mut out)
+            .expect("room for a test mesh");
         assert_eq!(out.len(), 4, "{out:?}");
         for (c, p) in out.iter().zip(&probes) {
             let radial = p.try_normalize(0.0).unwrap_or(Vec3::z());
@@ -837,7 +944,8 @@ mod tests {
             0.02,
             1.0,
             &mut out,
-        );
+        )
+        .expect("room for a test mesh");
         assert_eq!(out.len(), 1, "{out:?}");
         assert_eq!(out[0].idx[0], 1);
         assert!(out[0].dir.y > 0.9);
@@ -871,7 +979,8 @@ mod tests {
             Vec3::new(5.0, 5.0, 5.0),
         ];
         let mut out = Vec::new();
-        m.contacts(&cloth, &[[0, 1, 2]], 1.0, 0.01, 0.01, 1.0, &mut out);
+        m.contacts(&cloth, &[[0, 1, 2]], 1.0, 0.01, 0.01, 1.0, &mut out)
+            .expect("room for a test mesh");
         let edge = out.iter().find(|c| c.len == 2).expect("an edge contact");
         assert_eq!(edge.idx[..2], [0, 1]);
         assert!(
@@ -897,7 +1006,8 @@ mod tests {
             Vec3::new(-1.0, 0.305, 2.0),
         ];
         let mut out = Vec::new();
-        m.contacts(&cloth, &[[0, 2, 1]], 1.0, 0.01, 0.01, 1.0, &mut out);
+        m.contacts(&cloth, &[[0, 2, 1]], 1.0, 0.01, 0.01, 1.0, &mut out)
+            .expect("room for a test mesh");
         assert!(out.iter().any(|c| c.len == 3 && c.dir.y > 0.99), "{out:?}");
     }
 
@@ -933,7 +1043,8 @@ mod tests {
         ];
         let tris = [[0, 2, 1], [1, 2, 3]];
         let mut out = Vec::new();
-        m.contacts(&cloth, &tris, 1.0, 0.01, 0.005, 1.0, &mut out);
+        m.contacts(&cloth, &tris, 1.0, 0.01, 0.005, 1.0, &mut out)
+            .expect("room for a test mesh");
         assert_eq!(out.len(), 4, "contacts: {}", out.len());
         assert!(out.iter().all(|c| c.len == 1 && c.dir.y > 0.99));
     }
@@ -971,11 +1082,14 @@ mod tests {
                 })
                 .collect();
             let mut a = Vec::new();
-            kept.contacts(&cloth, &tris, 1.0, 0.01, 0.005, 0.03, &mut a);
+            kept.contacts(&cloth, &tris, 1.0, 0.01, 0.005, 0.03, &mut a)
+                .expect("room for a test mesh");
             let mut fresh = kept.clone();
             fresh.cache = Candidates::default();
             let mut b = Vec::new();
-            fresh.contacts(&cloth, &tris, 1.0, 0.01, 0.005, 0.03, &mut b);
+            fresh
+                .contacts(&cloth, &tris, 1.0, 0.01, 0.005, 0.03, &mut b)
+                .expect("room for a test mesh");
             // The same contacts, to rounding; a vertex deeper inside the ball than the reach
             // (margin and skin) is pushed out along a triangle near it, not always the nearest
             // (module docs), so only its contact is compared.
