@@ -7,7 +7,8 @@
 //! Keys (defaults in brackets): `scene=swing|curtain` [swing; the curtain is 1 x 1.5 m],
 //! `freq=0.25,0.5,1,2` (Hz), `amp=0.04` (m), `size=61x41` [51x76 for the curtain],
 //! `current=X,Y,Z` (m/s; with `amp=0`, how far the tip leans and flutters), `integrator=symplectic|implicit|explicit|symplectic2|implicit2` [symplectic], `dt` [2 ms
-//! explicit, 1/30 s implicit], `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
+//! explicit, 1/30 s implicit], `auto=1` (each `dt` split by the automatic step, as a host with
+//! `max_substep` automatic; with `dt=0.0333`, frames), `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
 //! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag), `scale=` (its smoothing length, m),
 //! `skin=` (N s/m^3), `damping=` (spring damping), `dscale=S,H,B` (its multiple per family: stretch, shear, bend), `bend=` (the bend springs' stiffness, times the
 //! preset's), `mode=velocity|fractional|strain|none` (what the
