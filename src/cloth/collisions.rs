@@ -180,6 +180,7 @@ impl Cloth {
             )
             .map_err(|why| Self::too_many_candidates(id, mesh, margin, why))?;
         }
+        let mesh_contacts = s.contacts.len();
         if m.self_collision_thickness > 0.0 {
             self.self_collision.contacts(
                 &self.x,
@@ -192,6 +193,20 @@ impl Cloth {
         }
         if s.contacts.is_empty() {
             return Ok(());
+        }
+        if !s.projected.is_empty() {
+            // Normal added mass: `Cloth::water_turning` wrote the normals and projected areas
+            // of the inertia this step takes.
+            let t = &self.topology;
+            let (normals, projected) = (s.force_pass.normals(), &s.projected);
+            let inertia =
+                |i: usize| crate::forces::Inertia::of(m, t.masses[i], t.areas[i], normals[i], projected[i]);
+            contact::inertia_scale(
+                &mut s.contacts[mesh_contacts..],
+                &self.pinned,
+                |i, n| inertia(i).effective_force(n) / t.masses[i],
+                |i| 1.0 / inertia(i).isotropic(),
+            );
         }
         if s.prior_forces.is_empty() {
             s.prior_forces.resize(self.x.len(), Vec3::zeros());

@@ -551,6 +551,7 @@ impl MeshCollider {
                         depth: (margin - d).min(max_depth),
                         surface_velocity: self.surface_velocity(t, w),
                         friction,
+                        scale: 1.0,
                     });
                 }
             }
@@ -591,6 +592,7 @@ impl MeshCollider {
                     depth: (margin - d).min(max_depth),
                     surface_velocity: self.velocity[m as usize],
                     friction,
+                    scale: 1.0,
                 });
             }
         }
@@ -626,6 +628,7 @@ impl MeshCollider {
                     depth: (margin - d).min(max_depth),
                     surface_velocity: v0 + t * (v1 - v0),
                     friction,
+                    scale: 1.0,
                 });
             }
         }

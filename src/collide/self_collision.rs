@@ -393,6 +393,7 @@ impl SelfCollision {
                     depth: (thickness - dist).min(cap),
                     surface_velocity: Vec3::zeros(),
                     friction,
+                    scale: 1.0,
                 });
             }
         };
