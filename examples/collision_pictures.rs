@@ -52,16 +52,14 @@ fn panel(
             .collect();
         chart.draw_series(std::iter::once(PathElement::new(p, RGBColor(30, 80, 160))))?;
     }
-    // Crossing pairs: both triangles in red.
+    // Crossing pairs: both triangles in red, each edge its own two-point line (a thick path
+    // through three nearly collinear points, a triangle seen edge-on, has a miter join that
+    // plotters draws far off the panel).
     for (a, b) in crossing_pairs(x, tris) {
-        {
-            for t in [tris[a as usize], tris[b as usize]] {
-                let p: Vec<(f64, f64)> = t
-                    .iter()
-                    .chain(std::iter::once(&t[0]))
-                    .map(|&i| view(&x[i as usize]))
-                    .collect();
-                chart.draw_series(std::iter::once(PathElement::new(p, RED.stroke_width(2))))?;
+        for t in [tris[a as usize], tris[b as usize]] {
+            for k in 0..3 {
+                let ends = vec![view(&x[t[k] as usize]), view(&x[t[(k + 1) % 3] as usize])];
+                chart.draw_series(std::iter::once(PathElement::new(ends, RED.stroke_width(2))))?;
             }
         }
     }
