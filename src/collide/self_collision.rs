@@ -48,7 +48,7 @@ pub const EXCLUDED: f64 = 2.2;
 /// has 55 a vertex at a thickness of 4 mm, 294 at 1 cm and 700 at 2 cm: they grow about as
 /// the square of thickness / spacing (a little slower on a grid this small, whose border
 /// has fewer neighbours), and so do the memory and the time of every look. Past it
-/// [`SelfCollision::prepare`] refuses the thickness.
+/// a cloth refuses the thickness (at create, or when given it).
 pub const PAIRS_PER_VERTEX: usize = 1024;
 
 /// A remembered pair: the two elements and the side, +1 or -1 (0: not known yet, until the
