@@ -63,11 +63,10 @@ fn a_towel_dropped_on_the_floor_folds_without_crossing_itself() {
     assert!(without > 0, "without self-collision the pile crosses itself");
 }
 
-/// A towel dropped over a torus mesh turning about its axis: no cloth vertex is inside the
-/// torus at any frame, and the towel rests on it (does not fall through).
-#[test]
-fn a_towel_on_a_turning_torus_stays_outside_it() {
-    let (tx, tt) = torus(Vec3::zeros(), 0.12, 0.05, 48, 16);
+/// A flat 25 x 25 towel of 1.6 cm spacing 8 cm above a torus mesh (major radius 12 cm, tube
+/// 5 cm) of `around` x `tube` quads: the cloth, the torus's id, and its mesh.
+fn towel_over_torus(around: u32, tube: u32) -> (Cloth, u32, fraccloth::collide::shapes::Mesh) {
+    let torus_mesh = torus(Vec3::zeros(), 0.12, 0.05, around, tube);
     let mut cloth = collision_towel(
         25,
         25,
@@ -78,7 +77,17 @@ fn a_towel_on_a_turning_torus_stays_outside_it() {
         Integrator::SymplecticEuler,
     )
     .unwrap();
-    let id = cloth.add_mesh_collider(&tx, &tt, None).unwrap();
+    let id = cloth
+        .add_mesh_collider(&torus_mesh.0, &torus_mesh.1, None)
+        .unwrap();
+    (cloth, id, torus_mesh)
+}
+
+/// A towel dropped over a torus mesh turning about its axis: no cloth vertex is inside the
+/// torus at any frame, and the towel rests on it (does not fall through).
+#[test]
+fn a_towel_on_a_turning_torus_stays_outside_it() {
+    let (mut cloth, id, (tx, tt)) = towel_over_torus(48, 16);
     cloth.set_collider_friction(id, 0.5).unwrap();
     let mut worst = 0;
     let mut posed = tx.clone();
@@ -572,18 +581,7 @@ fn a_thickness_too_large_for_the_mesh_is_refused_with_one_that_works() {
 /// with a sane margin again it steps on.
 #[test]
 fn a_margin_that_reaches_the_whole_mesh_is_refused_not_a_memory_blow_up() {
-    let (tx, tt) = torus(Vec3::zeros(), 0.12, 0.05, 96, 32);
-    let mut cloth = collision_towel(
-        25,
-        25,
-        0.016,
-        0.08,
-        TowelPose::Flat,
-        0.0,
-        Integrator::SymplecticEuler,
-    )
-    .unwrap();
-    let id = cloth.add_mesh_collider(&tx, &tt, None).unwrap();
+    let (mut cloth, id, _) = towel_over_torus(96, 32);
     cloth.step(1.0 / FPS).unwrap();
     for fixed in [false, true] {
         if fixed {

@@ -137,6 +137,22 @@ pub(crate) enum TooMany {
     Memory,
 }
 
+/// Refills `list` with what `query` finds (it calls its argument once a feature), keeping
+/// `total`, all the lists' entries, within `room`.
+fn refill(
+    list: &mut Vec<u32>,
+    total: &mut usize,
+    room: usize,
+    query: impl FnOnce(&mut dyn FnMut(u32)),
+) -> Result<(), TooMany> {
+    *total -= list.len();
+    list.clear();
+    let (others, mut refused) = (*total, None);
+    query(&mut |t| push_within(list, t, others, room, &mut refused));
+    *total += list.len();
+    refused.map_or(Ok(()), Err)
+}
+
 /// Pushes `t` onto `list` unless the lists' `total` (with `list` counted in) would pass `room`
 /// or memory runs out; then `refused` says why and nothing more is pushed.
 #[inline]
@@ -503,7 +519,10 @@ impl MeshCollider {
         max_depth: f64,
         out: &mut Vec<Contact>,
     ) -> Result<(), TooMany> {
-        self.refresh_candidates(x, cloth_triangles, margin, skin)?;
+        if let Err(why) = self.refresh_candidates(x, cloth_triangles, margin, skin) {
+            self.cache.stale = true;
+            return Err(why);
+        }
         let c = &mut self.cache;
         c.nearest.resize(x.len(), NONE);
         for &i in &c.touched {
@@ -639,23 +658,9 @@ impl MeshCollider {
     /// since it last looked, and of its triangles and edges (all of them after the mesh moved).
     /// A triangle's (edge's) vertices have then moved at most `skin` since it looked (each
     /// at most `skin / 2` since its own look, which was no later), which its query's `skin` and
-    /// the mesh's boxes' `reach` cover. Refused past the lists' room ([`CANDIDATES_PER_VERTEX`]),
-    /// every list then to be looked up again at the next call.
+    /// the mesh's boxes' `reach` cover. Refused past the lists' room ([`CANDIDATES_PER_VERTEX`]);
+    /// the caller then marks every list to be looked up again.
     fn refresh_candidates(
-        &mut self,
-        x: &[Vec3],
-        cloth_triangles: &[[u32; 3]],
-        margin: f64,
-        skin: f64,
-    ) -> Result<(), TooMany> {
-        let result = self.refresh_within(x, cloth_triangles, margin, skin);
-        if result.is_err() {
-            self.cache.stale = true;
-        }
-        result
-    }
-
-    fn refresh_within(
         &mut self,
         x: &[Vec3],
         cloth_triangles: &[[u32; 3]],
@@ -666,7 +671,6 @@ impl MeshCollider {
         let room = CANDIDATES_PER_VERTEX
             .saturating_mul(x.len())
             .saturating_add(CANDIDATES_FLOOR);
-        let mut refused = None;
         let c = &mut self.cache;
         let resized = c.vertex.len() != x.len() || c.triangle.len() != cloth_triangles.len();
         if resized || c.cloth_edges.is_empty() {
@@ -699,16 +703,10 @@ impl MeshCollider {
             let p = x[i];
             c.vertex_at[i] = p;
             let list = &mut c.vertex[i];
-            c.total -= list.len();
-            list.clear();
             let q = Aabb { min: p, max: p }.inflated(reach);
-            let total = c.total;
-            self.tri_bvh
-                .overlapping(&q, |t| push_within(list, t, total, room, &mut refused));
-            c.total += list.len();
-            if let Some(why) = refused {
-                return Err(why);
-            }
+            refill(list, &mut c.total, room, |push| {
+                self.tri_bvh.overlapping(&q, push)
+            })?;
             if list.is_empty() && self.closed && bounds.contains(&p) {
                 // Possibly deep inside: the nearest triangle of the whole mesh decides.
                 let (tris, target) = (&self.triangles, &self.target);
@@ -716,6 +714,7 @@ impl MeshCollider {
                     closest_at(target, &tris[t as usize], &p).1.norm_squared()
                 });
                 if let Some((t, _)) = nearest {
+                    let mut refused = None;
                     push_within(list, t, c.total, room, &mut refused);
                     if let Some(why) = refused {
                         return Err(why);
@@ -754,34 +753,22 @@ impl MeshCollider {
         }
         for &t in &c.dirty_triangles {
             let tri = &cloth_triangles[t as usize];
-            let list = &mut c.triangle[t as usize];
-            c.total -= list.len();
-            list.clear();
             // The vertices' boxes hold `reach` already; the triangle's grows by the skin its
             // vertices may move before it looks again.
             let q = Aabb::of(tri.iter().map(|&i| &x[i as usize])).inflated(skin);
-            let total = c.total;
-            self.vert_bvh
-                .overlapping(&q, |m| push_within(list, m, total, room, &mut refused));
-            c.total += list.len();
-            if let Some(why) = refused {
-                return Err(why);
-            }
+            let list = &mut c.triangle[t as usize];
+            refill(list, &mut c.total, room, |push| {
+                self.vert_bvh.overlapping(&q, push)
+            })?;
         }
         for &e in &c.dirty_edges {
             let [i0, i1] = c.cloth_edges[e as usize];
-            let list = &mut c.edge[e as usize];
-            c.total -= list.len();
-            list.clear();
             // The mesh edges' boxes hold `reach` already.
             let q = Aabb::of([&x[i0 as usize], &x[i1 as usize]]).inflated(skin);
-            let total = c.total;
-            self.edge_bvh
-                .overlapping(&q, |m| push_within(list, m, total, room, &mut refused));
-            c.total += list.len();
-            if let Some(why) = refused {
-                return Err(why);
-            }
+            let list = &mut c.edge[e as usize];
+            refill(list, &mut c.total, room, |push| {
+                self.edge_bvh.overlapping(&q, push)
+            })?;
         }
         if all {
             c.with_vertex.clear();
