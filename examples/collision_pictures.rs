@@ -139,7 +139,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &cloth,
             Some((&posed, &tt)),
             front,
-            ((-0.3, 0.3), (-0.25, 0.15)),
+            ((-0.5, 0.3), (-0.15, 0.15)),
         )?;
     }
     root.present()?;
