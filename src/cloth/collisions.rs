@@ -4,7 +4,8 @@
 
 use super::Cloth;
 use crate::bytes::{ByteReader, ByteWriter};
-use crate::collide::mesh::{TooMany, CANDIDATES_PER_VERTEX};
+use crate::collide::mesh::{candidate_room, CANDIDATES_PER_VERTEX};
+use crate::collide::room::Full;
 use crate::collide::self_collision::Pair;
 use crate::collide::{contact, Contact, MeshCollider};
 use crate::error::Error;
@@ -74,18 +75,19 @@ impl Cloth {
     }
 
     /// The error of mesh collider `id` whose candidate lists were refused (`why`) at margin
-    /// `margin`.
-    fn too_many_candidates(id: usize, mesh: &MeshCollider, margin: f64, why: TooMany) -> Error {
+    /// `margin` against a cloth of `vertices`.
+    fn too_many_candidates(id: usize, mesh: &MeshCollider, margin: f64, vertices: usize, why: Full) -> Error {
+        let (mean_edge, entries) = (mesh.mean_edge(), candidate_room(vertices));
         match why {
-            TooMany::Memory => Error::out_of_memory(format!(
+            Full::Memory => Error::out_of_memory(format!(
                 "mesh collider {id}: the lists of its triangles near the cloth cannot be allocated; state left unchanged"
             )),
-            TooMany::Room(entries) => Error::invalid(format!(
+            Full::Entries => Error::invalid(format!(
                 "mesh collider {id}: its margin of {margin} m reaches so many of its triangles from the cloth ({entries} entries, \
                  more than {CANDIDATES_PER_VERTEX} a cloth vertex) that the step would fill memory; its triangles' edges are \
                  {:.4} m long on average: give it a margin of a few of them at most (fc_cloth_set_collider_margin), or a coarser mesh; \
                  state left unchanged",
-                mesh.mean_edge()
+                mean_edge
             )),
         }
     }
@@ -123,7 +125,7 @@ impl Cloth {
                 MESH_MAX_DEPTH_MARGINS * margin,
                 &mut s.start_contacts,
             )
-            .map_err(|why| Self::too_many_candidates(id, mesh, margin, why))?;
+            .map_err(|why| Self::too_many_candidates(id, mesh, margin, self.x.len(), why))?;
         }
         if s.start_contacts.is_empty() {
             return Ok(());
@@ -178,7 +180,7 @@ impl Cloth {
                 MESH_MAX_DEPTH_MARGINS * margin,
                 &mut s.contacts,
             )
-            .map_err(|why| Self::too_many_candidates(id, mesh, margin, why))?;
+            .map_err(|why| Self::too_many_candidates(id, mesh, margin, self.x.len(), why))?;
         }
         let mesh_contacts = s.contacts.len();
         if m.self_collision_thickness > 0.0 {

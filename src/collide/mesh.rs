@@ -40,6 +40,7 @@
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
 use super::geometry::{closest_on_segments, closest_on_triangle, edges_of, offset_from_triangle};
+use super::room::{Full, Room};
 use crate::error::Error;
 use crate::math::Vec3;
 use crate::topology::Adjacency;
@@ -128,45 +129,22 @@ pub const CANDIDATES_PER_VERTEX: usize = 256;
 /// Room every cloth has, whatever its size (4 MB of entries).
 pub const CANDIDATES_FLOOR: usize = 1 << 20;
 
-/// Why a mesh collider's candidate lists were refused (the step is then refused too).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum TooMany {
-    /// Past the room ([`CANDIDATES_PER_VERTEX`]); the entries the lists held when it ran out.
-    Room(usize),
-    /// The allocator refused.
-    Memory,
+/// The entries a mesh collider's candidate lists may hold against a cloth of `vertices`.
+pub(crate) fn candidate_room(vertices: usize) -> usize {
+    CANDIDATES_PER_VERTEX
+        .saturating_mul(vertices)
+        .saturating_add(CANDIDATES_FLOOR)
 }
 
-/// Refills `list` with what `query` finds (it calls its argument once a feature), keeping
-/// `total`, all the lists' entries, within `room`.
-fn refill(
-    list: &mut Vec<u32>,
-    total: &mut usize,
-    room: usize,
-    query: impl FnOnce(&mut dyn FnMut(u32)),
-) -> Result<(), TooMany> {
-    *total -= list.len();
+/// Refills `list` with what `query` finds (it calls its argument once a feature) within
+/// `room`; false when the room refused.
+fn refill(list: &mut Vec<u32>, room: &mut Room, query: impl FnOnce(&mut dyn FnMut(u32))) -> bool {
+    room.give_back(list.len());
     list.clear();
-    let (others, mut refused) = (*total, None);
-    query(&mut |t| push_within(list, t, others, room, &mut refused));
-    *total += list.len();
-    refused.map_or(Ok(()), Err)
-}
-
-/// Pushes `t` onto `list` unless the lists' `total` (with `list` counted in) would pass `room`
-/// or memory runs out; then `refused` says why and nothing more is pushed.
-#[inline]
-fn push_within(list: &mut Vec<u32>, t: u32, total: usize, room: usize, refused: &mut Option<TooMany>) {
-    if refused.is_some() {
-        return;
-    }
-    if total + list.len() >= room {
-        *refused = Some(TooMany::Room(total + list.len()));
-    } else if list.len() == list.capacity() && list.try_reserve(list.len().max(8)).is_err() {
-        *refused = Some(TooMany::Memory);
-    } else {
-        list.push(t);
-    }
+    query(&mut |t| {
+        room.push(list, t);
+    });
+    room.full.is_none()
 }
 
 /// Updates `with` (ascending indices of non-empty `lists`) after the lists of `changed` were
@@ -518,7 +496,7 @@ impl MeshCollider {
         skin: f64,
         max_depth: f64,
         out: &mut Vec<Contact>,
-    ) -> Result<(), TooMany> {
+    ) -> Result<(), Full> {
         if let Err(why) = self.refresh_candidates(x, cloth_triangles, margin, skin) {
             self.cache.stale = true;
             return Err(why);
@@ -666,11 +644,9 @@ impl MeshCollider {
         cloth_triangles: &[[u32; 3]],
         margin: f64,
         skin: f64,
-    ) -> Result<(), TooMany> {
+    ) -> Result<(), Full> {
         let reach = margin + skin;
-        let room = CANDIDATES_PER_VERTEX
-            .saturating_mul(x.len())
-            .saturating_add(CANDIDATES_FLOOR);
+        let capacity = candidate_room(x.len());
         let c = &mut self.cache;
         let resized = c.vertex.len() != x.len() || c.triangle.len() != cloth_triangles.len();
         if resized || c.cloth_edges.is_empty() {
@@ -691,6 +667,12 @@ impl MeshCollider {
             c.total = 0;
             c.stale = false;
         }
+        let mut room = Room::new(capacity.saturating_sub(c.total));
+        // The entries the lists hold once the room is spent as far as it is.
+        let refused = |c: &mut Candidates, room: &Room| {
+            c.total = capacity - room.left();
+            Err(room.full.unwrap_or(Full::Entries))
+        };
         let moved = |at: &Vec3, p: &Vec3| (p - at).norm_squared() > 0.25 * skin * skin;
         let bounds = self.tri_bvh.bounds();
         c.looked.clear();
@@ -702,11 +684,13 @@ impl MeshCollider {
             }
             let p = x[i];
             c.vertex_at[i] = p;
-            let list = &mut c.vertex[i];
             let q = Aabb { min: p, max: p }.inflated(reach);
-            refill(list, &mut c.total, room, |push| {
+            if !refill(&mut c.vertex[i], &mut room, |push| {
                 self.tri_bvh.overlapping(&q, push)
-            })?;
+            }) {
+                return refused(c, &room);
+            }
+            let list = &mut c.vertex[i];
             if list.is_empty() && self.closed && bounds.contains(&p) {
                 // Possibly deep inside: the nearest triangle of the whole mesh decides.
                 let (tris, target) = (&self.triangles, &self.target);
@@ -714,12 +698,9 @@ impl MeshCollider {
                     closest_at(target, &tris[t as usize], &p).1.norm_squared()
                 });
                 if let Some((t, _)) = nearest {
-                    let mut refused = None;
-                    push_within(list, t, c.total, room, &mut refused);
-                    if let Some(why) = refused {
-                        return Err(why);
+                    if !room.push(list, t) {
+                        return refused(c, &room);
                     }
-                    c.total += 1;
                     // Inside, the nearest of the whole mesh changes with every move: looked up
                     // again at the next substep (outside, it is beyond reach: no contact).
                     let (w, r) = closest_at(target, &tris[t as usize], &p);
@@ -756,19 +737,21 @@ impl MeshCollider {
             // The vertices' boxes hold `reach` already; the triangle's grows by the skin its
             // vertices may move before it looks again.
             let q = Aabb::of(tri.iter().map(|&i| &x[i as usize])).inflated(skin);
-            let list = &mut c.triangle[t as usize];
-            refill(list, &mut c.total, room, |push| {
+            if !refill(&mut c.triangle[t as usize], &mut room, |push| {
                 self.vert_bvh.overlapping(&q, push)
-            })?;
+            }) {
+                return refused(c, &room);
+            }
         }
         for &e in &c.dirty_edges {
             let [i0, i1] = c.cloth_edges[e as usize];
             // The mesh edges' boxes hold `reach` already.
             let q = Aabb::of([&x[i0 as usize], &x[i1 as usize]]).inflated(skin);
-            let list = &mut c.edge[e as usize];
-            refill(list, &mut c.total, room, |push| {
+            if !refill(&mut c.edge[e as usize], &mut room, |push| {
                 self.edge_bvh.overlapping(&q, push)
-            })?;
+            }) {
+                return refused(c, &room);
+            }
         }
         if all {
             c.with_vertex.clear();
@@ -779,6 +762,7 @@ impl MeshCollider {
         update_with(&mut c.with_vertex, &c.vertex, &c.looked);
         update_with(&mut c.with_triangle, &c.triangle, &c.dirty_triangles);
         update_with(&mut c.with_edge, &c.edge, &c.dirty_edges);
+        c.total = capacity - room.left();
         Ok(())
     }
 }

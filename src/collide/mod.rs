@@ -10,6 +10,7 @@
 //! | `mesh.rs` | triangle-mesh colliders |
 //! | `neighbours.rs` | self-collision's pairs as the rest shape tells them: excluded, and rest-near |
 //! | `ownership.rs` | which triangle owns each vertex and edge (pair walks meet each pair once) |
+//! | `room.rs` | bounded, fallibly grown lists (entries a caller's input sets) |
 //! | `self_collision.rs` | the cloth against itself |
 //! | `shapes.rs` | closed meshes of simple solids (scenes and tests) |
 
@@ -20,6 +21,7 @@ pub mod intersections;
 pub mod mesh;
 mod neighbours;
 pub mod ownership;
+pub(crate) mod room;
 pub mod self_collision;
 pub mod shapes;
 

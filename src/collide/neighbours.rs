@@ -10,78 +10,9 @@
 
 use super::bvh::{Aabb, Bvh};
 use super::ownership::Ownership;
+use super::room::Room;
 use super::self_collision::{edge_edge, vertex_triangle};
 use crate::math::Vec3;
-
-/// Room for the lists worked out from the rest shape, in entries: every push counts against
-/// it and grows its list fallibly. A thickness large against the mesh's spacing makes the
-/// lists grow as (thickness / spacing)^2 a vertex; past the room they are refused with an
-/// error at create (or reconfigure), not left to exhaust memory, or to overflow the lists'
-/// 32-bit offsets, in the middle of a bake.
-#[derive(Debug)]
-pub(super) struct Room {
-    left: usize,
-    /// Why a push was refused, once one was: nothing more is pushed after it.
-    pub(super) full: Option<Full>,
-}
-
-/// Why the room ran out.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Full {
-    /// More entries than the room allows.
-    Entries,
-    /// The allocator refused.
-    Memory,
-}
-
-impl Room {
-    pub(super) fn new(entries: usize) -> Room {
-        Room {
-            left: entries.min(u32::MAX as usize - 1),
-            full: None,
-        }
-    }
-
-    /// Pushes `item` onto `list` if there is room; false (and nothing pushed) when not.
-    pub(super) fn push<T>(&mut self, list: &mut Vec<T>, item: T) -> bool {
-        if self.full.is_some() {
-            return false;
-        }
-        if self.left == 0 {
-            self.full = Some(Full::Entries);
-            return false;
-        }
-        if list.len() == list.capacity() && list.try_reserve(list.len().max(64)).is_err() {
-            self.full = Some(Full::Memory);
-            return false;
-        }
-        self.left -= 1;
-        list.push(item);
-        true
-    }
-
-    /// Makes space for `k` more entries in `list` (fallibly); false when it cannot.
-    pub(super) fn reserve<T>(&mut self, list: &mut Vec<T>, k: usize) -> bool {
-        if self.full.is_some() {
-            return false;
-        }
-        if list.capacity() - list.len() < k && list.try_reserve(list.len().max(64).max(k)).is_err() {
-            self.full = Some(Full::Memory);
-            return false;
-        }
-        true
-    }
-
-    /// Counts `k` entries pushed after a [`Room::reserve`] against the room.
-    pub(super) fn spend(&mut self, k: usize) {
-        if k > self.left {
-            self.left = 0;
-            self.full = Some(Full::Entries);
-        } else {
-            self.left -= k;
-        }
-    }
-}
 
 /// Each vertex's (edge's) excluded triangles (edges), sorted, as compressed rows.
 #[derive(Clone, Debug, Default)]
@@ -156,6 +87,12 @@ impl Exclusions {
             ee_start,
             ee,
         })
+    }
+
+    /// Entries in the rows (excluded vertex-triangle and edge-edge pairs).
+    #[cfg(test)]
+    pub(super) fn len(&self) -> usize {
+        self.vt.len() + self.ee.len()
     }
 
     pub(super) fn vertex_excludes(&self, p: u32, t: u32) -> bool {
@@ -249,30 +186,5 @@ impl NearPairs {
     #[inline]
     pub(super) fn rest_near(&self, i: u32, j: u32) -> bool {
         self.rest_boxes[i as usize].overlaps(&self.rest_boxes[j as usize])
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_room_refuses_past_its_entries_and_keeps_refusing() {
-        let mut room = Room::new(3);
-        let mut a = Vec::new();
-        assert!(room.push(&mut a, 1u32) && room.push(&mut a, 2));
-        assert!(room.reserve(&mut a, 9));
-        a.push(3);
-        room.spend(1);
-        assert_eq!(room.full, None);
-        assert!(!room.push(&mut a, 4), "a fourth entry in a room of three");
-        assert_eq!(room.full, Some(Full::Entries));
-        assert_eq!(a, [1, 2, 3]);
-        assert!(!room.reserve(&mut a, 1), "nothing more once full");
-        // Spending more than is left fills it too; the room never exceeds u32 offsets.
-        let mut room = Room::new(2);
-        room.spend(3);
-        assert_eq!(room.full, Some(Full::Entries));
-        assert_eq!(Room::new(usize::MAX).left, u32::MAX as usize - 1);
     }
 }

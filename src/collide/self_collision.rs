@@ -30,8 +30,9 @@
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
 use super::geometry::{closest_on_segments, edges_of, offset_from_triangle};
-use super::neighbours::{Exclusions, Full, NearPairs, Room};
+use super::neighbours::{Exclusions, NearPairs};
 use super::ownership::Ownership;
+use super::room::{Full, Room};
 use crate::error::Error;
 use crate::math::Vec3;
 
@@ -45,7 +46,7 @@ const PARALLEL_SINE: f64 = 0.05;
 pub const EXCLUDED: f64 = 2.2;
 /// At most this many pairs a vertex, on average, in the lists worked out from the rest shape
 /// (the neighbours left out and the rest-near pairs listed). A 61 x 61 grid of 1 cm spacing
-/// has 55 a vertex at a thickness of 4 mm, 294 at 1 cm and 700 at 2 cm: they grow about as
+/// has 55 a vertex at a thickness of 4 mm, 294 at 1 cm and 702 at 2 cm: they grow about as
 /// the square of thickness / spacing (a little slower on a grid this small, whose border
 /// has fewer neighbours), and so do the memory and the time of every look. Past it
 /// a cloth refuses the thickness (at create, or when given it).
@@ -331,8 +332,9 @@ impl SelfCollision {
     }
 
     fn prepare_within(&mut self, rest: &[Vec3], triangles: &[[u32; 3]], radius: f64) -> Result<(), Error> {
+        // The exclusions' rows start at u32 offsets.
         let entries = PAIRS_PER_VERTEX.saturating_mul(rest.len()).saturating_add(4096);
-        let mut room = Room::new(entries);
+        let mut room = Room::new(entries.min(u32::MAX as usize - 1));
         let owners = Ownership::new(rest.len(), triangles, &self.edges);
         let lists = Exclusions::new(rest, triangles, &self.edges, radius, &mut room).and_then(|excluded| {
             NearPairs::new(rest, triangles, &self.edges, &owners, &excluded, &mut room)
@@ -931,5 +933,34 @@ mod tests {
         }
         assert!(out.iter().all(|c| c.idx[0] != 3), "{out:?}");
         assert!(sc.pairs().0.iter().any(|q| q.0 == 3 && q.2 == -1));
+    }
+
+    /// The lists a thickness needs grow about as (thickness / spacing)^2: on a 61 x 61 grid of
+    /// 1 cm (the figures of docs/collisions.md, printed here) 4 mm, 1 cm and 2 cm are taken
+    /// with more entries each, and 6 cm, past [`PAIRS_PER_VERTEX`], is refused with a message
+    /// that names a thickness the mesh takes; the refusal changes nothing.
+    #[test]
+    fn the_lists_grow_with_the_thickness_and_a_thickness_past_the_room_is_refused() {
+        let (_, rest, triangles) = folded_sheet(61, 61);
+        let mut per_vertex = Vec::new();
+        for thickness in [0.004, 0.01, 0.02] {
+            let mut sc = SelfCollision::new(&triangles);
+            sc.prepare(&rest, &triangles, thickness)
+                .expect("a thickness the grid takes");
+            let listed = sc.excluded.len() + sc.near.vertex_triangle.len() + sc.near.edge_edge.len();
+            per_vertex.push(listed as f64 / rest.len() as f64);
+        }
+        println!("pairs a vertex at 4 mm, 1 cm, 2 cm: {per_vertex:.0?}");
+        assert!(per_vertex.windows(2).all(|w| w[1] > 2.0 * w[0]), "{per_vertex:?}");
+        assert!(per_vertex[2] < PAIRS_PER_VERTEX as f64);
+        let mut sc = SelfCollision::new(&triangles);
+        sc.prepare(&rest, &triangles, 0.004).expect("4 mm");
+        let e = sc.prepare(&rest, &triangles, 0.06).unwrap_err();
+        assert_eq!(e.kind, crate::ErrorKind::InvalidArgument);
+        assert!(e.message.contains("at most about"), "{}", e.message);
+        assert!(
+            sc.prepared(rest.len(), triangles.len(), EXCLUDED * 0.004),
+            "a refusal kept the lists"
+        );
     }
 }
