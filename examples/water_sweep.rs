@@ -10,7 +10,7 @@
 //! explicit, 1/30 s implicit], `auto=1` (each `dt` split by the automatic step, as a host with
 //! `max_substep` automatic; with `dt=0.0333`, frames), `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
 //! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag), `scale=` (its smoothing length, m),
-//! `skin=` (N s/m^3), `damping=` (spring damping), `dscale=S,H,B` (its multiple per family: stretch, shear, bend), `bend=` (the bend springs' stiffness, times the
+//! `skin=` (N s/m^3), `coarse=` (coarse added mass, kg/m^2) and `coarse_len=` [0.2] (its patch spacing, m), `damping=` (spring damping), `dscale=S,H,B` (its multiple per family: stretch, shear, bend), `bend=` (the bend springs' stiffness, times the
 //! preset's), `mode=velocity|fractional|strain|none` (what the
 //! springs damp), `history=` (history drag per area, N s^1/2/m^3; the SOE history is kept).
 
@@ -57,6 +57,8 @@ fn main() {
     w_.form_drag = num("cd", w_.form_drag);
     w_.form_drag_scale = num("scale", w_.form_drag_scale);
     w_.skin_drag = num("skin", w_.skin_drag);
+    w_.coarse_added_mass = num("coarse", w_.coarse_added_mass);
+    w_.coarse_length = num("coarse_len", 0.2);
     model.spring_damping = num("damping", model.spring_damping);
     if let Some(d) = get("dscale") {
         let v: Vec<f64> = d
@@ -80,9 +82,11 @@ fn main() {
     let seconds = num("seconds", 12.0);
     let fps = 30.0;
     println!(
-        "# {w}x{h} {} added {} entrained {} C_d {} over {} m, skin {} damping {}",
+        "# {w}x{h} {} added {} (coarse {} over {} m) entrained {} C_d {} over {} m, skin {} damping {}",
         integrator.key(),
         model.water.added_mass,
+        model.water.coarse_added_mass,
+        model.water.coarse_length,
         model.water.entrained_mass,
         model.water.form_drag,
         model.water.form_drag_scale,

@@ -16,7 +16,7 @@
 
 #define FC_VERSION_MAJOR 0
 #define FC_VERSION_MINOR 9
-#define FC_VERSION_PATCH 5
+#define FC_VERSION_PATCH 6
 /* Equals fc_version() of the library this header belongs to. */
 #define FC_VERSION (FC_VERSION_MAJOR * 1000000 + FC_VERSION_MINOR * 1000 + FC_VERSION_PATCH)
 
@@ -422,6 +422,19 @@ typedef struct {
    * the resolution. Default 0 (`FC_PRESET_UNDERWATER`: 0.01, see docs/underwater.md).
    */
   double bend_reference_spacing;
+  /**
+   * Added mass of the cloth's large-scale normal motion, kg/m^2 per unit area (>= 0; 0 =
+   * off, the default): motion smoother than `coarse_length` carries this much more water
+   * than `added_mass` alone, ripples shorter than it only `added_mass` (a scale-aware
+   * inertia; a rigid plate of width W carries about `water_density * pi * W / 4` in all).
+   * Costs a small solve a step and the tile-fused step. See docs/underwater.md.
+   */
+  double coarse_added_mass;
+  /**
+   * Spacing of the coarse level's patches over the rest shape, m (> 0 when
+   * `coarse_added_mass` is on). Default 0.
+   */
+  double coarse_length;
 } FcClothDesc;
 
 #ifdef __cplusplus

@@ -670,13 +670,33 @@ impl Cloth {
         let t = &self.topology;
         let n = self.x.len();
         let (mut normals, mut projected) = (vec![Vec3::zeros(); n], vec![1.0; n]);
-        if m.water.added_mass != 0.0 {
+        if m.water.normal_water() {
             forces::patch_normals(&self.x, t, &mut normals, &mut projected);
         }
         let mut e = 0.0;
         for (i, (x, v)) in self.x.iter().zip(&self.v).enumerate() {
             let inertia = forces::Inertia::of(m, t.masses[i], t.areas[i], normals[i], projected[i]);
             e += inertia.kinetic_energy(v) - forces::body_force(m, t.masses[i]).dot(x);
+        }
+        let w = &m.water;
+        if w.coarse_added_mass > 0.0 {
+            let s = |i: usize| projected[i] * normals[i].dot(&self.v[i]);
+            match &self.scratch.coarse {
+                Some(c) if c.built_for(w.coarse_added_mass, w.coarse_length, &self.pinned) => {
+                    e += c.kinetic_energy(s);
+                }
+                // Not stepped yet with these pins: the level the next step will build.
+                _ => {
+                    if let Ok(c) = forces::coarse_water::CoarseWater::new(
+                        t,
+                        w.coarse_added_mass,
+                        w.coarse_length,
+                        &self.pinned,
+                    ) {
+                        e += c.kinetic_energy(s);
+                    }
+                }
+            }
         }
         for s in &t.springs {
             let k = m.stiffness(s.kind, t.spacing);

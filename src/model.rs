@@ -119,9 +119,25 @@ pub struct Water {
     pub history_drag: f64,
     /// Normal drag per unit area, N s/m^3 (adds to [`Model::normal_drag`] times the area).
     pub normal_drag: f64,
+    /// Added mass of the cloth's large-scale normal motion, kg/m^2 (0 = off): motion smoother
+    /// than [`Water::coarse_length`] carries this much more water per unit area than
+    /// [`Water::added_mass`] alone, ripples shorter than it only the local added mass. A
+    /// scale-aware inertia (`forces/coarse_water.rs`): a rigid plate of width W carries
+    /// about `rho_w pi W / 4` in all (potential flow), a ripple of wavelength lambda about
+    /// `rho_w lambda / pi`. Costs one patches-by-patches solve a step and the tile-fused step.
+    pub coarse_added_mass: f64,
+    /// The coarse level's patch spacing over the rest shape, m (> 0 when
+    /// [`Water::coarse_added_mass`] is on): bilinear patches this far apart in the rest shape's
+    /// plane each average the normal velocity of their vertices.
+    pub coarse_length: f64,
 }
 
 impl Water {
+    /// Whether any water rides on the cloth's normal motion (the turning forces' pass).
+    pub fn normal_water(&self) -> bool {
+        self.added_mass != 0.0 || self.coarse_added_mass != 0.0
+    }
+
     /// The normal added mass per unit area of a cloth of width `width` (m) in water of density
     /// `water_density` (kg/m^3): `added_mass + added_mass_coefficient * water_density * width`.
     pub fn added_mass_for(&self, water_density: f64, width: f64) -> f64 {
@@ -201,6 +217,11 @@ impl Model {
         check_non_negative("viscous_drag_per_area", w.viscous_drag)?;
         check_non_negative("history_drag_per_area", w.history_drag)?;
         check_non_negative("normal_drag_per_area", w.normal_drag)?;
+        check_non_negative("coarse_added_mass", w.coarse_added_mass)?;
+        check_non_negative("coarse_length", w.coarse_length)?;
+        if w.coarse_added_mass > 0.0 {
+            check_positive("coarse_length (with coarse_added_mass on)", w.coarse_length)?;
+        }
         Ok(())
     }
 

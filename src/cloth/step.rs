@@ -111,6 +111,8 @@ pub(super) struct StepScratch {
     pub start_contacts: Vec<crate::collide::Contact>,
     pub contact_weight: Vec<f64>,
     pub turning: forces::TurningScratch,
+    /// The coarse level of the carried water (`forces::coarse_water`), when the model has one.
+    pub coarse: Option<forces::coarse_water::CoarseWater>,
     /// The wide form drag's buffers and rest weights.
     pub wide_drag: forces::WideDragScratch,
     /// Each patch's projected-area ratio ([`forces::patch_normals`]), with normal added mass
@@ -177,7 +179,7 @@ impl Cloth {
         self.pin_goals(&plan);
         let mut weights = self.step_velocities(&plan);
         self.element_forces(&mut weights);
-        self.water_turning();
+        self.water_turning()?;
         self.wide_form_drag();
         self.collisions(plan.fraction)?;
         let integrated_sound = match Route::of(self.config.integrator) {
@@ -344,17 +346,34 @@ impl Cloth {
     /// The carried water's forces as the normals turn (`dT/dx - (dM/dt) v`,
     /// [`forces::turning_forces`]), added to the forces before the pass; nothing without
     /// normal added mass.
-    fn water_turning(&mut self) {
+    fn water_turning(&mut self) -> Result<(), Error> {
         let (s, t) = (&mut self.scratch, &self.topology);
-        if self.config.model.water.added_mass == 0.0 {
+        let w = &self.config.model.water;
+        if !w.normal_water() {
             s.projected.clear();
-            return;
+            s.coarse = None;
+            return Ok(());
         }
         if s.prior_forces.is_empty() {
             s.prior_forces.resize(self.x.len(), Vec3::zeros());
         }
         s.projected.resize(self.x.len(), 0.0);
         let m = &self.config.model;
+        let wanted = (w.coarse_added_mass, w.coarse_length);
+        if wanted.0 == 0.0 {
+            s.coarse = None;
+        } else if s
+            .coarse
+            .as_ref()
+            .is_none_or(|c| !c.built_for(wanted.0, wanted.1, &self.pinned))
+        {
+            s.coarse = Some(forces::coarse_water::CoarseWater::new(
+                t,
+                wanted.0,
+                wanted.1,
+                &self.pinned,
+            )?);
+        }
         let normals = s.force_pass.normals_to_write(self.x.len());
         forces::turning_forces(
             m,
@@ -365,7 +384,9 @@ impl Cloth {
             &mut s.projected,
             normals,
             &mut s.prior_forces,
+            s.coarse.as_mut(),
         );
+        Ok(())
     }
 
     /// Form drag on the smoothed normal velocity ([`forces::add_wide_form_drag`]), added to
@@ -386,6 +407,9 @@ impl Cloth {
     /// The force pass with an explicit integrator stepping each tile in cache; returns whether
     /// every result it wrote was sound.
     fn forces_and_explicit_step(&mut self, h: f64, weights: Weights, step: StepSoa) -> bool {
+        if self.scratch.coarse.is_some() {
+            return self.forces_coarse_and_explicit_step(h, weights, step);
+        }
         let s = &mut self.scratch;
         let input = ForceInput {
             model: &self.config.model,
@@ -445,6 +469,68 @@ impl Cloth {
         all_sound.into_inner()
     }
 
+    /// The force pass into one array, the coarse water's Woodbury solve, then the explicit
+    /// step tile by tile.
+    fn forces_coarse_and_explicit_step(&mut self, h: f64, weights: Weights, step: StepSoa) -> bool {
+        let n = self.vertex_count();
+        let s = &mut self.scratch;
+        s.force_array.resize(n, Vec3::zeros());
+        let input = ForceInput {
+            model: &self.config.model,
+            topology: &self.topology,
+            x: &self.x,
+            v: &s.v_step,
+            half_derivative: &s.half,
+            colliders: &self.colliders,
+            prior_forces: &s.prior_forces,
+            weights,
+        };
+        forces::total_forces_with(
+            &input,
+            &mut s.force_pass,
+            SpringInputs::Filled,
+            &mut s.force_array,
+        );
+        let t = &self.topology;
+        let Some(coarse) = s.coarse.as_mut() else {
+            return false;
+        };
+        coarse.effective_forces(
+            &self.config.model,
+            t,
+            s.force_pass.normals(),
+            &s.projected,
+            &mut s.force_array,
+        );
+        let max_speed2 = self.config.max_speed * self.config.max_speed;
+        let mut ok = true;
+        let mut lo = 0;
+        while lo < n {
+            let hi = (lo + TILE).min(n);
+            let len = hi - lo;
+            let mut a = [[0.0; TILE]; 9];
+            for k in 0..len {
+                let (xk, vk, fk) = (self.x[lo + k], s.v_step[lo + k], s.force_array[lo + k]);
+                for c in 0..3 {
+                    a[c][k] = xk[c];
+                    a[3 + c][k] = vk[c];
+                    a[6 + c][k] = fk[c];
+                }
+            }
+            let input = integrate::StepInput {
+                h,
+                x: [&a[0][..len], &a[1][..len], &a[2][..len]],
+                v: [&a[3][..len], &a[4][..len], &a[5][..len]],
+                force: [&a[6][..len], &a[7][..len], &a[8][..len]],
+                masses: &t.masses[lo..hi],
+                max_speed2,
+            };
+            ok &= step(&input, &mut s.x_new[lo..hi], &mut s.v_new[lo..hi]);
+            lo = hi;
+        }
+        ok
+    }
+
     /// The force pass into one array, then linearised backward Euler solved by CG; refused
     /// when the solver stops above its tolerance (unless accepted). The result is checked by
     /// [`Self::check`], so this returns false (not checked here).
@@ -481,6 +567,10 @@ impl Cloth {
             contacts: &s.contacts,
             contact_stiffness: self.config.model.collision_stiffness,
             contact_damping: self.config.model.collision_damping,
+            coarse: s
+                .coarse
+                .as_ref()
+                .map(|c| (c, s.force_pass.normals(), &s.projected[..])),
         };
         self.solver_stats = implicit_euler(&inp, &mut s.implicit, &mut s.v_new);
         let st = self.solver_stats;

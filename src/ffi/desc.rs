@@ -223,6 +223,15 @@ pub struct FcClothDesc {
     /// `bend_stiffness * (reference / h)^2`, so its bending, and the look, do not change with
     /// the resolution. Default 0 (`FC_PRESET_UNDERWATER`: 0.01, see docs/underwater.md).
     pub bend_reference_spacing: f64,
+    /// Added mass of the cloth's large-scale normal motion, kg/m^2 per unit area (>= 0; 0 =
+    /// off, the default): motion smoother than `coarse_length` carries this much more water
+    /// than `added_mass` alone, ripples shorter than it only `added_mass` (a scale-aware
+    /// inertia; a rigid plate of width W carries about `water_density * pi * W / 4` in all).
+    /// Costs a small solve a step and the tile-fused step. See docs/underwater.md.
+    pub coarse_added_mass: f64,
+    /// Spacing of the coarse level's patches over the rest shape, m (> 0 when
+    /// `coarse_added_mass` is on). Default 0.
+    pub coarse_length: f64,
 }
 
 /// Each ABI enumeration value beside the library's, once: [`FcClothDesc::config`] reads
@@ -365,6 +374,8 @@ impl FcClothDesc {
             added_mass_coefficient: model.water.added_mass_coefficient,
             form_drag_scale: model.water.form_drag_scale,
             bend_reference_spacing: model.bend_reference_spacing,
+            coarse_added_mass: model.water.coarse_added_mass,
+            coarse_length: model.water.coarse_length,
         }
     }
 
@@ -457,6 +468,8 @@ impl FcClothDesc {
                     viscous_drag: self.viscous_drag_per_area,
                     history_drag: self.history_drag_per_area,
                     normal_drag: self.normal_drag_per_area,
+                    coarse_added_mass: self.coarse_added_mass,
+                    coarse_length: self.coarse_length,
                 },
             },
             scheme,

@@ -104,15 +104,12 @@ mod tests {
     fn a_short_struct_reads_its_fields_and_defaults_the_rest() {
         let mut host = fc_cloth_desc_default();
         host.width = 7;
-        host.bend_reference_spacing = 0.5; // the last field: beyond a host 8 bytes shorter
+        host.coarse_length = 0.5; // the last field: beyond a host 8 bytes shorter
         host.struct_size = (DESC_SIZE - 8) as u32;
         // SAFETY: a whole struct is readable.
         let d = unsafe { read_desc(&host, fc_cloth_desc_default()) }.expect("accepted");
         assert_eq!(d.width, 7);
-        assert_eq!(
-            d.bend_reference_spacing,
-            fc_cloth_desc_default().bend_reference_spacing
-        );
+        assert_eq!(d.coarse_length, fc_cloth_desc_default().coarse_length);
         assert_eq!(d.struct_size as usize, DESC_SIZE);
     }
 

@@ -43,7 +43,7 @@ pub struct Inertia {
 
 /// Whether the model carries any water (so that the mass matrix differs from `m I`).
 pub fn carries_water(m: &Model) -> bool {
-    m.water.added_mass != 0.0 || m.water.entrained_mass != 0.0
+    m.water.normal_water() || m.water.entrained_mass != 0.0
 }
 
 impl Inertia {
@@ -205,9 +205,10 @@ pub fn turning_forces(
     projected: &mut [f64],
     normals: &mut [Vec3],
     out: &mut [Vec3],
+    coarse: Option<&mut super::coarse_water::CoarseWater>,
 ) {
     let ma = m.water.added_mass;
-    if ma == 0.0 {
+    if ma == 0.0 && coarse.is_none() {
         return;
     }
     // Faces, vertices and faces again; both paths give every vertex the same terms in the same
@@ -217,12 +218,12 @@ pub fn turning_forces(
     // 8.12 G (the pool's path before the wavefront), at 201 x 201 the turning forces 1.69 G
     // against 1.47 G, and no faster at 1001 x 1001.)
     let n = x.len();
-    if parallel::worth_it(n) {
+    if parallel::worth_it(n) && coarse.is_none() {
         // Four chunks a thread, so that the pool can even out uneven chunks.
         let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
         turning_chunked(ma, t, x, v, scratch, chunk, true, projected, normals, out);
     } else {
-        turning_serial(ma, t, x, v, scratch, projected, normals, out);
+        turning_serial(ma, t, x, v, scratch, projected, normals, out, coarse);
     }
 }
 
@@ -242,6 +243,7 @@ fn turning_serial(
     projected: &mut [f64],
     normals: &mut [Vec3],
     out: &mut [Vec3],
+    coarse: Option<&mut super::coarse_water::CoarseWater>,
 ) {
     let (areas, triangles) = (&t.areas, &t.triangles);
     let n = x.len();
@@ -273,6 +275,10 @@ fn turning_serial(
             &mut normals[i],
         )
     }));
+    if let Some(c) = coarse {
+        let ps = &t.patch_scale;
+        c.add_turning(|i| (ps[i] * sums[i], ps[i] * rates[i], ps[i]), v, out, patches);
+    }
     // W of every face and its gradients at its corners, added to the corners' forces.
     for tri in triangles {
         let [gb, gc] = face_gradients(x, patches, tri);
@@ -699,7 +705,17 @@ mod tests {
         let mut s = TurningScratch::default();
         let mut projected = vec![0.0; x.len()];
         let mut normals = vec![Vec3::zeros(); x.len()];
-        turning_forces(&m, &t, &x, &v, &mut s, &mut projected, &mut normals, &mut got);
+        turning_forces(
+            &m,
+            &t,
+            &x,
+            &v,
+            &mut s,
+            &mut projected,
+            &mut normals,
+            &mut got,
+            None,
+        );
         // The normals are the force pass's, bit for bit (it reads these instead).
         let mut want_normals = vec![Vec3::zeros(); x.len()];
         crate::forces::normals::vertex_normals(&x, &t.triangles, &mut want_normals);
@@ -752,6 +768,7 @@ mod tests {
             &mut projected,
             &mut normals,
             &mut none,
+            None,
         );
         assert!(none.iter().all(|f| *f == Vec3::zeros()));
     }
@@ -813,7 +830,7 @@ mod tests {
                 for _ in 0..2 {
                     out.clone_from(&prior);
                     match chunk {
-                        None => turning_serial(8.0, &t, &x, &v, &mut s, &mut p, &mut nr, &mut out),
+                        None => turning_serial(8.0, &t, &x, &v, &mut s, &mut p, &mut nr, &mut out, None),
                         Some((c, par)) => {
                             turning_chunked(8.0, &t, &x, &v, &mut s, c, par, &mut p, &mut nr, &mut out)
                         }

@@ -18,6 +18,7 @@
 
 mod assemble;
 mod body;
+pub(crate) mod coarse_water;
 mod contact;
 mod drag;
 mod elements;

@@ -16,6 +16,7 @@ use nalgebra::Matrix3;
 use super::cg::{self, CgScratch, SolverSettings, SolverStats};
 use crate::collide::{contact, Contact};
 use crate::forces::add_spring_values;
+use crate::forces::coarse_water::CoarseWater;
 use crate::forces::{Linearisation, SpringBlock};
 use crate::math::Vec3;
 use crate::parallel;
@@ -52,6 +53,9 @@ pub struct ImplicitInput<'a> {
     pub contacts: &'a [Contact],
     pub contact_stiffness: f64,
     pub contact_damping: f64,
+    /// The carried water's coarse level with the step's unit normals and projected-area
+    /// ratios (`forces::coarse_water`), when the model has one: its `W'^T K W'` joins `M`.
+    pub coarse: Option<(&'a CoarseWater, &'a [Vec3], &'a [f64])>,
 }
 
 /// Writes `out[k] = blocks[k] (p_i - p_j)` for every spring k.
@@ -95,6 +99,9 @@ fn apply_system(
         }
         add_spring_values(inp.topology, first, values, -1.0, chunk);
     });
+    if let Some((coarse, normals, projected)) = inp.coarse {
+        coarse.add_product(normals, projected, p, out);
+    }
     contact::add_system_product(inp.contacts, contact_weights, p, out);
 }
 

@@ -51,6 +51,8 @@ DESC_FIELDS = [
     ('self_collision_friction', ctypes.c_double, 'Coulomb friction coefficient of the cloth against itself (>= 0). Default 0.'),
     ('form_drag_scale', ctypes.c_double, "Length over which the form drag smooths the normal velocity before it acts, m (>= 0; 0 = each particle's own). Ripples much shorter than it shed little drag, so a brisk swing keeps its short bumps while the sheet's motion at large is damped in full. Default 0 (`FC_PRESET_UNDERWATER`: see docs/underwater.md)."),
     ('bend_reference_spacing', ctypes.c_double, "Spacing at which `bend_stiffness` holds, m (>= 0; 0 = the paper's spring constant at any spacing). With a reference, a cloth of spacing h (a grid's `spacing`; for a mesh the side of a square of two of its triangles' mean area) takes `bend_stiffness * (reference / h)^2`, so its bending, and the look, do not change with the resolution. Default 0 (`FC_PRESET_UNDERWATER`: 0.01, see docs/underwater.md)."),
+    ('coarse_added_mass', ctypes.c_double, "Added mass of the cloth's large-scale normal motion, kg/m^2 per unit area (>= 0; 0 = off, the default): motion smoother than `coarse_length` carries this much more water than `added_mass` alone, ripples shorter than it only `added_mass` (a scale-aware inertia; a rigid plate of width W carries about `water_density * pi * W / 4` in all). Costs a small solve a step and the tile-fused step. See docs/underwater.md."),
+    ('coarse_length', ctypes.c_double, "Spacing of the coarse level's patches over the rest shape, m (> 0 when `coarse_added_mass` is on). Default 0."),
 ]
 
 # Every FC_* enum value of the header.
