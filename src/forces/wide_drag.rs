@@ -60,6 +60,13 @@ const LANES: usize = 8;
 /// matrix then shrinks from 84 bytes a row to four, which is what a pass streamed from memory
 /// once the cloth leaves the cache (`docs/benchmarks.md`). Same entries in the same order: the
 /// same bits.
+///
+/// **Windowed blocks.** A stored block whose rows' columns all lie within a few offsets of their
+/// rows (the union of its rows' offsets, at most [`MAX_WINDOW`]: an irregular mesh numbered in
+/// rows, such as a grid with random diagonals) reads `u` as plain slices at those offsets, as a
+/// shifted block does, with a weight per lane ([`ABSENT`] where the lane's row has no entry):
+/// no column loads, no gathers. The offsets ascend, so each lane meets its row's entries in the
+/// row's order: the same bits.
 #[derive(Clone, Debug, Default)]
 struct Blocks {
     /// Rows.
@@ -71,7 +78,22 @@ struct Blocks {
     shape: Vec<u32>,
     /// The distinct shapes of shifted blocks.
     shapes: Vec<Shape>,
+    /// Per stored block: the index of its window in `windows`, or [`STORED`] when its lanes
+    /// gather their columns.
+    window: Vec<u32>,
+    /// The distinct windows of windowed blocks.
+    windows: Vec<Vec<isize>>,
 }
+
+/// Most column offsets a windowed block may read a lane: a 3 x 3 neighbourhood of a mesh
+/// numbered in rows (the nine offsets of a grid-like mesh with random diagonals), and some.
+const MAX_WINDOW: usize = 12;
+
+/// A windowed block's weight for an offset its lane's row has no entry at: 0, which no weight
+/// of a windowed block's rows is (a block with a zero weight, from a face of no area, stays
+/// stored), so the lane adds `-0.0` there (no change to any sum, a zero's sign included)
+/// whatever it reads.
+const ABSENT: f64 = 0.0;
 
 /// [`Blocks::shape`] of a block whose entries are stored.
 const STORED: u32 = u32::MAX;
@@ -130,12 +152,36 @@ impl Blocks {
                     }
                 };
                 b.shape.push(k as u32);
+                b.window.push(STORED);
                 b.starts.push((b.cols.len() / LANES) as u32);
                 continue;
             }
             b.shape.push(STORED);
-            let width = rows.clone().map(|i| row(i).len()).max().unwrap_or(0);
             let at = b.cols.len();
+            if let Some(offsets) = Self::window_of(s, rows.clone()) {
+                // One entry a lane per offset, ABSENT where the lane's row has none there.
+                let k = match b.windows.iter().position(|w| *w == offsets) {
+                    Some(k) => k,
+                    None => {
+                        b.windows.push(offsets.clone());
+                        b.windows.len() - 1
+                    }
+                };
+                b.window.push(k as u32);
+                b.cols.resize(at + offsets.len() * LANES, n as u32);
+                b.weights.resize(at + offsets.len() * LANES, ABSENT);
+                for i in rows {
+                    for e in row(i) {
+                        let d = s.cols[e] as isize - i as isize;
+                        let k = offsets.iter().position(|&o| o == d).expect("in the window");
+                        b.weights[at + k * LANES + i - first] = s.weights[e];
+                    }
+                }
+                b.starts.push((b.cols.len() / LANES) as u32);
+                continue;
+            }
+            b.window.push(STORED);
+            let width = rows.clone().map(|i| row(i).len()).max().unwrap_or(0);
             b.cols.resize(at + width * LANES, n as u32);
             b.weights.resize(at + width * LANES, 0.0);
             for i in rows {
@@ -149,6 +195,36 @@ impl Blocks {
         b.cols.shrink_to_fit();
         b.weights.shrink_to_fit();
         b
+    }
+}
+
+impl Blocks {
+    /// The ascending column offsets rows `rows` of `s` read, if they make a window: a full
+    /// block, at most [`MAX_WINDOW`] offsets, every lane's slice at every offset inside the
+    /// rows (`0 ..= n - LANES`), and no weight of 0 ([`ABSENT`]).
+    fn window_of(s: &Stencil, rows: std::ops::Range<usize>) -> Option<Vec<isize>> {
+        let n = s.offsets.len().saturating_sub(1);
+        if rows.len() != LANES {
+            return None;
+        }
+        let first = rows.start;
+        let mut offsets: Vec<isize> = Vec::new();
+        for i in rows {
+            for e in s.offsets[i] as usize..s.offsets[i + 1] as usize {
+                if s.weights[e] == 0.0 {
+                    return None;
+                }
+                let d = s.cols[e] as isize - i as isize;
+                if let Err(k) = offsets.binary_search(&d) {
+                    offsets.insert(k, d);
+                }
+            }
+        }
+        let inside = |d: &isize| {
+            let at = first as isize + d;
+            at >= 0 && at as usize + LANES <= n
+        };
+        (offsets.len() <= MAX_WINDOW && offsets.iter().all(inside)).then_some(offsets)
     }
 }
 
@@ -178,8 +254,36 @@ fn apply_blocks(b: &Blocks, first: usize, u: &[f64], out: &mut [f64]) {
             continue;
         }
         let (lo, hi) = (b.starts[block] as usize, b.starts[block + 1] as usize);
-        let cols = &b.cols[lo * LANES..hi * LANES];
         let weights = &b.weights[lo * LANES..hi * LANES];
+        if let Some(window) = b.windows.get(b.window[block] as usize) {
+            // A windowed block (full, every slice inside the rows): plain slices, a weight a
+            // lane. An ABSENT weight adds `0 x u = +-0`, which leaves every sum as the row's
+            // own unless that sum is zero (a -0.0 may come out +0.0): a lane that sums to zero
+            // is summed again over its own entries (rare: a field that vanishes on a row).
+            let row0 = first + k * LANES;
+            let mut acc = [-0.0f64; LANES];
+            for (&d, w) in window.iter().zip(weights.chunks_exact(LANES)) {
+                let at = row0.wrapping_add_signed(d);
+                let v: &[f64; LANES] = u[at..at + LANES].try_into().expect("a block's columns");
+                let w: &[f64; LANES] = w.try_into().expect("a lane's entries");
+                for l in 0..LANES {
+                    acc[l] += w[l] * v[l];
+                }
+            }
+            if acc.contains(&0.0) {
+                for (l, a) in acc.iter_mut().enumerate().filter(|(_, a)| **a == 0.0) {
+                    *a = window
+                        .iter()
+                        .zip(weights.chunks_exact(LANES))
+                        .filter(|(_, w)| w[l] != ABSENT)
+                        .map(|(&d, w)| w[l] * u[(row0 + l).wrapping_add_signed(d)])
+                        .fold(-0.0, |s, t| s + t);
+                }
+            }
+            o.copy_from_slice(&acc);
+            continue;
+        }
+        let cols = &b.cols[lo * LANES..hi * LANES];
         // Each lane's sum starts as an iterator's sum of f64 does (-0.0), so the first entry
         // comes through exactly.
         let mut acc = [-0.0f64; LANES];
@@ -513,12 +617,51 @@ mod tests {
         .expect("a fan")
     }
 
-    /// The blocked rows give the bits of the rows summed one by one, on a grid (rows of 7) and
-    /// on a fan whose centre has 14 entries beside rows of 4-6, for any values (signed zeros
-    /// too).
+    /// A `w x h` grid of 1 cm numbered in rows, its cells split along random diagonals and its
+    /// inner vertices moved up to 15 % of the spacing: rows of 4 to 9 entries within a 3 x 3
+    /// neighbourhood, no two alike (the scenes' jittered mesh).
+    fn jittered(w: u32, h: u32) -> Topology {
+        use crate::topology::{MeshMass, MeshSpec};
+        let mut r = crate::testing::numbers(11);
+        let positions: Vec<Vec3> = (0..w * h)
+            .map(|k| {
+                let (i, j) = (k % w, k / w);
+                let inner = i > 0 && j > 0 && i + 1 < w && j + 1 < h;
+                let jitter = if inner {
+                    0.0015 * Vec3::new(r(), r(), 0.0)
+                } else {
+                    Vec3::zeros()
+                };
+                Vec3::new(0.01 * f64::from(i), 0.01 * f64::from(j), 0.0) + jitter
+            })
+            .collect();
+        let mut indices = Vec::new();
+        for j in 0..h - 1 {
+            for i in 0..w - 1 {
+                let (a, b, c, d) = (j * w + i, j * w + i + 1, (j + 1) * w + i + 1, (j + 1) * w + i);
+                if r() < 0.0 {
+                    indices.extend([a, d, b, b, d, c]);
+                } else {
+                    indices.extend([a, d, c, a, c, b]);
+                }
+            }
+        }
+        MeshSpec {
+            positions: &positions,
+            indices: &indices,
+            face_size: 3,
+            mass: MeshMass::Total(0.01),
+        }
+        .build()
+        .expect("a jittered mesh")
+    }
+
+    /// The blocked rows give the bits of the rows summed one by one, on a grid (rows of 7), on
+    /// a fan whose centre has 14 entries beside rows of 4-6, and on a jittered mesh (windowed
+    /// blocks), for any values (signed zeros too, and rows that sum to zero).
     #[test]
     fn blocked_rows_give_the_bits_of_the_rows() {
-        for t in [grid(13, 9, 0.01), fan()] {
+        for t in [grid(13, 9, 0.01), fan(), jittered(17, 11)] {
             let s = one_pass(&t);
             let blocks = Blocks::new(&s);
             let n = t.vertex_count();
@@ -530,7 +673,18 @@ mod tests {
             mixed[2] = 0.0;
             let mut zeros = vec![-0.0; n];
             zeros[0] = 1.0;
-            for u in [mixed, zeros] {
+            // Ones but -0.0 on one row's entries: that row sums to -0.0 while a window around it
+            // reads ones where the row has no entry (on a windowed block's row, if any).
+            let mut hole = vec![1.0; n];
+            let row = blocks
+                .window
+                .iter()
+                .position(|&k| k != STORED)
+                .map_or(0, |b| b * LANES + 3);
+            for e in s.offsets[row] as usize..s.offsets[row + 1] as usize {
+                hole[s.cols[e] as usize] = -0.0;
+            }
+            for u in [mixed, zeros, hole] {
                 let mut padded = u.clone();
                 padded.resize((n + 1).next_power_of_two(), -0.0);
                 let (mut by_rows, mut by_blocks) = (vec![0.0; n], vec![0.0; n]);
@@ -544,10 +698,19 @@ mod tests {
                 "blocks of mixed widths: {widths:?}"
             );
             // The grid's interior blocks are shifted rows (one shape), the rest stored; the fan
-            // has no shifted block.
+            // has no shifted block; the jittered mesh's blocks away from its first and last rows
+            // are windowed, none shifted.
             let shifted = blocks.shape.iter().filter(|&&k| k != STORED).count();
+            let windowed = blocks.window.iter().filter(|&&k| k != STORED).count();
             let expected = if n == 13 * 9 { (4, 1) } else { (0, 0) };
             assert_eq!((shifted, blocks.shapes.len()), expected);
+            if n == 17 * 11 {
+                assert!(
+                    windowed >= 18,
+                    "{windowed} of {} blocks windowed",
+                    blocks.window.len()
+                );
+            }
         }
     }
 
