@@ -432,7 +432,9 @@ typedef struct {
   double coarse_added_mass;
   /**
    * Spacing of the coarse level's patches over the rest shape, m (> 0 when
-   * `coarse_added_mass` is on). Default 0.
+   * `coarse_added_mass` is on): at most this far apart along the rest shape's two principal
+   * directions, at most 256 patches (a shorter length is refused with
+   * `FC_ERROR_INVALID_ARGUMENT`, the message naming one that fits). Default 0.
    */
   double coarse_length;
 } FcClothDesc;

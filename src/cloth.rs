@@ -196,6 +196,7 @@ impl Cloth {
             (n as u64).saturating_mul(crate::memory::STATE_BYTES_PER_PARTICLE + 2 * history_bytes),
             &format!("a cloth of {n} particles"),
         )?;
+        forces::coarse_water::check(&topology, &config.model)?;
         let mut self_collision = SelfCollision::new(&topology.triangles);
         self_collision.prepare(
             &topology.rest_positions,
@@ -253,6 +254,7 @@ impl Cloth {
                 "the model's fractional terms (history drag, fractional springs) must be on or off as when the cloth was created: the history it keeps was sized then; create a new cloth, or set a coefficient to a tiny value instead of 0",
             ));
         }
+        forces::coarse_water::check(&self.topology, &config.model)?;
         let thickness = config.model.self_collision_thickness;
         let old_thickness = old.model.self_collision_thickness;
         self.self_collision

@@ -128,7 +128,8 @@ pub struct Water {
     pub coarse_added_mass: f64,
     /// The coarse level's patch spacing over the rest shape, m (> 0 when
     /// [`Water::coarse_added_mass`] is on): bilinear patches this far apart in the rest shape's
-    /// plane each average the normal velocity of their vertices.
+    /// plane each average the normal velocity of their vertices; at most
+    /// 256 of them (a shorter length is refused).
     pub coarse_length: f64,
 }
 

@@ -270,6 +270,59 @@ fn a_free_cloth_with_coarse_added_mass_does_not_gain_energy() {
 }
 
 #[test]
+fn a_coarse_length_too_short_for_the_cloth_is_refused_with_one_that_works() {
+    // The coarse level's matrix is dense and factored every step: at most 256 patches. On the
+    // 0.1 m plate, 1 mm makes 100 x 100 cells; the message names a length that fits, which is
+    // accepted, and a refused reconfigure leaves the cloth as it was.
+    let water = |length: f64| Water {
+        added_mass: 5.0,
+        coarse_added_mass: 10.0,
+        coarse_length: length,
+        ..Water::default()
+    };
+    let make = |w: Water| {
+        let mut model = Model::underwater();
+        model.water = w;
+        let grid = GridSpec {
+            width: 11,
+            height: 11,
+            spacing: SIDE / 10.0,
+            total_mass: MU * SIDE * SIDE,
+        }
+        .build()
+        .unwrap();
+        Cloth::new(
+            grid,
+            ClothConfig {
+                model,
+                ..ClothConfig::default()
+            },
+        )
+    };
+    let Err(err) = make(water(1e-3)) else {
+        panic!("a 1 mm coarse length on a 0.1 m plate was accepted")
+    };
+    let msg = err.to_string();
+    println!("{msg}");
+    assert!(msg.contains("at most 256 patches"), "{msg}");
+    let suggested: f64 = msg
+        .rsplit("at least ")
+        .next()
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .expect("a suggested length");
+    let mut c = make(water(suggested)).expect("the suggested length is accepted");
+    c.step(1e-4).unwrap();
+    // A zero length with coarse water on is refused too; a refused reconfigure changes nothing.
+    assert!(make(water(0.0)).is_err());
+    let before = c.config().clone();
+    let mut bad = before.clone();
+    bad.model.water.coarse_length = 1e-4;
+    assert!(c.reconfigure(bad).is_err());
+    assert_eq!(c.config().model, before.model);
+}
+
+#[test]
 fn coarse_added_mass_slows_a_whole_plate_face_first_and_not_edgewise() {
     // A flat plate pushed by a uniform force per area moves rigidly: its coarse water adds
     // exactly `coarse_added_mass` per area (the patches are a partition of unity), so every

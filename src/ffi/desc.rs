@@ -230,7 +230,9 @@ pub struct FcClothDesc {
     /// Costs a small solve a step and the tile-fused step. See docs/underwater.md.
     pub coarse_added_mass: f64,
     /// Spacing of the coarse level's patches over the rest shape, m (> 0 when
-    /// `coarse_added_mass` is on). Default 0.
+    /// `coarse_added_mass` is on): at most this far apart along the rest shape's two principal
+    /// directions, at most 256 patches (a shorter length is refused with
+    /// `FC_ERROR_INVALID_ARGUMENT`, the message naming one that fits). Default 0.
     pub coarse_length: f64,
 }
 

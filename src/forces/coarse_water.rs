@@ -44,16 +44,26 @@ pub struct CoarseWater {
     sums2: Vec<f64>,
 }
 
-impl CoarseWater {
-    /// The coarse level of `t` with `mass` kg/m^2 carried by motion smoother than `length` m:
-    /// the fewest cells no longer than `length` along each of the rest shape's two principal
-    /// directions, a hat on every grid node.
-    ///
-    /// # Errors
-    /// `OutOfMemory` when the weights (48 bytes a vertex) cannot be allocated.
-    pub fn new(t: &Topology, mass: f64, length: f64, pinned: &[bool]) -> Result<CoarseWater, Error> {
-        let n = t.rest_positions.len();
+/// Most patches a coarse level may have: its patches-by-patches matrix is dense and factored
+/// every step (256: 0.5 MB and about 6 M flops).
+pub const MAX_PATCHES: usize = 256;
+
+/// Where the patches lie: the rest shape's coordinates in its two principal directions, and
+/// the fewest cells no longer than the coarse length along each (a hat on every node).
+struct PatchGrid {
+    /// Each vertex's coordinates, m.
+    uv: Vec<(f64, f64)>,
+    /// The lowest coordinates.
+    lo: (f64, f64),
+    cells: (usize, usize),
+    /// The cells' sides, m.
+    step: (f64, f64),
+}
+
+impl PatchGrid {
+    fn of(t: &Topology, length: f64) -> Result<PatchGrid, Error> {
         let x = &t.rest_positions;
+        let n = x.len();
         let centre: Vec3 = x.iter().sum::<Vec3>() / n.max(1) as f64;
         let mut cov = nalgebra::Matrix3::zeros();
         for p in x {
@@ -67,21 +77,71 @@ impl CoarseWater {
             eig.eigenvectors.column(order[0]).into(),
             eig.eigenvectors.column(order[1]).into(),
         );
-        let uv: Vec<(f64, f64)> = x
-            .iter()
-            .map(|p| ((p - centre).dot(&e1), (p - centre).dot(&e2)))
-            .collect();
+        let mut uv = Vec::new();
+        uv.try_reserve_exact(n).map_err(|e| {
+            Error::out_of_memory(format!(
+                "the coarse water's patch coordinates for {n} vertices: {e}"
+            ))
+        })?;
+        uv.extend(x.iter().map(|p| ((p - centre).dot(&e1), (p - centre).dot(&e2))));
         let lo = uv
             .iter()
             .fold((f64::MAX, f64::MAX), |a, b| (a.0.min(b.0), a.1.min(b.1)));
         let hi = uv
             .iter()
             .fold((f64::MIN, f64::MIN), |a, b| (a.0.max(b.0), a.1.max(b.1)));
+        let span = if n == 0 {
+            (0.0, 0.0)
+        } else {
+            (hi.0 - lo.0, hi.1 - lo.1)
+        };
         // Patches at most `length` apart (a rounding's worth of slack, so that a span of exactly
-        // two lengths takes two cells).
+        // two lengths takes two cells); `as` saturates a huge count.
         let cells = |span: f64| ((span / length * (1.0 - 1e-9)).ceil() as usize).max(1);
-        let (cu, cv) = (cells(hi.0 - lo.0), cells(hi.1 - lo.1));
-        let (du, dv) = ((hi.0 - lo.0) / cu as f64, (hi.1 - lo.1) / cv as f64);
+        let (cu, cv) = (cells(span.0), cells(span.1));
+        let patches = cu.saturating_add(1).saturating_mul(cv.saturating_add(1));
+        if patches > MAX_PATCHES {
+            // The fewest cells a side that fit: about sqrt(MAX_PATCHES) over the longer span.
+            // Rounded up to the millimetre it is printed with.
+            let shortest = (span.0.max(span.1) / ((MAX_PATCHES as f64).sqrt() - 1.0) * 1e3).ceil() / 1e3;
+            return Err(Error::invalid(format!(
+                "coarse_length {length} m makes {cu} x {cv} cells ({patches} patches) over this cloth ({:.3} x {:.3} m); at most {MAX_PATCHES} patches: use a coarse_length of at least {shortest:.3} m",
+                span.0, span.1
+            )));
+        }
+        Ok(PatchGrid {
+            uv,
+            lo,
+            cells: (cu, cv),
+            step: (span.0 / cu as f64, span.1 / cv as f64),
+        })
+    }
+}
+
+/// Checks that `model`'s coarse water (if any) fits cloth `t` ([`MAX_PATCHES`]), so that a
+/// cloth is refused when it is made or reconfigured, not at its first step.
+pub fn check(t: &Topology, model: &Model) -> Result<(), Error> {
+    if model.water.coarse_added_mass > 0.0 {
+        PatchGrid::of(t, model.water.coarse_length)?;
+    }
+    Ok(())
+}
+
+impl CoarseWater {
+    /// The coarse level of `t` with `mass` kg/m^2 carried by motion smoother than `length` m
+    /// ([`PatchGrid`]).
+    ///
+    /// # Errors
+    /// `InvalidArgument` when `length` makes more than [`MAX_PATCHES`] patches over the cloth;
+    /// `OutOfMemory` when the weights (48 bytes a vertex) cannot be allocated.
+    pub fn new(t: &Topology, mass: f64, length: f64, pinned: &[bool]) -> Result<CoarseWater, Error> {
+        let n = t.rest_positions.len();
+        let PatchGrid {
+            uv,
+            lo,
+            cells: (cu, cv),
+            step: (du, dv),
+        } = PatchGrid::of(t, length)?;
         let nodes_u = cu + 1;
         let room = |e: std::collections::TryReserveError| {
             Error::out_of_memory(format!("the coarse water's weights for {n} vertices: {e}"))
