@@ -118,29 +118,39 @@ fn added_mass_slows_the_start_of_a_face_first_fall_and_not_an_edgewise_one() {
         added_mass: 20.0,
         ..Water::default()
     };
-    let h = 1e-4;
     for integrator in [Integrator::SymplecticEuler, Integrator::ImplicitEuler] {
-        let mut face = plate(10, Vec3::new(0.0, 0.0, -9.81), water, integrator);
-        face.step(h).unwrap();
-        let t = face.topology().clone();
-        for i in 0..face.vertex_count() {
-            let a = -face.velocities()[i].z / h;
-            let want = g_eff() * t.masses[i] / (t.masses[i] + 20.0 * t.areas[i]);
+        first_steps_accelerate(water, integrator, |t, i| {
             assert!((t.masses[i] - MU * t.areas[i]).abs() < 1e-15);
-            assert!(
-                (a - want).abs() < 1e-6 * want,
-                "{integrator:?} face-first {i}: {a} vs {want}"
-            );
-        }
-        let mut edge = plate(10, Vec3::new(0.0, -9.81, 0.0), water, integrator);
-        edge.step(h).unwrap();
-        let a = -mean_velocity(&edge).y / h;
+            g_eff() * t.masses[i] / (t.masses[i] + 20.0 * t.areas[i])
+        });
+    }
+}
+
+/// Steps a plate in `water` once from rest, face first and edgewise, and checks each particle's
+/// face-first acceleration against `want(topology, i)` and the edgewise one against g' (1e-6).
+fn first_steps_accelerate(
+    water: Water,
+    integrator: Integrator,
+    want: impl Fn(&fraccloth::Topology, usize) -> f64,
+) {
+    let h = 1e-4;
+    let mut face = plate(10, Vec3::new(0.0, 0.0, -9.81), water, integrator);
+    face.step(h).unwrap();
+    for (i, v) in face.velocities().iter().enumerate() {
+        let (a, want) = (-v.z / h, want(face.topology(), i));
         assert!(
-            (a - g_eff()).abs() < 1e-6 * g_eff(),
-            "{integrator:?} edgewise {a} vs {}",
-            g_eff()
+            (a - want).abs() < 1e-6 * want,
+            "{integrator:?} face-first {i}: {a} vs {want}"
         );
     }
+    let mut edge = plate(10, Vec3::new(0.0, -9.81, 0.0), water, integrator);
+    edge.step(h).unwrap();
+    let a = -mean_velocity(&edge).y / h;
+    assert!(
+        (a - g_eff()).abs() < 1e-6 * g_eff(),
+        "{integrator:?} edgewise {a} vs {}",
+        g_eff()
+    );
 }
 
 #[test]
@@ -222,15 +232,25 @@ fn crumpled_plate_in(integrator: Integrator, water: Water) -> (Cloth, Vec<Vec3>)
     (c, x)
 }
 
-/// The worst and last energy over 10 s of a crumpled free plate in `water`, against its start,
-/// and how far it moved.
-fn free_energy(integrator: Integrator, dt: f64, water: Water) -> (f64, f64, f64, f64) {
+/// Energy over 10 s of a crumpled free plate in `water`: at the start, least, most, at the
+/// end (J), and how far it moved (m).
+struct FreeEnergy {
+    start: f64,
+    least: f64,
+    worst: f64,
+    end: f64,
+    moved: f64,
+}
+
+fn free_energy(integrator: Integrator, dt: f64, water: Water) -> FreeEnergy {
     let (mut c, x) = crumpled_plate_in(integrator, water);
-    let e0 = c.energy();
-    let mut worst = e0;
+    let start = c.energy();
+    let (mut least, mut worst) = (start, start);
     for _ in 0..(10.0 / dt) as usize {
         c.step(dt).unwrap();
-        worst = worst.max(c.energy());
+        let e = c.energy();
+        worst = worst.max(e);
+        least = least.min(e);
     }
     let moved = c
         .positions()
@@ -238,7 +258,13 @@ fn free_energy(integrator: Integrator, dt: f64, water: Water) -> (f64, f64, f64,
         .zip(&x)
         .map(|(a, b)| (a - b).norm())
         .fold(0.0, f64::max);
-    (e0, worst, c.energy(), moved)
+    FreeEnergy {
+        start,
+        least,
+        worst,
+        end: c.energy(),
+        moved,
+    }
 }
 
 #[test]
@@ -257,7 +283,13 @@ fn a_free_cloth_with_coarse_added_mass_does_not_gain_energy() {
         (Integrator::SymplecticEuler, 1e-4),
         (Integrator::ImplicitEuler, 1e-3),
     ] {
-        let (e0, worst, end, moved) = free_energy(integrator, dt, water);
+        let FreeEnergy {
+            start: e0,
+            worst,
+            end,
+            moved,
+            ..
+        } = free_energy(integrator, dt, water);
         println!("{integrator:?} dt {dt}, coarse water: energy {e0:.4e} J at the start, at most {worst:.4e}, {end:.4e} at the end; moved {moved:.4} m");
         assert!(
             worst <= e0 * 1.02,
@@ -334,26 +366,8 @@ fn coarse_added_mass_slows_a_whole_plate_face_first_and_not_edgewise() {
         coarse_length: 0.04,
         ..Water::default()
     };
-    let h = 1e-4;
     for integrator in [Integrator::SymplecticEuler, Integrator::ImplicitEuler] {
-        let mut face = plate(10, Vec3::new(0.0, 0.0, -9.81), water, integrator);
-        face.step(h).unwrap();
-        let want = g_eff() * MU / (MU + ma + mc);
-        for (i, v) in face.velocities().iter().enumerate() {
-            let a = -v.z / h;
-            assert!(
-                (a - want).abs() < 1e-6 * want,
-                "{integrator:?} face-first {i}: {a} vs {want}"
-            );
-        }
-        let mut edge = plate(10, Vec3::new(0.0, -9.81, 0.0), water, integrator);
-        edge.step(h).unwrap();
-        let a = -mean_velocity(&edge).y / h;
-        assert!(
-            (a - g_eff()).abs() < 1e-6 * g_eff(),
-            "{integrator:?} edgewise {a} vs {}",
-            g_eff()
-        );
+        first_steps_accelerate(water, integrator, |_, _| g_eff() * MU / (MU + ma + mc));
     }
 }
 
@@ -368,31 +382,25 @@ fn a_free_cloth_with_strongly_anisotropic_added_mass_does_not_gain_energy() {
         (Integrator::SymplecticEuler, 1e-4),
         (Integrator::ImplicitEuler, 1e-3),
     ] {
-        let (mut c, x) = crumpled_plate(integrator);
-        let e0 = c.energy();
-        let (mut worst, mut least) = (e0, e0);
-        let steps = (10.0 / dt) as usize;
-        for _ in 0..steps {
-            c.step(dt).unwrap();
-            let e = c.energy();
-            worst = worst.max(e);
-            least = least.min(e);
-        }
+        let water = Water {
+            added_mass: 100.0 * MU,
+            ..Water::default()
+        };
+        let FreeEnergy {
+            start: e0,
+            least,
+            worst,
+            end,
+            moved,
+        } = free_energy(integrator, dt, water);
         println!(
-            "{integrator:?} dt {dt}: energy {e0:.4e} J at the start, {least:.4e} to {worst:.4e} over 10 s, {:.4e} at the end",
-            c.energy()
+            "{integrator:?} dt {dt}: energy {e0:.4e} J at the start, {least:.4e} to {worst:.4e} over 10 s, {end:.4e} at the end"
         );
         assert!(
             worst <= e0 * 1.02,
             "{integrator:?}: energy grew from {e0} to {worst}"
         );
         // And it moved: the test is not of a cloth at rest.
-        let moved = c
-            .positions()
-            .iter()
-            .zip(&x)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max);
         assert!(moved > 2e-3, "{integrator:?}: the cloth moved only {moved} m");
     }
 }

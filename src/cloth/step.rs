@@ -171,6 +171,23 @@ impl Rollback {
     }
 }
 
+/// What the force pass reads, from the cloth `$c` and its step scratch `$s` (borrowed apart,
+/// so that the pass may write the scratch's other buffers).
+macro_rules! force_input {
+    ($c:ident, $s:ident, $weights:expr) => {
+        ForceInput {
+            model: &$c.config.model,
+            topology: &$c.topology,
+            x: &$c.x,
+            v: &$s.v_step,
+            half_derivative: &$s.half,
+            colliders: &$c.colliders,
+            prior_forces: &$s.prior_forces,
+            weights: $weights,
+        }
+    };
+}
+
 impl Cloth {
     /// One step as `plan` says. Nothing is committed unless every pass succeeds.
     pub(super) fn advance(&mut self, plan: StepPlan) -> Result<(), Error> {
@@ -411,16 +428,7 @@ impl Cloth {
             return self.forces_coarse_and_explicit_step(h, weights, step);
         }
         let s = &mut self.scratch;
-        let input = ForceInput {
-            model: &self.config.model,
-            topology: &self.topology,
-            x: &self.x,
-            v: &s.v_step,
-            half_derivative: &s.half,
-            colliders: &self.colliders,
-            prior_forces: &s.prior_forces,
-            weights,
-        };
+        let input = force_input!(self, s, weights);
         let (masses, areas) = (&self.topology.masses, &self.topology.areas);
         let projected = &s.projected;
         let model = &self.config.model;
@@ -469,28 +477,26 @@ impl Cloth {
         all_sound.into_inner()
     }
 
-    /// The force pass into one array, the coarse water's Woodbury solve, then the explicit
-    /// step tile by tile.
-    fn forces_coarse_and_explicit_step(&mut self, h: f64, weights: Weights, step: StepSoa) -> bool {
+    /// The force pass into the one force array (`scratch.force_array`).
+    fn forces_into_array(&mut self, weights: Weights) {
         let n = self.vertex_count();
         let s = &mut self.scratch;
         s.force_array.resize(n, Vec3::zeros());
-        let input = ForceInput {
-            model: &self.config.model,
-            topology: &self.topology,
-            x: &self.x,
-            v: &s.v_step,
-            half_derivative: &s.half,
-            colliders: &self.colliders,
-            prior_forces: &s.prior_forces,
-            weights,
-        };
+        let input = force_input!(self, s, weights);
         forces::total_forces_with(
             &input,
             &mut s.force_pass,
             SpringInputs::Filled,
             &mut s.force_array,
         );
+    }
+
+    /// The force pass into one array, the coarse water's Woodbury solve, then the explicit
+    /// step tile by tile.
+    fn forces_coarse_and_explicit_step(&mut self, h: f64, weights: Weights, step: StepSoa) -> bool {
+        self.forces_into_array(weights);
+        let n = self.vertex_count();
+        let s = &mut self.scratch;
         let t = &self.topology;
         let Some(coarse) = s.coarse.as_mut() else {
             return false;
@@ -535,25 +541,10 @@ impl Cloth {
     /// when the solver stops above its tolerance (unless accepted). The result is checked by
     /// [`Self::check`], so this returns false (not checked here).
     fn forces_and_implicit_step(&mut self, h: f64, weights: Weights) -> Result<bool, Error> {
+        self.forces_into_array(weights);
         let n = self.vertex_count();
         let s = &mut self.scratch;
-        s.force_array.resize(n, Vec3::zeros());
-        let input = ForceInput {
-            model: &self.config.model,
-            topology: &self.topology,
-            x: &self.x,
-            v: &s.v_step,
-            half_derivative: &s.half,
-            colliders: &self.colliders,
-            prior_forces: &s.prior_forces,
-            weights,
-        };
-        forces::total_forces_with(
-            &input,
-            &mut s.force_pass,
-            SpringInputs::Filled,
-            &mut s.force_array,
-        );
+        let input = force_input!(self, s, weights);
         forces::linearise(&input, s.force_pass.normals(), &s.projected, &mut s.implicit.lin);
         let inp = ImplicitInput {
             h,

@@ -340,28 +340,14 @@ impl CoarseWater {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::forces::{patch_normals, turning_forces, Inertia, TurningScratch};
+    use crate::forces::{patch_normals, Inertia};
     use crate::model::Model;
     use crate::topology::GridSpec;
 
     /// A crumpled, moving 6 x 5 patch, a model with normal added mass, and a coarse level of
     /// 3 x 2 patches carrying 40 kg/m^2.
     fn setup() -> (Topology, Vec<Vec3>, Vec<Vec3>, Model, CoarseWater) {
-        let t = GridSpec {
-            width: 6,
-            height: 5,
-            spacing: 0.1,
-            total_mass: 0.2,
-        }
-        .build()
-        .expect("a valid grid");
-        let mut r = crate::testing::numbers(5);
-        let x = t
-            .rest_positions
-            .iter()
-            .map(|p| p + 0.03 * Vec3::new(r(), r(), r()))
-            .collect();
-        let v = (0..t.vertex_count()).map(|_| Vec3::new(r(), r(), r())).collect();
+        let (t, x, v) = crate::testing::crumpled_grid(6, 5, 5);
         let mut m = Model::fractional();
         m.water.added_mass = 30.0;
         let c = CoarseWater::new(&t, 40.0, 0.25, &[]).expect("room");
@@ -450,44 +436,14 @@ mod tests {
     #[test]
     fn the_coarse_turning_forces_are_lagranges_terms() {
         let (t, x, v, m, mut c) = setup();
-        let n = x.len();
-        let mut got = vec![Vec3::zeros(); n];
-        let mut s = TurningScratch::default();
-        let (mut projected, mut normals) = (vec![0.0; n], vec![Vec3::zeros(); n]);
-        turning_forces(
-            &m,
-            &t,
+        let (got, _, _) = crate::forces::inertia::check::turning_of(&m, &t, &x, &v, Some(&mut c));
+        crate::forces::inertia::check::lagranges_terms(
+            &got,
             &x,
             &v,
-            &mut s,
-            &mut projected,
-            &mut normals,
-            &mut got,
-            Some(&mut c),
+            |y| energy_and_momentum(&t, &m, &c, y, &v).0,
+            |y, j| energy_and_momentum(&t, &m, &c, y, &v).1[j],
         );
-        let eps = 1e-6;
-        for j in 0..n {
-            let mut grad = Vec3::zeros();
-            for a in 0..3 {
-                let shifted = |s: f64| {
-                    let mut y = x.clone();
-                    y[j][a] += s * eps;
-                    energy_and_momentum(&t, &m, &c, &y, &v).0
-                };
-                grad[a] = (shifted(1.0) - shifted(-1.0)) / (2.0 * eps);
-            }
-            let m_v = |s: f64| {
-                let y: Vec<Vec3> = x.iter().zip(&v).map(|(x, v)| x + s * eps * v).collect();
-                energy_and_momentum(&t, &m, &c, &y, &v).1[j]
-            };
-            let want = grad - (m_v(1.0) - m_v(-1.0)) / (2.0 * eps);
-            assert!(
-                (got[j] - want).norm() < 1e-6 * (1.0 + want.norm()),
-                "particle {j}: {} against {}",
-                got[j],
-                want
-            );
-        }
     }
 
     #[test]

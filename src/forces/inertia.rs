@@ -653,28 +653,72 @@ fn corner_term(tri: &[u32; 3], i: usize, gb: Vec3, gc: Vec3) -> Vec3 {
     }
 }
 
+/// Test helpers shared with the coarse water's tests.
+#[cfg(test)]
+pub(crate) mod check {
+    use super::*;
+
+    /// The turning forces of `m` (and `coarse`) at `x`, `v`, with the projected-area ratios and
+    /// unit normals the pass writes.
+    pub(crate) fn turning_of(
+        m: &Model,
+        t: &Topology,
+        x: &[Vec3],
+        v: &[Vec3],
+        coarse: Option<&mut super::super::coarse_water::CoarseWater>,
+    ) -> (Vec<Vec3>, Vec<f64>, Vec<Vec3>) {
+        let n = x.len();
+        let (mut got, mut projected, mut normals) =
+            (vec![Vec3::zeros(); n], vec![0.0; n], vec![Vec3::zeros(); n]);
+        let mut s = TurningScratch::default();
+        turning_forces(m, t, x, v, &mut s, &mut projected, &mut normals, &mut got, coarse);
+        (got, projected, normals)
+    }
+
+    /// Asserts that `got` are Lagrange's terms `dT/dx - (dM/dt) v` at `x`, `v` (to 1e-6): `dT/dx`
+    /// by central differences of `energy(y)` (the water's kinetic energy at positions y and
+    /// velocity v), `(dM/dt) v` by central differences of `momentum(x + s v)[j]` in s (the
+    /// water's part of `M(y) v`).
+    pub(crate) fn lagranges_terms(
+        got: &[Vec3],
+        x: &[Vec3],
+        v: &[Vec3],
+        energy: impl Fn(&[Vec3]) -> f64,
+        momentum: impl Fn(&[Vec3], usize) -> Vec3,
+    ) {
+        let eps = 1e-6;
+        for j in 0..x.len() {
+            let mut grad = Vec3::zeros();
+            for a in 0..3 {
+                let shifted = |s: f64| {
+                    let mut y = x.to_vec();
+                    y[j][a] += s * eps;
+                    energy(&y)
+                };
+                grad[a] = (shifted(1.0) - shifted(-1.0)) / (2.0 * eps);
+            }
+            let m_v = |s: f64| {
+                let y: Vec<Vec3> = x.iter().zip(v).map(|(x, v)| x + s * eps * v).collect();
+                momentum(&y, j)
+            };
+            let want = grad - (m_v(1.0) - m_v(-1.0)) / (2.0 * eps);
+            assert!(
+                (got[j] - want).norm() < 1e-6 * (1.0 + want.norm()),
+                "particle {j}: {} against {}",
+                got[j],
+                want
+            );
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::topology::GridSpec;
 
     /// A crumpled, moving patch: positions, velocities, and a model with normal added mass.
     fn patch() -> (Topology, Vec<Vec3>, Vec<Vec3>, Model) {
-        let t = GridSpec {
-            width: 4,
-            height: 3,
-            spacing: 0.1,
-            total_mass: 0.2,
-        }
-        .build()
-        .expect("a valid grid");
-        let mut r = crate::testing::numbers(3);
-        let x = t
-            .rest_positions
-            .iter()
-            .map(|p| p + 0.03 * Vec3::new(r(), r(), r()))
-            .collect();
-        let v = (0..t.vertex_count()).map(|_| Vec3::new(r(), r(), r())).collect();
+        let (t, x, v) = crate::testing::crumpled_grid(4, 3, 3);
         let mut m = Model::fractional();
         m.water.added_mass = 30.0;
         (t, x, v, m)
@@ -701,21 +745,7 @@ mod tests {
     #[test]
     fn turning_forces_are_lagranges_terms() {
         let (t, x, v, m) = patch();
-        let mut got = vec![Vec3::zeros(); x.len()];
-        let mut s = TurningScratch::default();
-        let mut projected = vec![0.0; x.len()];
-        let mut normals = vec![Vec3::zeros(); x.len()];
-        turning_forces(
-            &m,
-            &t,
-            &x,
-            &v,
-            &mut s,
-            &mut projected,
-            &mut normals,
-            &mut got,
-            None,
-        );
+        let (got, projected, normals) = check::turning_of(&m, &t, &x, &v, None);
         // The normals are the force pass's, bit for bit (it reads these instead).
         let mut want_normals = vec![Vec3::zeros(); x.len()];
         crate::forces::normals::vertex_normals(&x, &t.triangles, &mut want_normals);
@@ -730,46 +760,15 @@ mod tests {
         let mut rest = vec![0.0; x.len()];
         patch_normals(&t.rest_positions, &t, &mut n, &mut rest);
         assert!(rest.iter().all(|r| (r - 1.0).abs() < 1e-12), "{rest:?}");
-        // dT/dx by central differences of T at fixed v; (dM/dt) v by central differences
-        // of M(x + s v) v in s.
-        let eps = 1e-6;
-        for j in 0..x.len() {
-            let mut grad = Vec3::zeros();
-            for a in 0..3 {
-                let shifted = |s: f64| {
-                    let mut y = x.clone();
-                    y[j][a] += s * eps;
-                    water_energy(&t, &m, &y, &v)
-                };
-                grad[a] = (shifted(1.0) - shifted(-1.0)) / (2.0 * eps);
-            }
-            let m_v = |s: f64| {
-                let y: Vec<Vec3> = x.iter().zip(&v).map(|(x, v)| x + s * eps * v).collect();
-                inertias(&t, &m, &y)[j].apply(&v[j])
-            };
-            let mdot_v = (m_v(1.0) - m_v(-1.0)) / (2.0 * eps);
-            let want = grad - mdot_v;
-            assert!(
-                (got[j] - want).norm() < 1e-6 * (1.0 + want.norm()),
-                "particle {j}: {} against {}",
-                got[j],
-                want
-            );
-        }
-        // Nothing without normal added mass.
-        let mut none = vec![Vec3::zeros(); x.len()];
-        let plain = Model::fractional();
-        turning_forces(
-            &plain,
-            &t,
+        check::lagranges_terms(
+            &got,
             &x,
             &v,
-            &mut s,
-            &mut projected,
-            &mut normals,
-            &mut none,
-            None,
+            |y| water_energy(&t, &m, y, &v),
+            |y, j| inertias(&t, &m, y)[j].apply(&v[j]),
         );
+        // Nothing without normal added mass.
+        let (none, _, _) = check::turning_of(&Model::fractional(), &t, &x, &v, None);
         assert!(none.iter().all(|f| *f == Vec3::zeros()));
     }
 

@@ -22,7 +22,7 @@ pub(crate) mod coarse_water;
 mod contact;
 mod drag;
 mod elements;
-mod inertia;
+pub(crate) mod inertia;
 mod inputs;
 mod jacobian;
 mod memories;

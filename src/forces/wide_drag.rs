@@ -589,7 +589,6 @@ mod tests {
     /// A fan of 13 triangles around a centre vertex and a ring, then a strip: rows of 3 to 14
     /// entries, blocks of mixed widths.
     fn fan() -> Topology {
-        use crate::topology::{MeshMass, MeshSpec};
         let k = 13u32;
         let mut positions = vec![Vec3::zeros()];
         for i in 0..k {
@@ -607,21 +606,26 @@ mod tests {
             indices.extend([0, r0, r1]);
             indices.extend([r0, r0 + 1, r1]);
         }
+        triangles(&positions, &indices)
+    }
+
+    /// A triangle mesh of 10 g.
+    fn triangles(positions: &[Vec3], indices: &[u32]) -> Topology {
+        use crate::topology::{MeshMass, MeshSpec};
         MeshSpec {
-            positions: &positions,
-            indices: &indices,
+            positions,
+            indices,
             face_size: 3,
             mass: MeshMass::Total(0.01),
         }
         .build()
-        .expect("a fan")
+        .expect("a triangle mesh")
     }
 
     /// A `w x h` grid of 1 cm numbered in rows, its cells split along random diagonals and its
     /// inner vertices moved up to 15 % of the spacing: rows of 4 to 9 entries within a 3 x 3
     /// neighbourhood, no two alike (the scenes' jittered mesh).
     fn jittered(w: u32, h: u32) -> Topology {
-        use crate::topology::{MeshMass, MeshSpec};
         let mut r = crate::testing::numbers(11);
         let positions: Vec<Vec3> = (0..w * h)
             .map(|k| {
@@ -646,14 +650,7 @@ mod tests {
                 }
             }
         }
-        MeshSpec {
-            positions: &positions,
-            indices: &indices,
-            face_size: 3,
-            mass: MeshMass::Total(0.01),
-        }
-        .build()
-        .expect("a jittered mesh")
+        triangles(&positions, &indices)
     }
 
     /// The blocked rows give the bits of the rows summed one by one, on a grid (rows of 7), on
