@@ -42,6 +42,9 @@ pub struct CoarseWater {
     /// Per-step scratch: patch sums, the coarse matrix.
     sums: Vec<f64>,
     sums2: Vec<f64>,
+    /// The step's patches-by-patches matrix and right-hand side, kept between steps.
+    gram: DMatrix<f64>,
+    rhs: DVector<f64>,
 }
 
 /// Most patches a coarse level may have: its patches-by-patches matrix is dense and factored
@@ -197,6 +200,8 @@ impl CoarseWater {
             carried,
             sums: Vec::new(),
             sums2: Vec::new(),
+            gram: DMatrix::zeros(0, 0),
+            rhs: DVector::zeros(0),
         })
     }
 
@@ -288,7 +293,12 @@ impl CoarseWater {
         let n = f.len();
         let np = self.patches();
         let inertia = |i: usize| super::Inertia::of(model, t.masses[i], t.areas[i], normals[i], projected[i]);
-        let mut g = DMatrix::<f64>::zeros(np, np);
+        // The buffers of the last step, filled afresh (no allocation after the first step).
+        let mut g = std::mem::replace(&mut self.gram, DMatrix::zeros(0, 0));
+        if g.shape() != (np, np) {
+            g = DMatrix::zeros(np, np);
+        }
+        g.fill(0.0);
         for p in 0..np {
             // A patch of pinned vertices only carries nothing and meets nothing.
             g[(p, p)] = if self.carried[p] > 0.0 {
@@ -297,7 +307,11 @@ impl CoarseWater {
                 1.0
             };
         }
-        let mut z = DVector::<f64>::zeros(np);
+        let mut z = std::mem::replace(&mut self.rhs, DVector::zeros(0));
+        if z.len() != np {
+            z = DVector::zeros(np);
+        }
+        z.fill(0.0);
         for i in 0..n {
             let inr = inertia(i);
             let e = inr.isotropic() + inr.normal_mass;
@@ -312,7 +326,17 @@ impl CoarseWater {
             }
         }
         // G is K^{-1} (positive) plus a Gram matrix: symmetric positive definite.
-        let q = g.cholesky().map_or_else(|| DVector::zeros(np), |c| c.solve(&z));
+        // The factor is solved in place and handed back as next step's buffer. (Not positive
+        // definite only with non-finite forces: no coarse correction, and the step's soundness
+        // check refuses the result.)
+        match nalgebra::Cholesky::new(g) {
+            Some(c) => {
+                c.solve_mut(&mut z);
+                self.gram = c.unpack();
+            }
+            None => z.fill(0.0),
+        }
+        let q = z;
         for i in 0..n {
             let inr = inertia(i);
             let (iso, e) = (inr.isotropic(), inr.isotropic() + inr.normal_mass);
@@ -321,6 +345,7 @@ impl CoarseWater {
             let nu = inr.normal_mass * sigma + wq;
             f[i] = (inr.mass / iso) * (f[i] - nu * normals[i]);
         }
+        self.rhs = q;
     }
 
     /// Adds the coarse water's `M u` to `out`: `a_i (W^T K W s)_i`, `s_i = a_i . u_i`, with
