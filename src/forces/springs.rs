@@ -141,19 +141,26 @@ crate::simd_dispatch! { pub(super) fn run_uniform_widest(p: &Params<'_>, run: &S
 
 #[inline(always)]
 fn run_kernel_each(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) {
-    run_kernel::<false>(p, run, first_spring, 0.0, out)
+    match run.second {
+        None => run_kernel::<false, false>(p, run, first_spring, 0.0, out),
+        Some(_) => run_kernel::<false, true>(p, run, first_spring, 0.0, out),
+    }
 }
 
 #[inline(always)]
 fn run_kernel_uniform(p: &Params<'_>, run: &SpringRun, first_spring: usize, rest: f64, out: [&mut [f64]; 3]) {
-    run_kernel::<true>(p, run, first_spring, rest, out)
+    run_kernel::<true, false>(p, run, first_spring, rest, out)
 }
 
 /// Springs `first_spring ..` of `run`, as many as `out` holds. With `UNIFORM`, every spring
-/// has the rest length `uniform_rest` and `p.rest` is not read (same arithmetic either way);
-/// without, padding slots (a negative-signed rest length) are set to no force.
+/// has the rest length `uniform_rest` and `p.rest` is not read (same arithmetic either way).
+/// Padding slots (a NaN rest length) come out as garbage: the caller sets them to no force
+/// ([`zero_pads_widest`]). With `TWO` (a run two
+/// families share, `SpringRun::second`), a slot whose rest length is negated is of the second
+/// family and takes its constants (a select by the sign, no per-slot load more), the rest
+/// length its magnitude: the same arithmetic as the family's own run.
 #[inline(always)]
-fn run_kernel<'a, const UNIFORM: bool>(
+fn run_kernel<'a, const UNIFORM: bool, const TWO: bool>(
     p: &Params<'a>,
     run: &SpringRun,
     first_spring: usize,
@@ -175,8 +182,22 @@ fn run_kernel<'a, const UNIFORM: bool>(
     } else {
         &p.rest[first_spring..first_spring + n]
     };
-    let rest_at = |t: usize| if UNIFORM { uniform_rest } else { rest[t] };
     let kd = p.kd[p.kinds[first_spring] as usize];
+    let second = run.second.map_or(0, usize::from);
+    let (ks2, kd2) = (p.stiffness[second], p.kd[second]);
+    // Slot t's stiffness, damping and rest length.
+    let slot = |t: usize| -> (f64, f64, f64) {
+        if UNIFORM {
+            (ks, kd, uniform_rest)
+        } else if TWO {
+            let r = rest[t];
+            let two = r < 0.0;
+            (if two { ks2 } else { ks }, if two { kd2 } else { kd }, r.abs())
+        } else {
+            (ks, kd, rest[t])
+        }
+    };
+    let undamped = kd == 0.0 && (!TWO || kd2 == 0.0);
     // A squared length outside `[SEED_MIN, SEED_MAX]` (see `inverse_length`), or NaN: the slice
     // is done again exactly.
     let mut outside = false;
@@ -188,13 +209,14 @@ fn run_kernel<'a, const UNIFORM: bool>(
         outside |= !(SEED_MIN..=SEED_MAX).contains(&l2);
         let inv = inverse_length(l2);
         let len = l2 * inv;
+        let (ks, kd, r) = slot(t);
         // F = (mag / |l|) l with mag = -k_s (|l| - r) - k_d (dq . l) / |l|.
-        let mag = if kd == 0.0 {
-            -ks * (len - rest_at(t))
+        let mag = if undamped {
+            -ks * (len - r)
         } else {
             let (dx, dy, dz) = (qxi[t] - qxj[t], qyi[t] - qyj[t], qzi[t] - qzj[t]);
             let dql = dx.mul_add(lx, dy.mul_add(ly, dz * lz));
-            (-ks).mul_add(len - rest_at(t), -(kd * inv) * dql)
+            (-ks).mul_add(len - r, -(kd * inv) * dql)
         };
         let s = mag * inv;
         fx[t] = s * lx;
@@ -203,24 +225,29 @@ fn run_kernel<'a, const UNIFORM: bool>(
     }
     if outside {
         exact_kernel(
-            ks,
-            kd,
+            undamped,
             [xi, yi, zi],
             [xj, yj, zj],
             [qxi, qyi, qzi],
             [qxj, qyj, qzj],
-            rest_at,
+            slot,
             [&mut *fx, &mut *fy, &mut *fz],
         );
     }
-    if !UNIFORM {
-        // Padding slots (rest length -0.0, `topology::PAD_REST`) get no force: a mask over the
-        // slice, vectorised, instead of a walk over a list of pads (an irregular mesh's runs
-        // hold many).
-        for t in 0..n {
-            if rest[t].is_sign_negative() {
-                (fx[t], fy[t], fz[t]) = (0.0, 0.0, 0.0);
-            }
+}
+
+crate::simd_dispatch! { pub(super) fn zero_pads_widest(rest: &[f64], out: [&mut [f64]; 3]) => zero_pads }
+
+/// Sets the force of every padding slot (rest length NaN, `topology::PAD_REST`) among `rest` to
+/// none: a mask over the slice, vectorised, for runs that hold many (an irregular mesh's).
+#[inline(always)]
+fn zero_pads(rest: &[f64], out: [&mut [f64]; 3]) {
+    let [fx, fy, fz] = out;
+    let n = rest.len();
+    let (fx, fy, fz) = (&mut fx[..n], &mut fy[..n], &mut fz[..n]);
+    for t in 0..n {
+        if rest[t].is_nan() {
+            (fx[t], fy[t], fz[t]) = (0.0, 0.0, 0.0);
         }
     }
 }
@@ -243,30 +270,31 @@ fn inverse_length(l2: f64) -> f64 {
 
 /// The spring pass with f64 square root and division, for slices with a squared length outside
 /// `[SEED_MIN, SEED_MAX]` (collapsed or absurdly long springs). A zero-length spring has no
-/// direction: no force rather than NaN. `rest(t)`: the rest length of spring t.
+/// direction: no force rather than NaN. `slot(t)`: the stiffness, damping and rest length of
+/// spring t; `undamped`: every damping is 0.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn exact_kernel(
-    ks: f64,
-    kd: f64,
+    undamped: bool,
     xi: [&[f64]; 3],
     xj: [&[f64]; 3],
     qi: [&[f64]; 3],
     qj: [&[f64]; 3],
-    rest: impl Fn(usize) -> f64,
+    slot: impl Fn(usize) -> (f64, f64, f64),
     out: [&mut [f64]; 3],
 ) {
     let [fx, fy, fz] = out;
     for t in 0..fx.len() {
+        let (ks, kd, rest) = slot(t);
         let l = [xi[0][t] - xj[0][t], xi[1][t] - xj[1][t], xi[2][t] - xj[2][t]];
         let dq = [qi[0][t] - qj[0][t], qi[1][t] - qj[1][t], qi[2][t] - qj[2][t]];
         let len = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
         let dql = dq[0] * l[0] + dq[1] * l[1] + dq[2] * l[2];
         let inv = 1.0 / len;
-        let mag = if kd == 0.0 {
-            -ks * (len - rest(t))
+        let mag = if undamped {
+            -ks * (len - rest)
         } else {
-            -ks * (len - rest(t)) - kd * dql * inv
+            -ks * (len - rest) - kd * dql * inv
         };
         let s = if len > 0.0 { mag * inv } else { 0.0 };
         fx[t] = s * l[0];

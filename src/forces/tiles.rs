@@ -26,7 +26,7 @@
 //! the sums do not depend on the thread count.
 
 use super::inputs::InputWindow;
-use super::springs::{run_uniform_widest, run_widest, Params};
+use super::springs::{run_uniform_widest, run_widest, zero_pads_widest, Params};
 pub use crate::parallel::TILE;
 use crate::topology::{TileLayout as Layout, TileRuns, Topology, GATHER_RUNS};
 
@@ -254,22 +254,23 @@ fn evaluate(
 }
 
 /// Evaluates the slots `s .. s + out[0].len()` of run `k` into `out`; padding slots were
-/// evaluated like springs and are set to no force (a uniform run's from the list of pads, which
-/// are few there; an irregular mesh's runs hold many, set in the spring kernel).
+/// evaluated like springs and are set to no force: from the list of pads where they are few
+/// (a grid's, at its row ends), by a mask over the rest lengths where they are many (an
+/// irregular mesh's runs).
 #[inline]
 fn evaluate_slots(p: &Params<'_>, tr: &TileRuns, k: usize, s: usize, out: [&mut [f64]; 3]) {
     let run = &tr.runs[k];
     let [x, y, z] = out;
+    let slots = s..s + x.len();
     match tr.uniform_rest[k] {
-        Some(r) => {
-            run_uniform_widest(p, run, s, r, [&mut *x, &mut *y, &mut *z]);
-            for q in tr.pads_in(s..s + x.len()) {
-                (x[q - s], y[q - s], z[q - s]) = (0.0, 0.0, 0.0);
-            }
-        }
-        None => {
-            // Sets its padding to no force itself (by the sign of the rest length).
-            run_widest(p, run, s, [&mut *x, &mut *y, &mut *z]);
+        Some(r) => run_uniform_widest(p, run, s, r, [&mut *x, &mut *y, &mut *z]),
+        None => run_widest(p, run, s, [&mut *x, &mut *y, &mut *z]),
+    }
+    if tr.many_pads[k] {
+        zero_pads_widest(&tr.rest[slots], [x, y, z]);
+    } else {
+        for q in tr.pads_in(slots) {
+            (x[q - s], y[q - s], z[q - s]) = (0.0, 0.0, 0.0);
         }
     }
 }
@@ -498,8 +499,8 @@ mod tests {
             let l = x[i] - x[j];
             let len = l.norm();
             let dir = l / len;
-            let mag =
-                -m.stiffness(s.kind, t.spacing) * (len - s.rest) - m.spring_damping * (q[i] - q[j]).dot(&dir);
+            let mag = -m.stiffness(s.kind, t.spacing) * (len - s.rest)
+                - m.spring_damping_of(s.kind) * (q[i] - q[j]).dot(&dir);
             f[i] += mag * dir;
             f[j] -= mag * dir;
         }
@@ -534,6 +535,8 @@ mod tests {
         m.gravity = Vec3::zeros();
         m.viscous_drag = 0.0;
         m.history_drag = 0.0;
+        // A damping of its own for each family: a run two families share takes each slot's.
+        m.spring_damping_scale = [1.0, 0.5, 0.25];
         // Rest lengths that differ within a family (as a mesh's do): the tiled pass reads them
         // per slot instead of one number per run.
         let mut springs = t.springs.clone();
@@ -619,7 +622,23 @@ mod tests {
         assert!(gathered(&gap) && gathered(&holes));
         assert!(many.tiled.is_some() && !gathered(&many));
         assert!(gathered(&t) && gathered(&varied) && gathered(&wide));
+        // The scenes' jittered mesh: its diagonals' stretch and bend springs share runs.
+        let jittered = crate::testing::jittered_mesh(101, 101);
+        let two = jittered
+            .tile_runs
+            .runs
+            .iter()
+            .filter(|r| r.second.is_some())
+            .count();
+        assert!(two >= 2, "runs of two families: {two}");
+        assert!(gathered(&jittered));
+        let x_jittered: Vec<Vec3> = jittered
+            .rest_positions
+            .iter()
+            .map(|p| p + 0.002 * Vec3::new(rnd(), rnd(), rnd()))
+            .collect();
         for (topology, x, q) in [
+            (&jittered, &x_jittered, &q),
             (&t, &x, &q),
             (&buffered, &x, &q),
             (&varied, &x, &q),

@@ -622,35 +622,9 @@ mod tests {
         .expect("a triangle mesh")
     }
 
-    /// A `w x h` grid of 1 cm numbered in rows, its cells split along random diagonals and its
-    /// inner vertices moved up to 15 % of the spacing: rows of 4 to 9 entries within a 3 x 3
-    /// neighbourhood, no two alike (the scenes' jittered mesh).
+    /// The scenes' jittered mesh (`crate::testing::jittered_mesh`).
     fn jittered(w: u32, h: u32) -> Topology {
-        let mut r = crate::testing::numbers(11);
-        let positions: Vec<Vec3> = (0..w * h)
-            .map(|k| {
-                let (i, j) = (k % w, k / w);
-                let inner = i > 0 && j > 0 && i + 1 < w && j + 1 < h;
-                let jitter = if inner {
-                    0.0015 * Vec3::new(r(), r(), 0.0)
-                } else {
-                    Vec3::zeros()
-                };
-                Vec3::new(0.01 * f64::from(i), 0.01 * f64::from(j), 0.0) + jitter
-            })
-            .collect();
-        let mut indices = Vec::new();
-        for j in 0..h - 1 {
-            for i in 0..w - 1 {
-                let (a, b, c, d) = (j * w + i, j * w + i + 1, (j + 1) * w + i + 1, (j + 1) * w + i);
-                if r() < 0.0 {
-                    indices.extend([a, d, b, b, d, c]);
-                } else {
-                    indices.extend([a, d, c, a, c, b]);
-                }
-            }
-        }
-        triangles(&positions, &indices)
+        crate::testing::jittered_mesh(w, h)
     }
 
     /// The blocked rows give the bits of the rows summed one by one, on a grid (rows of 7), on

@@ -17,6 +17,11 @@ pub struct SpringRun {
     pub first_vertex: u32,
     pub offset: u32,
     pub len: u32,
+    /// The family of the run's springs (`SpringKind as u8`).
+    pub kind: u8,
+    /// A second family sharing the run (tile runs only, [`TileRuns`]): its springs' slots hold
+    /// their rest lengths negated. None: every spring of the run is of `kind`.
+    pub second: Option<u8>,
 }
 
 /// Calls `f(run, lo, hi)` for every run overlapping the springs `first .. end`, in order, with
@@ -40,12 +45,18 @@ pub fn for_each_piece(
 /// Sorts `springs` (each with i < j) by (kind, j - i, i) and returns the runs.
 pub fn order_into_runs(springs: &mut [Spring]) -> Vec<SpringRun> {
     springs.sort_by_key(|s| (s.kind as u8, s.j - s.i, s.i));
+    runs_by(springs, |s| (s.kind as u8, None))
+}
+
+/// The runs of `springs`, sorted so that springs of one class (`class`: a family, and a second
+/// family sharing its runs) and offset follow each other by first vertex.
+fn runs_by(springs: &[Spring], class: impl Fn(&Spring) -> (u8, Option<u8>)) -> Vec<SpringRun> {
     let mut runs: Vec<SpringRun> = Vec::new();
     for (k, s) in springs.iter().enumerate() {
         let offset = s.j - s.i;
+        let (kind, second) = class(s);
         if let Some(r) = runs.last_mut() {
-            let prev = &springs[k - 1];
-            if prev.kind == s.kind && r.offset == offset && r.first_vertex + r.len == s.i {
+            if (r.kind, r.second) == (kind, second) && r.offset == offset && r.first_vertex + r.len == s.i {
                 r.len += 1;
                 continue;
             }
@@ -55,9 +66,53 @@ pub fn order_into_runs(springs: &mut [Spring]) -> Vec<SpringRun> {
             first_vertex: s.i,
             offset,
             len: 1,
+            kind,
+            second,
         });
     }
     runs
+}
+
+/// The springs in the order of runs in which the two families at an offset that exactly two
+/// families have, never both at one first vertex, share their runs, and those runs, when there
+/// is such an offset. An irregular triangle mesh numbered in rows has them: a cell's two
+/// diagonals are one edge (a stretch spring) and one bend spring across it, at the same
+/// offset, in cells that alternate at random; as two families they are two half-empty runs at
+/// each diagonal offset, as one, one full run.
+fn mixed_order(springs: &[Spring]) -> Option<(Vec<Spring>, Vec<SpringRun>)> {
+    use std::collections::{BTreeMap, HashSet};
+    let mut families: BTreeMap<u32, u8> = BTreeMap::new();
+    for s in springs {
+        *families.entry(s.j - s.i).or_default() |= 1 << (s.kind as u8);
+    }
+    let mut shared: BTreeMap<u32, (u8, u8)> = families
+        .into_iter()
+        .filter(|(_, bits)| bits.count_ones() == 2)
+        .map(|(offset, bits)| {
+            let a = bits.trailing_zeros() as u8;
+            let b = (bits & (bits - 1)).trailing_zeros() as u8;
+            (offset, (a, b))
+        })
+        .collect();
+    // Two springs of one offset at one first vertex cannot share a run's slot.
+    let mut seen = HashSet::new();
+    for s in springs {
+        let offset = s.j - s.i;
+        if shared.contains_key(&offset) && !seen.insert((offset, s.i)) {
+            shared.remove(&offset);
+        }
+    }
+    if shared.is_empty() {
+        return None;
+    }
+    let class = |s: &Spring| match shared.get(&(s.j - s.i)) {
+        Some(&(a, b)) => (a, Some(b)),
+        None => (s.kind as u8, None),
+    };
+    let mut sorted = springs.to_vec();
+    sorted.sort_by_key(|s| (class(s), s.j - s.i, s.i));
+    let runs = runs_by(&sorted, class);
+    Some((sorted, runs))
 }
 
 /// Largest gap (missing springs) between two runs of one family and offset that [`TileRuns`]
@@ -70,30 +125,37 @@ const MAX_GAP: u32 = 4;
 /// about 1.5x after), while a mesh whose runs lie far apart is not padded without bound.
 const MAX_PADDED: usize = 3;
 
-/// The rest length a padding slot holds: -0.0, so the force pass can tell padding from springs
-/// by the sign bit of the rest lengths it reads anyway.
-pub const PAD_REST: f64 = -0.0;
+/// The rest length a padding slot holds: NaN, so the force pass can tell padding from springs
+/// by the rest lengths it reads anyway (a spring's is a finite number, negated for a run's
+/// second family).
+pub const PAD_REST: f64 = f64::NAN;
 
 /// The runs again, with runs of the same family and offset that are separated by a few missing
 /// springs joined into one by padding slots (a grid's rows break every horizontal, shear and
 /// bend run at the row end: padding makes each family one run). A slot is a real spring or
-/// padding (listed in `pads`, rest 0): the force pass evaluates padding like a spring and then
+/// padding (listed in `pads`, rest NaN): the force pass evaluates padding like a spring and then
 /// sets its force to zero, so it reads nothing per slot to tell them apart.
+/// Where two families share an offset (an irregular mesh's diagonals), they may share its runs
+/// ([`SpringRun::second`]), when that takes fewer slots: the second family's slots hold their
+/// rest lengths negated, and the force pass takes each slot's constants by that sign.
 /// `SpringRun::first_spring` indexes slots here. Used by the tiled force pass, where fewer,
 /// longer runs mean fewer, longer vector loops.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TileRuns {
     pub runs: Vec<SpringRun>,
-    /// Rest length of each slot, m ([`PAD_REST`], -0.0, for padding: no spring's rest length,
-    /// which is never negative, has that sign).
+    /// Rest length of each slot, m: negated for a run's second family, [`PAD_REST`] (NaN) for
+    /// padding.
     pub rest: Vec<f64>,
-    /// Family of each slot (`SpringKind as u8`).
+    /// Family of each slot's run (`SpringRun::kind`).
     pub kinds: Vec<u8>,
     /// The padding slots, ascending.
     pub pads: Vec<u32>,
     /// Per run: the rest length every spring of it has, when they all have the same one (a
     /// regular grid's families), so the force pass need not read `rest` for it.
     pub uniform_rest: Vec<Option<f64>>,
+    /// Per run: whether padding is more than a sixteenth of its slots, so that the force pass
+    /// sets padding to no force by a mask over the rest lengths rather than from `pads`.
+    pub many_pads: Vec<bool>,
     /// Runs touching each chunk of vertices.
     pub chunk_runs: super::Adjacency,
     /// Largest offset of any run.
@@ -103,8 +165,25 @@ pub struct TileRuns {
 impl TileRuns {
     /// Pads `runs` (from `order_into_runs` on `springs`) for `n` vertices: every run of a family
     /// and offset joined into one when the padding stays within `MAX_PADDED` slots a spring,
-    /// else only over gaps of at most `MAX_GAP`.
+    /// else only over gaps of at most `MAX_GAP`. Two families sharing an offset share its runs
+    /// when that takes fewer slots.
     pub fn new(n: usize, springs: &[Spring], runs: &[SpringRun]) -> Self {
+        let plain = Self::bounded(n, springs, runs);
+        match mixed_order(springs) {
+            Some((sorted, mixed_runs)) => {
+                let mixed = Self::bounded(n, &sorted, &mixed_runs);
+                if mixed.rest.len() < plain.rest.len() {
+                    mixed
+                } else {
+                    plain
+                }
+            }
+            None => plain,
+        }
+    }
+
+    /// [`TileRuns::new`] for one order of the springs.
+    fn bounded(n: usize, springs: &[Spring], runs: &[SpringRun]) -> Self {
         let joined = Self::padded(n, springs, runs, u32::MAX);
         if joined.rest.len() <= MAX_PADDED * springs.len().max(1) {
             return joined;
@@ -116,10 +195,10 @@ impl TileRuns {
     fn padded(n: usize, springs: &[Spring], runs: &[SpringRun], max_gap: u32) -> Self {
         let mut t = Self::default();
         for r in runs {
-            let kind = springs[r.first_spring as usize].kind as u8;
+            let kind = r.kind;
             let gap = t.runs.last().and_then(|last| {
                 let end = last.first_vertex + last.len;
-                let same = t.kinds[last.first_spring as usize] == kind && last.offset == r.offset;
+                let same = (last.kind, last.second) == (kind, r.second) && last.offset == r.offset;
                 (same && r.first_vertex >= end && r.first_vertex - end <= max_gap)
                     .then(|| r.first_vertex - end)
             });
@@ -139,11 +218,20 @@ impl TileRuns {
                 }),
             }
             for s in &springs[r.first_spring as usize..(r.first_spring + r.len) as usize] {
-                t.rest.push(s.rest);
+                let second = r.second == Some(s.kind as u8);
+                t.rest.push(if second { -s.rest } else { s.rest });
                 t.kinds.push(kind);
             }
         }
         t.uniform_rest = t.runs.iter().map(|r| t.uniform(r)).collect();
+        t.many_pads = t
+            .runs
+            .iter()
+            .map(|r| {
+                let slots = r.first_spring as usize..(r.first_spring + r.len) as usize;
+                16 * t.pads_in(slots).count() > r.len as usize
+            })
+            .collect();
         // Built by pushes: drop the spare capacity (these live as long as the cloth).
         t.rest.shrink_to_fit();
         t.kinds.shrink_to_fit();
@@ -154,8 +242,12 @@ impl TileRuns {
         t
     }
 
-    /// The rest length shared by every spring (not padding) of `run`, if there is one.
+    /// The rest length shared by every spring (not padding) of `run`, if there is one (never
+    /// for a run of two families).
     fn uniform(&self, run: &SpringRun) -> Option<f64> {
+        if run.second.is_some() {
+            return None;
+        }
         let slots = run.first_spring as usize..(run.first_spring + run.len) as usize;
         let mut pads = self.pads_in(slots.clone()).peekable();
         let mut shared: Option<f64> = None;
@@ -264,9 +356,7 @@ mod tests {
                         assert_eq!(p.kinds[slot], t.springs[s].kind as u8);
                         seen[s] += 1;
                     }
-                    None => assert!(
-                        pads.contains(&slot) && p.rest[slot] == 0.0 && p.rest[slot].is_sign_negative()
-                    ),
+                    None => assert!(pads.contains(&slot) && p.rest[slot].is_nan()),
                 }
             }
         }
