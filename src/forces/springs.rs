@@ -183,8 +183,10 @@ fn run_kernel<'a, const UNIFORM: bool, const TWO: bool>(
         &p.rest[first_spring..first_spring + n]
     };
     let kd = p.kd[p.kinds[first_spring] as usize];
-    let second = run.second.map_or(0, usize::from);
-    let (ks2, kd2) = (p.stiffness[second], p.kd[second]);
+    let (ks2, kd2) = match run.second {
+        Some(b) if TWO => (p.stiffness[usize::from(b)], p.kd[usize::from(b)]),
+        _ => (ks, kd),
+    };
     // Slot t's stiffness, damping and rest length.
     let slot = |t: usize| -> (f64, f64, f64) {
         if UNIFORM {
