@@ -29,7 +29,7 @@ this add-on.
 bl_info = {
     "name": "fraccloth: underwater cloth",
     "author": "fraccloth developers",
-    "version": (0, 9, 6),
+    "version": (0, 9, 7),
     "blender": (4, 2, 0),
     "location": "Properties > Physics > fraccloth",
     "description": "Cloth that moves as if underwater (fractional mass-spring model), baked to a point cache",
@@ -84,19 +84,19 @@ PRESETS = {
         "stretch_stiffness": 4.0, "shear_stiffness": 0.8, "bend_stiffness": 0.02, "bend_spacing": 0.01,
         "damping_mode": "VELOCITY", "spring_damping": 0.005, "history_drag": 0.0, "viscous_drag": 0.0,
         "normal_drag": 0.0, "mass_per_area": 0.1, "cloth_density": 1300.0, "water_density": 1000.0,
-        "entrained_mass": 2.0, "added_mass": 0.0, "form_drag": 1.0, "form_drag_scale": 0.0, "skin_drag": 0.5,
+        "entrained_mass": 2.0, "added_mass": 0.0, "form_drag": 1.0, "form_drag_scale": 0.0, "skin_drag": 0.5, "coarse_added_mass": 0.0,
         "history": "OFF", "integrator": "SYMPLECTIC"}),
     "CANVAS": ("Heavy canvas", "A heavy sheet: sinks and folds in broad, slow waves", {
         "stretch_stiffness": 40.0, "shear_stiffness": 8.0, "bend_stiffness": 4.0, "bend_spacing": 0.01,
         "damping_mode": "VELOCITY", "spring_damping": 0.05, "history_drag": 0.0, "viscous_drag": 0.0,
         "normal_drag": 0.0, "mass_per_area": 2.0, "cloth_density": 1500.0, "water_density": 1000.0,
-        "entrained_mass": 10.0, "added_mass": 0.0, "form_drag": 1.5, "form_drag_scale": 0.0, "skin_drag": 0.0,
+        "entrained_mass": 10.0, "added_mass": 0.0, "form_drag": 1.5, "form_drag_scale": 0.0, "skin_drag": 0.0, "coarse_added_mass": 0.0,
         "history": "OFF", "integrator": "SYMPLECTIC"}),
     "PAPER": ("Fractional (paper)", "The paper's fractional cloth: half-derivative springs and drags, no water inertia", {
         "stretch_stiffness": 10.0, "shear_stiffness": 2.0, "bend_stiffness": 0.5, "bend_spacing": 0.0,
         "damping_mode": "FRACTIONAL", "spring_damping": 0.35, "history_drag": 2e-3, "viscous_drag": 1e-3,
         "normal_drag": 0.0, "mass_per_area": 1.0, "cloth_density": 1100.0, "water_density": 1000.0,
-        "entrained_mass": 0.0, "added_mass": 0.0, "form_drag": 0.0, "form_drag_scale": 0.0, "skin_drag": 0.0,
+        "entrained_mass": 0.0, "added_mass": 0.0, "form_drag": 0.0, "form_drag_scale": 0.0, "skin_drag": 0.0, "coarse_added_mass": 0.0,
         "history": "SOE", "integrator": "SYMPLECTIC"}),
 }
 PRESET_ITEMS = [("CUSTOM", "Custom", "Your own values")] + [(k, v[0], v[1]) for k, v in PRESETS.items()]
@@ -135,9 +135,18 @@ def _library_preset():
         "normal_drag": d.normal_drag_per_area * 1e-4,
         "mass_per_area": d.areal_density, "cloth_density": d.cloth_density, "water_density": d.water_density,
         "entrained_mass": d.entrained_mass, "added_mass": d.added_mass, "form_drag": d.form_drag,
-        "form_drag_scale": d.form_drag_scale, "skin_drag": d.skin_drag, "history": "SOE" if fractional else "OFF",
+        "form_drag_scale": d.form_drag_scale, "skin_drag": d.skin_drag,
+        # The patch size is unused while the large-scale water is off (the preset's 0): the
+        # panel then shows a usable one.
+        "coarse_added_mass": d.coarse_added_mass, "coarse_length": d.coarse_length or COARSE_LENGTH,
+        "history": "SOE" if fractional else "OFF",
         "integrator": integrators[d.integrator],
     }
+
+
+# The panel's patch size for the large-scale water when the library's preset gives none (its
+# term off), m: a few patches across a towel (docs/underwater.md, "The water's inertia by scale").
+COARSE_LENGTH = 0.2
 
 
 # True while a preset writes its values (so that they do not count as the artist's edits).
@@ -187,6 +196,8 @@ class FracclothSettings(bpy.types.PropertyGroup):
     form_drag: bpy.props.FloatProperty(name="Form drag", description="Drag coefficient of the cloth moving face first through water (1 to 2 for a sheet)", default=1.0, min=0.0, soft_max=4.0, update=_edited)
     form_drag_scale: bpy.props.FloatProperty(name="Drag ripple size", description="Ripples shorter than about this shed little drag, so a brisk swing keeps its small bumps while the cloth's motion at large is slowed in full (0: every ripple is dragged), m", default=0.012, min=0.0, soft_max=0.1, precision=3, update=_edited)
     skin_drag: bpy.props.FloatProperty(name="Skin drag", description="Drag of water sliding along the cloth, N s/m^3", default=1.15, min=0.0, soft_max=5.0, update=_edited)
+    coarse_added_mass: bpy.props.FloatProperty(name="Added mass at large", description="More water carried when the cloth moves as a whole (smoother than the patch size), kg per m^2; ripples carry only the added mass across. 0: off (the presets). Costs a small solve a step", default=0.0, min=0.0, soft_max=200.0, update=_edited)
+    coarse_length: bpy.props.FloatProperty(name="Patch size", description="Size of the patches over which the cloth's motion counts as motion at large, m (the library refuses one that makes more than 256 patches over the cloth, naming one that fits)", default=COARSE_LENGTH, min=1e-3, soft_max=1.0, precision=3, update=_edited)
     current: bpy.props.FloatVectorProperty(name="Current", description="Water current, m/s (world)", default=(0.0, 0.0, 0.0), size=3)
     history: bpy.props.EnumProperty(name="History", items=HISTORY_ITEMS, default="OFF", update=_edited)
     integrator: bpy.props.EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="SYMPLECTIC", update=_edited)
@@ -431,6 +442,8 @@ def describe(s, scene=None):
     desc.form_drag = s.form_drag
     desc.form_drag_scale = s.form_drag_scale
     desc.skin_drag = s.skin_drag
+    desc.coarse_added_mass = s.coarse_added_mass
+    desc.coarse_length = s.coarse_length if s.coarse_added_mass > 0.0 else 0.0
     desc.collision_margin = s.collision_margin
     desc.self_collision_thickness = s.self_collision
     desc.self_collision_friction = s.self_friction
@@ -782,7 +795,8 @@ class FRACCLOTH_PT_panel(bpy.types.Panel):
         for title, names in (
             ("Cloth", ("mass_per_area", "cloth_density", "stretch_stiffness", "shear_stiffness", "bend_stiffness",
                        "bend_spacing", "damping_mode", "spring_damping")),
-            ("Water", ("water_density", "entrained_mass", "added_mass", "form_drag", "form_drag_scale", "skin_drag", "history_drag",
+            ("Water", ("water_density", "entrained_mass", "added_mass", "coarse_added_mass", "coarse_length", "form_drag",
+                       "form_drag_scale", "skin_drag", "history_drag",
                        "viscous_drag", "normal_drag", "current")),
             ("Colliders", ("collider_shape", "friction", "collision_margin", "self_collision", "self_friction")),
             ("Solver", ("history", "integrator", "auto_step", "time_step")),

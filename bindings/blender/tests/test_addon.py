@@ -187,7 +187,8 @@ def test_the_underwater_preset_is_the_librarys(addon, tmp_path):
     got = addon.describe(s)
     want = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
     for field in ("stretch_stiffness", "shear_stiffness", "bend_stiffness", "bend_reference_spacing", "spring_damping", "spring_damping_mode",
-                  "entrained_mass", "added_mass", "form_drag", "form_drag_scale", "skin_drag", "cloth_density", "water_density",
+                  "entrained_mass", "added_mass", "coarse_added_mass", "coarse_length", "form_drag", "form_drag_scale",
+                  "skin_drag", "cloth_density", "water_density",
                   "integrator", "viscous_drag", "history_drag", "normal_drag", "viscous_drag_per_area",
                   "history_drag_per_area", "normal_drag_per_area"):
         assert getattr(got, field) == pytest.approx(getattr(want, field), rel=1e-6), field
@@ -201,6 +202,33 @@ def test_the_underwater_preset_is_the_librarys(addon, tmp_path):
     s.auto_step = True
     built, (frame_dt, substeps), _, _ = addon.build_cloth(bpy.context, cloth, [])
     assert substeps is None and built.desc.max_substep == fraccloth.MAX_SUBSTEP_AUTO
+
+
+def test_the_water_at_large_reaches_the_library_and_a_bad_patch_size_is_refused(addon, tmp_path):
+    """The panel's large-scale added mass and patch size are the library's `coarse_added_mass`
+    and `coarse_length`; the water carried at large slows the towel's fall face first; a patch
+    size that makes too many patches is refused with the library's reason and no cache."""
+    cloth, others = make_scene(tmp_path, "PC2")
+    s = cloth.fraccloth
+    assert s.coarse_added_mass == 0.0 and addon.describe(s).coarse_length == 0.0
+    s.coarse_added_mass, s.coarse_length = 100.0, 0.1
+    d = addon.describe(s)
+    assert d.coarse_added_mass == pytest.approx(100.0) and d.coarse_length == pytest.approx(0.1)
+    rest = np.array([v.co[:] for v in cloth.data.vertices], dtype=np.float64)
+
+    def sag(mass):
+        s.coarse_added_mass = mass
+        frames = {f: local for f, _, local in addon.simulate(bpy.context, cloth, others)}
+        return np.abs(frames[6].astype(np.float64) - rest).max()
+
+    with_water, without = sag(100.0), sag(0.0)
+    assert 0.0 < with_water < 0.8 * without, (with_water, without)
+    s.coarse_added_mass = 100.0
+    s.coarse_length = 0.001
+    with pytest.raises(RuntimeError, match="at most 256 patches: use a coarse_length of at least"):
+        bpy.ops.fraccloth.bake()
+    assert not Path(str(tmp_path / "cloth") + ".pc2").exists()
+    assert cloth.modifiers.get("fraccloth") is None
 
 
 def test_two_cloths_bake_to_their_own_caches(addon, tmp_path):
