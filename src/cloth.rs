@@ -141,8 +141,8 @@ pub(crate) struct ColliderSlot {
 pub struct Cloth {
     topology: Topology,
     config: ClothConfig,
-    x: Vec<Vec3>,
-    v: Vec<Vec3>,
+    x: crate::aligned::AlignedVec3,
+    v: crate::aligned::AlignedVec3,
     /// Fully pinned (weight 1): the solver treats these as prescribed.
     pinned: Vec<bool>,
     /// Pin weight of every vertex in [0, 1]; 0 = free.
@@ -205,12 +205,12 @@ impl Cloth {
         )?;
         let x = topology.rest_positions.clone();
         Ok(Self {
-            v: vec![Vec3::zeros(); n],
+            v: crate::aligned::AlignedVec3::from_slice(&vec![Vec3::zeros(); n]),
             pinned: vec![false; n],
             pin_weight: vec![0.0; n],
             pin_list: Vec::new(),
             pin_target: x.clone(),
-            x,
+            x: crate::aligned::AlignedVec3::from_slice(&x),
             collider_slots: Vec::new(),
             colliders: Vec::new(),
             friction: Vec::new(),

@@ -375,8 +375,8 @@ impl Cloth {
         next.config.model.current = current;
         next.config.solver = solver;
         next.pinned = weights.iter().map(|&w| w == 1.0).collect();
-        next.x = x;
-        next.v = v;
+        next.x = crate::aligned::AlignedVec3::from_slice(&x);
+        next.v = crate::aligned::AlignedVec3::from_slice(&v);
         next.pin_weight = weights;
         next.pin_list = pin_list;
         next.pin_target = targets;
@@ -402,7 +402,8 @@ impl Cloth {
         };
         let trial = |c: &Cloth| -> Result<(), Error> {
             let mut t = c.clone();
-            t.pin_target.clone_from(&t.x);
+            t.pin_target.clear();
+            t.pin_target.extend_from_slice(&t.x);
             t.config.accept_unconverged = true;
             t.advance(StepPlan::new(t.config.integrator, h, None, Stage::Whole))
         };

@@ -87,16 +87,16 @@ impl Route {
 #[derive(Clone, Debug, Default)]
 pub(super) struct StepScratch {
     /// The step's velocity of every particle (pins' from their goals), m/s.
-    pub v_step: Vec<Vec3>,
+    pub v_step: crate::aligned::AlignedVec3,
     /// Velocity relative to the water, m/s.
     pub v_rel: Vec<Vec3>,
     /// D^{1/2}x of the displacement relative to the water, m s^{-1/2}.
-    pub half: Vec<Vec3>,
+    pub half: crate::aligned::AlignedVec3,
     /// Total forces as one array (the implicit route only), N.
     pub force_array: Vec<Vec3>,
     /// The state the step proposes; committed only if sound.
-    pub x_new: Vec<Vec3>,
-    pub v_new: Vec<Vec3>,
+    pub x_new: crate::aligned::AlignedVec3,
+    pub v_new: crate::aligned::AlignedVec3,
     /// The pins' goals and paths (`pins.rs`).
     pub pins: PinPaths,
     /// The pair elements' own passes: the rates their memories record (`forces::elements`).
@@ -126,8 +126,8 @@ pub(super) struct StepScratch {
 /// step of an extrapolated integrator).
 #[derive(Clone, Debug, Default)]
 pub(super) struct Rollback {
-    pub(super) x: Vec<Vec3>,
-    pub(super) v: Vec<Vec3>,
+    pub(super) x: crate::aligned::AlignedVec3,
+    pub(super) v: crate::aligned::AlignedVec3,
     histories: Option<Histories>,
     /// Self-collision's remembered pairs and sides (state: a snapshot carries them).
     self_collision: crate::collide::self_collision::SavedMemory,
@@ -216,14 +216,10 @@ impl Cloth {
         self.histories.reserve_step()?;
         let n = self.vertex_count();
         let s = &mut self.scratch;
-        for buf in [
-            &mut s.v_step,
-            &mut s.v_rel,
-            &mut s.half,
-            &mut s.x_new,
-            &mut s.v_new,
-            &mut s.pins.goal,
-        ] {
+        for buf in [&mut s.v_step, &mut s.half, &mut s.x_new, &mut s.v_new] {
+            buf.resize(n, Vec3::zeros());
+        }
+        for buf in [&mut s.v_rel, &mut s.pins.goal] {
             buf.resize(n, Vec3::zeros());
         }
         Ok(())

@@ -84,6 +84,109 @@ impl DerefMut for AlignedF64 {
     }
 }
 
+/// A growable array of [`crate::Vec3`] whose first vector starts a cache line, as
+/// [`AlignedF64`]: the state arrays the step streams (positions, velocities and their next
+/// values) then sit at the same offset within a line wherever the allocator puts them, so the
+/// step's speed does not depend on the heap's layout (a `Vec<Vec3>` from `malloc` starts 16
+/// bytes into a line or a page, wherever the allocations before it left it).
+#[derive(Default)]
+pub struct AlignedVec3 {
+    lines: Vec<Line>,
+    len: usize,
+}
+
+/// Cache lines holding `len` vectors of three numbers.
+fn lines_for(len: usize) -> usize {
+    (3 * len).div_ceil(PER_LINE)
+}
+
+impl AlignedVec3 {
+    /// A copy of `a`.
+    pub fn from_slice(a: &[crate::Vec3]) -> Self {
+        let mut out = Self {
+            lines: vec![Line::default(); lines_for(a.len())],
+            len: a.len(),
+        };
+        out.copy_from_slice(a);
+        out
+    }
+
+    /// Sets the length to `len`; new entries are `value`.
+    pub fn resize(&mut self, len: usize, value: crate::Vec3) {
+        let old = self.len;
+        self.lines.resize(lines_for(len), Line::default());
+        self.len = len;
+        if len > old {
+            self[old..].fill(value);
+        }
+    }
+}
+
+impl Clone for AlignedVec3 {
+    fn clone(&self) -> Self {
+        Self {
+            lines: self.lines.clone(),
+            len: self.len,
+        }
+    }
+
+    /// Reuses the allocation when it is large enough (as `Vec::clone_from` does).
+    fn clone_from(&mut self, source: &Self) {
+        self.lines.clone_from(&source.lines);
+        self.len = source.len;
+    }
+}
+
+impl PartialEq for AlignedVec3 {
+    fn eq(&self, other: &Self) -> bool {
+        self[..] == other[..]
+    }
+}
+
+impl std::fmt::Debug for AlignedVec3 {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self[..].fmt(f)
+    }
+}
+
+impl Deref for AlignedVec3 {
+    type Target = [crate::Vec3];
+
+    fn deref(&self) -> &[crate::Vec3] {
+        // SAFETY: `Vec3` (nalgebra's `Matrix`, `repr(C)` over `[[f64; 3]; 1]`) is three f64s
+        // with no padding and alignment 8; the lines are `8 * lines.len() >= 3 * len`
+        // contiguous, initialised f64s starting at alignment 64, and any f64 bits are valid.
+        unsafe { std::slice::from_raw_parts(self.lines.as_ptr().cast::<crate::Vec3>(), self.len) }
+    }
+}
+
+impl DerefMut for AlignedVec3 {
+    fn deref_mut(&mut self) -> &mut [crate::Vec3] {
+        // SAFETY: as in `deref`, and `&mut self` borrows the lines exclusively.
+        unsafe { std::slice::from_raw_parts_mut(self.lines.as_mut_ptr().cast::<crate::Vec3>(), self.len) }
+    }
+}
+
+impl<'a> IntoIterator for &'a AlignedVec3 {
+    type Item = &'a crate::Vec3;
+    type IntoIter = std::slice::Iter<'a, crate::Vec3>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.iter()
+    }
+}
+
+impl<'a> IntoIterator for &'a mut AlignedVec3 {
+    type Item = &'a mut crate::Vec3;
+    type IntoIter = std::slice::IterMut<'a, crate::Vec3>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.iter_mut()
+    }
+}
+
+const _: () = assert!(std::mem::size_of::<crate::Vec3>() == 24 && std::mem::align_of::<crate::Vec3>() <= 64);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -129,5 +232,24 @@ mod tests {
         c.resize(20);
         assert_eq!(b, c);
         assert_eq!(format!("{b:?}"), format!("{:?}", &b[..]));
+    }
+
+    #[test]
+    fn vectors_start_on_a_cache_line_and_resize_like_a_vec() {
+        use crate::Vec3;
+        let src: Vec<Vec3> = (0..11).map(|k| Vec3::new(k as f64, -(k as f64), 0.5)).collect();
+        let mut a = AlignedVec3::from_slice(&src);
+        assert_eq!(&a[..], &src[..]);
+        assert_eq!(a.as_ptr() as usize % 64, 0);
+        a.resize(4, Vec3::zeros());
+        a.resize(7, Vec3::new(1.0, 2.0, 3.0));
+        let mut want = src[..4].to_vec();
+        want.resize(7, Vec3::new(1.0, 2.0, 3.0));
+        assert_eq!(&a[..], &want[..]);
+        let mut b = AlignedVec3::default();
+        b.clone_from(&a);
+        assert_eq!(b, a);
+        assert_eq!(b.as_ptr() as usize % 64, 0);
+        assert_eq!(format!("{b:?}"), format!("{:?}", &want[..]));
     }
 }
