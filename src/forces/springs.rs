@@ -193,7 +193,8 @@ fn run_kernel<'a, const UNIFORM: bool, const TWO: bool>(
             (ks, kd, uniform_rest)
         } else if TWO {
             let r = rest[t];
-            let two = r < 0.0;
+            // The sign bit, not `r < 0.0`: a second-family spring of rest length 0 holds -0.0.
+            let two = r.is_sign_negative();
             (if two { ks2 } else { ks }, if two { kd2 } else { kd }, r.abs())
         } else {
             (ks, kd, rest[t])

@@ -637,8 +637,35 @@ mod tests {
             .iter()
             .map(|p| p + 0.002 * Vec3::new(rnd(), rnd(), rnd()))
             .collect();
+        // A second-family spring of rest length 0 (its slot holds -0.0): still the second's.
+        let shared = jittered
+            .tile_runs
+            .runs
+            .iter()
+            .find(|r| r.second.is_some())
+            .copied();
+        let shared = shared.expect("a shared run");
+        let mut springs = jittered.springs.clone();
+        let zeroed = springs
+            .iter_mut()
+            .find(|s| s.j - s.i == shared.offset && Some(s.kind as u8) == shared.second)
+            .expect("a spring of the second family");
+        zeroed.rest = 0.0;
+        let zero_rest = Topology::new(
+            jittered.rest_positions.clone(),
+            jittered.masses.clone(),
+            springs,
+            jittered.triangles.clone(),
+            jittered.grid,
+        );
+        assert!(zero_rest
+            .tile_runs
+            .rest
+            .iter()
+            .any(|r| *r == 0.0 && r.is_sign_negative()));
         for (topology, x, q) in [
             (&jittered, &x_jittered, &q),
+            (&zero_rest, &x_jittered, &q),
             (&t, &x, &q),
             (&buffered, &x, &q),
             (&varied, &x, &q),
