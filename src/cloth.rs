@@ -205,7 +205,7 @@ impl Cloth {
         )?;
         let x = topology.rest_positions.clone();
         Ok(Self {
-            v: crate::aligned::AlignedVec3::from_slice(&vec![Vec3::zeros(); n]),
+            v: crate::aligned::AlignedVec3::zeros(n),
             pinned: vec![false; n],
             pin_weight: vec![0.0; n],
             pin_list: Vec::new(),

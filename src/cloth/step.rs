@@ -217,7 +217,7 @@ impl Cloth {
         let n = self.vertex_count();
         let s = &mut self.scratch;
         for buf in [&mut s.v_step, &mut s.half, &mut s.x_new, &mut s.v_new] {
-            buf.resize(n, Vec3::zeros());
+            buf.resize(n);
         }
         for buf in [&mut s.v_rel, &mut s.pins.goal] {
             buf.resize(n, Vec3::zeros());

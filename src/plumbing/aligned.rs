@@ -1,7 +1,11 @@
-//! A growable array of f64 whose first number starts a cache line (64 bytes), so that the
-//! vector loops over it (AVX-512: one cache line per load) never split a load or a store across
-//! two lines. `Vec<f64>` only promises 8-byte alignment, and a large one from `malloc` starts
-//! 16 bytes into a page: every 64-byte access then touches two lines.
+//! Growable arrays whose first element starts a cache line (64 bytes), so that the vector
+//! loops over them (AVX-512: one cache line per load) never split a load or a store across two
+//! lines more than the element size makes them. `Vec<f64>` only promises 8-byte alignment, and
+//! a large one from `malloc` starts 16 bytes into a page: every 64-byte access then touches two
+//! lines. [`AlignedF64`] holds numbers (the SOE modes, the component arrays, the tile walks'
+//! windows); [`AlignedVec3`] holds vectors (the state the step streams: positions, velocities
+//! and their next values), which then also sit at the same offset within a line wherever the
+//! allocator puts them, so the step's speed does not depend on the heap's layout.
 
 use std::ops::{Deref, DerefMut};
 
@@ -12,30 +16,77 @@ struct Line([f64; 8]);
 
 const PER_LINE: usize = 8;
 
-/// `len` numbers in whole cache lines. Compares and prints as the slice of its `len` numbers.
-#[derive(Default)]
-pub struct AlignedF64 {
-    lines: Vec<Line>,
-    len: usize,
+/// An element of an [`Aligned`] array: `F64S` f64s with no padding, of alignment at most 64,
+/// every bit pattern of which is a valid value (all zeros being zero).
+///
+/// # Safety
+/// An implementation promises exactly that layout: [`Aligned`] reads its cache lines of f64s
+/// as elements.
+pub unsafe trait Element: Copy {
+    /// f64s in one element.
+    const F64S: usize;
 }
 
-impl PartialEq for AlignedF64 {
+// SAFETY: an f64 is one f64.
+unsafe impl Element for f64 {
+    const F64S: usize = 1;
+}
+
+// SAFETY: `Vec3` (nalgebra's `Matrix`, `repr(C)` over `[[f64; 3]; 1]`) is three f64s with no
+// padding and alignment 8 (checked below); any three f64s are a vector.
+unsafe impl Element for crate::Vec3 {
+    const F64S: usize = 3;
+}
+
+const _: () = assert!(std::mem::size_of::<crate::Vec3>() == 24 && std::mem::align_of::<crate::Vec3>() == 8);
+
+/// `len` elements in whole cache lines, starting on one. Compares and prints as the slice of
+/// its `len` elements.
+pub struct Aligned<T: Element> {
+    lines: Vec<Line>,
+    len: usize,
+    _element: std::marker::PhantomData<T>,
+}
+
+/// Numbers on cache lines.
+pub type AlignedF64 = Aligned<f64>;
+
+/// Vectors on cache lines.
+pub type AlignedVec3 = Aligned<crate::Vec3>;
+
+/// Cache lines holding `len` elements of `f64s` numbers each.
+fn lines_for(len: usize, f64s: usize) -> usize {
+    (f64s * len).div_ceil(PER_LINE)
+}
+
+impl<T: Element> Default for Aligned<T> {
+    fn default() -> Self {
+        Self {
+            lines: Vec::new(),
+            len: 0,
+            _element: std::marker::PhantomData,
+        }
+    }
+}
+
+impl<T: Element + PartialEq> PartialEq for Aligned<T> {
     fn eq(&self, other: &Self) -> bool {
         self[..] == other[..]
     }
 }
 
-impl std::fmt::Debug for AlignedF64 {
+impl<T: Element + std::fmt::Debug> std::fmt::Debug for Aligned<T> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         self[..].fmt(f)
     }
 }
 
-impl Clone for AlignedF64 {
+impl<T: Element> Clone for Aligned<T> {
     fn clone(&self) -> Self {
         Self {
             lines: self.lines.clone(),
             len: self.len,
+            _element: std::marker::PhantomData,
         }
     }
 
@@ -46,146 +97,74 @@ impl Clone for AlignedF64 {
     }
 }
 
-impl AlignedF64 {
+impl<T: Element> Aligned<T> {
     /// `len` zeros.
     pub fn zeros(len: usize) -> Self {
         Self {
-            lines: vec![Line::default(); len.div_ceil(PER_LINE)],
+            lines: vec![Line::default(); lines_for(len, T::F64S)],
             len,
+            _element: std::marker::PhantomData,
         }
+    }
+
+    /// A copy of `a`.
+    pub fn from_slice(a: &[T]) -> Self {
+        let mut out = Self::zeros(a.len());
+        out.copy_from_slice(a);
+        out
     }
 
     /// Sets the length to `len`; new entries are zero.
     pub fn resize(&mut self, len: usize) {
         let old = self.len;
-        self.lines.resize(len.div_ceil(PER_LINE), Line::default());
+        self.lines.resize(lines_for(len, T::F64S), Line::default());
         self.len = len;
         if len > old {
-            // Entries after the old length in its last line may hold stale numbers.
-            self[old..].fill(0.0);
+            // Numbers after the old length in its last line may hold stale values.
+            let numbers = self.lines.iter_mut().flat_map(|line| line.0.iter_mut());
+            for x in numbers.skip(old * T::F64S).take((len - old) * T::F64S) {
+                *x = 0.0;
+            }
         }
     }
 }
 
-impl Deref for AlignedF64 {
-    type Target = [f64];
+impl<T: Element> Deref for Aligned<T> {
+    type Target = [T];
 
-    fn deref(&self) -> &[f64] {
+    fn deref(&self) -> &[T] {
         // SAFETY: `Line` is `repr(C)` around `[f64; 8]` with no padding (size 64 = 8 * 8), so
-        // the lines are `8 * lines.len() >= len` contiguous, initialised f64s.
-        unsafe { std::slice::from_raw_parts(self.lines.as_ptr().cast::<f64>(), self.len) }
+        // the lines are `8 * lines.len() >= F64S * len` contiguous, initialised f64s starting
+        // at alignment 64; `T: Element` is `F64S` f64s with no padding, alignment at most 64,
+        // valid for any bits.
+        unsafe { std::slice::from_raw_parts(self.lines.as_ptr().cast::<T>(), self.len) }
     }
 }
 
-impl DerefMut for AlignedF64 {
-    fn deref_mut(&mut self) -> &mut [f64] {
+impl<T: Element> DerefMut for Aligned<T> {
+    fn deref_mut(&mut self) -> &mut [T] {
         // SAFETY: as in `deref`, and `&mut self` borrows the lines exclusively.
-        unsafe { std::slice::from_raw_parts_mut(self.lines.as_mut_ptr().cast::<f64>(), self.len) }
+        unsafe { std::slice::from_raw_parts_mut(self.lines.as_mut_ptr().cast::<T>(), self.len) }
     }
 }
 
-/// A growable array of [`crate::Vec3`] whose first vector starts a cache line, as
-/// [`AlignedF64`]: the state arrays the step streams (positions, velocities and their next
-/// values) then sit at the same offset within a line wherever the allocator puts them, so the
-/// step's speed does not depend on the heap's layout (a `Vec<Vec3>` from `malloc` starts 16
-/// bytes into a line or a page, wherever the allocations before it left it).
-#[derive(Default)]
-pub struct AlignedVec3 {
-    lines: Vec<Line>,
-    len: usize,
-}
-
-/// Cache lines holding `len` vectors of three numbers.
-fn lines_for(len: usize) -> usize {
-    (3 * len).div_ceil(PER_LINE)
-}
-
-impl AlignedVec3 {
-    /// A copy of `a`.
-    pub fn from_slice(a: &[crate::Vec3]) -> Self {
-        let mut out = Self {
-            lines: vec![Line::default(); lines_for(a.len())],
-            len: a.len(),
-        };
-        out.copy_from_slice(a);
-        out
-    }
-
-    /// Sets the length to `len`; new entries are `value`.
-    pub fn resize(&mut self, len: usize, value: crate::Vec3) {
-        let old = self.len;
-        self.lines.resize(lines_for(len), Line::default());
-        self.len = len;
-        if len > old {
-            self[old..].fill(value);
-        }
-    }
-}
-
-impl Clone for AlignedVec3 {
-    fn clone(&self) -> Self {
-        Self {
-            lines: self.lines.clone(),
-            len: self.len,
-        }
-    }
-
-    /// Reuses the allocation when it is large enough (as `Vec::clone_from` does).
-    fn clone_from(&mut self, source: &Self) {
-        self.lines.clone_from(&source.lines);
-        self.len = source.len;
-    }
-}
-
-impl PartialEq for AlignedVec3 {
-    fn eq(&self, other: &Self) -> bool {
-        self[..] == other[..]
-    }
-}
-
-impl std::fmt::Debug for AlignedVec3 {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self[..].fmt(f)
-    }
-}
-
-impl Deref for AlignedVec3 {
-    type Target = [crate::Vec3];
-
-    fn deref(&self) -> &[crate::Vec3] {
-        // SAFETY: `Vec3` (nalgebra's `Matrix`, `repr(C)` over `[[f64; 3]; 1]`) is three f64s
-        // with no padding and alignment 8; the lines are `8 * lines.len() >= 3 * len`
-        // contiguous, initialised f64s starting at alignment 64, and any f64 bits are valid.
-        unsafe { std::slice::from_raw_parts(self.lines.as_ptr().cast::<crate::Vec3>(), self.len) }
-    }
-}
-
-impl DerefMut for AlignedVec3 {
-    fn deref_mut(&mut self) -> &mut [crate::Vec3] {
-        // SAFETY: as in `deref`, and `&mut self` borrows the lines exclusively.
-        unsafe { std::slice::from_raw_parts_mut(self.lines.as_mut_ptr().cast::<crate::Vec3>(), self.len) }
-    }
-}
-
-impl<'a> IntoIterator for &'a AlignedVec3 {
-    type Item = &'a crate::Vec3;
-    type IntoIter = std::slice::Iter<'a, crate::Vec3>;
+impl<'a, T: Element> IntoIterator for &'a Aligned<T> {
+    type Item = &'a T;
+    type IntoIter = std::slice::Iter<'a, T>;
 
     fn into_iter(self) -> Self::IntoIter {
         self.iter()
     }
 }
 
-impl<'a> IntoIterator for &'a mut AlignedVec3 {
-    type Item = &'a mut crate::Vec3;
-    type IntoIter = std::slice::IterMut<'a, crate::Vec3>;
+impl<'a, T: Element> IntoIterator for &'a mut Aligned<T> {
+    type Item = &'a mut T;
+    type IntoIter = std::slice::IterMut<'a, T>;
 
     fn into_iter(self) -> Self::IntoIter {
         self.iter_mut()
     }
 }
-
-const _: () = assert!(std::mem::size_of::<crate::Vec3>() == 24 && std::mem::align_of::<crate::Vec3>() <= 64);
 
 #[cfg(test)]
 mod tests {
@@ -241,10 +220,10 @@ mod tests {
         let mut a = AlignedVec3::from_slice(&src);
         assert_eq!(&a[..], &src[..]);
         assert_eq!(a.as_ptr() as usize % 64, 0);
-        a.resize(4, Vec3::zeros());
-        a.resize(7, Vec3::new(1.0, 2.0, 3.0));
+        a.resize(4);
+        a.resize(7);
         let mut want = src[..4].to_vec();
-        want.resize(7, Vec3::new(1.0, 2.0, 3.0));
+        want.resize(7, Vec3::zeros());
         assert_eq!(&a[..], &want[..]);
         let mut b = AlignedVec3::default();
         b.clone_from(&a);
