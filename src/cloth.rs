@@ -203,14 +203,13 @@ impl Cloth {
             &topology.triangles,
             config.model.self_collision_thickness,
         )?;
-        let x = topology.rest_positions.clone();
         Ok(Self {
             v: crate::aligned::AlignedVec3::zeros(n),
             pinned: vec![false; n],
             pin_weight: vec![0.0; n],
             pin_list: Vec::new(),
-            pin_target: x.clone(),
-            x: crate::aligned::AlignedVec3::from_slice(&x),
+            pin_target: topology.rest_positions.clone(),
+            x: crate::aligned::AlignedVec3::from_slice(&topology.rest_positions),
             collider_slots: Vec::new(),
             colliders: Vec::new(),
             friction: Vec::new(),

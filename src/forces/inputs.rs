@@ -199,7 +199,6 @@ mod tests {
                     q: [&[]; 3],
                     base: 0,
                     rest: &[],
-                    kinds: &[],
                 };
                 let p = w.params(&p);
                 let end = upto.min(n);

@@ -34,9 +34,9 @@ pub(super) struct Params<'a> {
     /// The particle at index 0 of `x` and `q`: 0 for whole-cloth arrays, the window's first
     /// particle for a tile walk's window ([`super::inputs`]).
     pub base: usize,
-    /// Rest length and family of each spring (or slot of a padded run).
+    /// Rest length of each spring (or slot of a padded run); a run's family is its own
+    /// (`SpringRun::kind`).
     pub rest: &'a [f64],
-    pub kinds: &'a [u8],
 }
 
 /// Copies of the positions and of the damping rate in component arrays, reused between steps.
@@ -114,7 +114,6 @@ pub(super) fn params<'a>(
         },
         base: 0,
         rest: &t.spring_rest,
-        kinds: &t.spring_kinds,
     }
 }
 
@@ -172,7 +171,7 @@ fn run_kernel<'a, const UNIFORM: bool, const TWO: bool>(
     let (fy, fz) = (&mut fy[..n], &mut fz[..n]);
     let i0 = run.first_vertex as usize + (first_spring - run.first_spring as usize);
     let j0 = i0 + run.offset as usize;
-    let ks = p.stiffness[p.kinds[first_spring] as usize];
+    let ks = p.stiffness[usize::from(run.kind)];
     let ends = |a: [&'a [f64]; 3], s: usize| [&a[0][s..s + n], &a[1][s..s + n], &a[2][s..s + n]];
     let (i0, j0) = (i0 - p.base, j0 - p.base);
     let ([xi, yi, zi], [xj, yj, zj]) = (ends(p.x, i0), ends(p.x, j0));
@@ -182,7 +181,7 @@ fn run_kernel<'a, const UNIFORM: bool, const TWO: bool>(
     } else {
         &p.rest[first_spring..first_spring + n]
     };
-    let kd = p.kd[p.kinds[first_spring] as usize];
+    let kd = p.kd[usize::from(run.kind)];
     let (ks2, kd2) = match run.second {
         Some(b) if TWO => (p.stiffness[usize::from(b)], p.kd[usize::from(b)]),
         _ => (ks, kd),

@@ -68,7 +68,6 @@ pub(super) fn spring_forces<F>(
     let max_offset = t.tile_runs.max_offset;
     let p = &Params {
         rest: &t.tile_runs.rest,
-        kinds: &t.tile_runs.kinds,
         ..*p
     };
     window.fill(0.0);
@@ -151,11 +150,7 @@ pub(super) fn spring_forces_gathered<F>(
     let tr = &t.tile_runs;
     let (runs, w, lead) = (&tr.runs, layout.force_window, layout.lead);
     debug_assert!(runs.len() == layout.gather_runs && w >= lead + TILE && lead >= tr.max_offset);
-    let p = &Params {
-        rest: &tr.rest,
-        kinds: &tr.kinds,
-        ..*p
-    };
+    let p = &Params { rest: &tr.rest, ..*p };
     let (forces, sums) = scratch.split_at_mut(3 * w * runs.len());
     let c1 = c0 + len;
     // Particle i's entry in a force window is `i + lead - origin`: the windows start `lead`

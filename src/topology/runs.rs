@@ -146,8 +146,6 @@ pub struct TileRuns {
     /// Rest length of each slot, m: negated for a run's second family, [`PAD_REST`] (NaN) for
     /// padding.
     pub rest: Vec<f64>,
-    /// Family of each slot's run (`SpringRun::kind`).
-    pub kinds: Vec<u8>,
     /// The padding slots, ascending.
     pub pads: Vec<u32>,
     /// Per run: the rest length every spring of it has, when they all have the same one (a
@@ -195,10 +193,9 @@ impl TileRuns {
     fn padded(n: usize, springs: &[Spring], runs: &[SpringRun], max_gap: u32) -> Self {
         let mut t = Self::default();
         for r in runs {
-            let kind = r.kind;
             let gap = t.runs.last().and_then(|last| {
                 let end = last.first_vertex + last.len;
-                let same = (last.kind, last.second) == (kind, r.second) && last.offset == r.offset;
+                let same = (last.kind, last.second, last.offset) == (r.kind, r.second, r.offset);
                 (same && r.first_vertex >= end && r.first_vertex - end <= max_gap)
                     .then(|| r.first_vertex - end)
             });
@@ -207,7 +204,6 @@ impl TileRuns {
                     for _ in 0..gap {
                         t.pads.push(t.rest.len() as u32);
                         t.rest.push(PAD_REST);
-                        t.kinds.push(kind);
                     }
                     last.len += gap + r.len;
                 }
@@ -220,7 +216,6 @@ impl TileRuns {
             for s in &springs[r.first_spring as usize..(r.first_spring + r.len) as usize] {
                 let second = r.second == Some(s.kind as u8);
                 t.rest.push(if second { -s.rest } else { s.rest });
-                t.kinds.push(kind);
             }
         }
         t.uniform_rest = t.runs.iter().map(|r| t.uniform(r)).collect();
@@ -234,7 +229,6 @@ impl TileRuns {
             .collect();
         // Built by pushes: drop the spare capacity (these live as long as the cloth).
         t.rest.shrink_to_fit();
-        t.kinds.shrink_to_fit();
         t.pads.shrink_to_fit();
         t.runs.shrink_to_fit();
         t.chunk_runs = super::Adjacency::chunk_runs(n, &t.runs);
@@ -353,7 +347,7 @@ mod tests {
                     Some(s) => {
                         assert!(!pads.contains(&slot));
                         assert_eq!(p.rest[slot], t.springs[s].rest);
-                        assert_eq!(p.kinds[slot], t.springs[s].kind as u8);
+                        assert_eq!(r.kind, t.springs[s].kind as u8);
                         seen[s] += 1;
                     }
                     None => assert!(pads.contains(&slot) && p.rest[slot].is_nan()),
@@ -377,7 +371,7 @@ mod tests {
             .runs
             .iter()
             .zip(&p.uniform_rest)
-            .partition(|(r, _)| p.kinds[r.first_spring as usize] == kind && r.first_vertex == 0);
+            .partition(|(r, _)| r.kind == kind && r.first_vertex == 0);
         assert!(with.iter().any(|(_, u)| u.is_none()));
         assert!(without.iter().all(|(_, u)| u.is_some()));
     }
