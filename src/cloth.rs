@@ -159,6 +159,9 @@ pub struct Cloth {
     mesh_slots: Vec<Option<MeshCollider>>,
     /// Self-collision's search and remembered sides (`collide/self_collision.rs`).
     self_collision: SelfCollision,
+    /// Where the mesh colliders were (a fraction of the call's travel) when the last accepted
+    /// step of this call ended: where the next step's continuous check starts them.
+    mesh_from: f64,
     /// The half-derivative memories the model's terms and pair elements read.
     histories: Histories,
     time: f64,
@@ -215,6 +218,7 @@ impl Cloth {
             friction: Vec::new(),
             mesh_slots: Vec::new(),
             self_collision,
+            mesh_from: 0.0,
             histories: Histories::new(&config.model, config.scheme, &topology)?,
             time: 0.0,
             steps: 0,
@@ -605,13 +609,22 @@ impl Cloth {
             ..StepStats::default()
         };
         let extrapolated = self.config.integrator.is_extrapolated();
+        self.mesh_from = 0.0;
         if substeps == 1 && !extrapolated {
-            return self.advance(StepPlan::new(
+            // Nothing to roll back but what self-collision learns in the step (its sides).
+            let mut saved = std::mem::take(&mut self.rollback.self_collision);
+            self.self_collision.save_memory(&mut saved);
+            let done = self.advance(StepPlan::new(
                 self.config.integrator,
                 dt,
                 None,
                 step::Stage::Whole,
             ));
+            if done.is_err() {
+                self.self_collision.swap_memory(&mut saved);
+            }
+            self.rollback.self_collision = saved;
+            return done;
         }
         let h = dt / f64::from(substeps);
         let mut snap = std::mem::take(&mut self.rollback);

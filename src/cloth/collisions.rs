@@ -4,9 +4,10 @@
 
 use super::Cloth;
 use crate::bytes::{ByteReader, ByteWriter};
+use crate::collide::impact_zones::{keep_from_passing, ZoneInput};
 use crate::collide::mesh::{candidate_room, CANDIDATES_PER_VERTEX};
 use crate::collide::room::Full;
-use crate::collide::self_collision::Pair;
+use crate::collide::self_collision::{Pair, ZoneTotals};
 use crate::collide::{contact, Contact, MeshCollider};
 use crate::error::Error;
 use crate::math::Vec3;
@@ -20,6 +21,11 @@ const MESH_MAX_DEPTH_MARGINS: f64 = 3.0;
 /// Self-collision's step limit: no free vertex moves more than this fraction of the thickness
 /// in one step (a faster one is slowed to it; `Cloth::limit_collision_step`).
 pub const SELF_COLLISION_STEP_LIMIT: f64 = 0.5;
+/// How near (in thicknesses) a vertex and a triangle, or two edges, must come at a coplanar
+/// instant of a step for self-collision's continuous check to call it a passage.
+pub const PASSAGE_TOLERANCE: f64 = 1e-3;
+/// At most this many rounds of the mesh colliders' continuous check in a step.
+pub const MESH_PASSAGE_ROUNDS: usize = 4;
 
 impl Cloth {
     /// Adds a triangle-mesh collider (vertices in m, triangles as vertex indices, velocities
@@ -67,6 +73,12 @@ impl Cloth {
     /// Self-collision's remembered pairs (vertex-triangle, edge-edge; each `(a, b, side)`).
     pub fn self_collision_pairs(&self) -> (&[Pair], &[Pair]) {
         self.self_collision.pairs()
+    }
+
+    /// What self-collision's impact zones did since the cloth was made (the step's fail-safe:
+    /// `collide::impact_zones`).
+    pub fn self_collision_zones(&self) -> ZoneTotals {
+        self.self_collision.zones
     }
 
     /// How many times self-collision looked its pairs up again since the cloth was made.
@@ -237,6 +249,111 @@ impl Cloth {
             &self.pinned,
             &mut s.v_new,
         )
+    }
+
+    /// The mesh colliders' continuous check, after the step with the pins placed
+    /// (`MeshCollider::passages`): a cloth vertex, triangle or edge that would pass through a
+    /// mesh collider in this step is carried by the mesh instead (its free vertices moved by
+    /// the mesh's displacement there, their velocities that over the step), so a collider
+    /// too fast for the penalty to stop the cloth within its margin still cannot go through.
+    /// Looked at again (the carried vertices may meet another face) up to
+    /// [`MESH_PASSAGE_ROUNDS`] times. Returns how many vertices were carried.
+    pub(super) fn carry_through_meshes(&mut self, h: f64, fraction: Option<f64>) -> usize {
+        let s = &mut self.scratch;
+        s.carried.clear();
+        if self.mesh_slots.iter().all(Option::is_none) {
+            return 0;
+        }
+        let (f0, f1) = (self.mesh_from, fraction.unwrap_or(1.0));
+        let tolerance = PASSAGE_TOLERANCE * self.config.model.collision_margin;
+        for _ in 0..MESH_PASSAGE_ROUNDS {
+            s.mesh_passages.clear();
+            for mesh in self.mesh_slots.iter().flatten() {
+                mesh.passages(
+                    &self.x,
+                    &s.x_new,
+                    &self.topology.triangles,
+                    f0,
+                    f1,
+                    tolerance,
+                    &mut s.mesh_passages,
+                );
+            }
+            if s.mesh_passages.is_empty() {
+                break;
+            }
+            for p in &s.mesh_passages {
+                for &i in &p.cloth {
+                    let i = i as usize;
+                    if !self.pinned[i] {
+                        s.x_new[i] = self.x[i] + p.carry;
+                        s.v_new[i] = p.carry / h;
+                        s.carried.push(i as u32);
+                    }
+                }
+            }
+        }
+        s.carried.sort_unstable();
+        s.carried.dedup();
+        s.carried.len()
+    }
+
+    /// Self-collision's impact zones, after the step with the pins placed
+    /// (`collide::impact_zones`): a free vertex that would pass through a triangle of the
+    /// cloth, or an edge through an edge, in this step moves as one with the others of its
+    /// zone (with a pinned row that presses it, or at their shared momentum), its velocity its
+    /// new displacement over the step. Returns how many vertices were moved.
+    pub(super) fn impact_zones(&mut self, h: f64) -> usize {
+        let thickness = self.config.model.self_collision_thickness;
+        let sc = &self.self_collision;
+        if thickness <= 0.0 || (sc.vertex_triangle.is_empty() && sc.edge_edge.is_empty()) {
+            return 0;
+        }
+        let super::step::StepScratch {
+            carried,
+            kinematic,
+            x_new,
+            v_new,
+            zone_moved,
+            zone_stopped,
+            ..
+        } = &mut self.scratch;
+        // Vertices a mesh carried this step are held like pins.
+        let kinematic = if carried.is_empty() {
+            &self.pinned
+        } else {
+            kinematic.clone_from(&self.pinned);
+            for &i in carried.iter() {
+                kinematic[i as usize] = true;
+            }
+            &*kinematic
+        };
+        let input = ZoneInput {
+            x0: &self.x,
+            masses: &self.topology.masses,
+            kinematic,
+            triangles: &self.topology.triangles,
+            vertex_triangles: sc.vertex_triangles(),
+            neighbours: sc.excluded_rows(),
+            edges: sc.edges(),
+            vertex_triangle: &sc.vertex_triangle,
+            edge_edge: &sc.edge_edge,
+            tolerance: PASSAGE_TOLERANCE * thickness,
+        };
+        let report = keep_from_passing(&input, x_new, zone_moved, zone_stopped);
+        for &i in zone_moved.iter() {
+            let i = i as usize;
+            v_new[i] = (x_new[i] - self.x[i]) / h;
+        }
+        self.self_collision.zones.add(&report);
+        report.moved
+    }
+
+    /// After a step the impact zones changed, once it is accepted: a pair kept from passing
+    /// stays on the side it started on, and that is its side now (a remembered side it was not
+    /// on would have the contacts push it through at the next step).
+    pub(super) fn learn_stopped_sides(&mut self) {
+        self.self_collision.relearn_sides(&self.scratch.zone_stopped);
     }
 
     /// Self-collision's step limit ([`SELF_COLLISION_STEP_LIMIT`]): a free vertex that would

@@ -106,6 +106,16 @@ pub(super) struct StepScratch {
     pub prior_forces: Vec<Vec3>,
     /// The collision pass's contact elements (mesh colliders, self-collision).
     pub contacts: Vec<crate::collide::Contact>,
+    /// The free vertices self-collision's impact zones moved this step.
+    pub zone_moved: Vec<u32>,
+    /// The cloth's passages through the mesh colliders this step, the free vertices they
+    /// carried (ascending) and, when some were, the vertices the impact zones may not move
+    /// (pinned or carried).
+    pub mesh_passages: Vec<crate::collide::mesh::MeshPassage>,
+    pub carried: Vec<u32>,
+    pub kinematic: Vec<bool>,
+    /// The passages they stopped (`collide::impact_zones`).
+    pub zone_stopped: Vec<crate::collide::impact_zones::Passage>,
     /// The mesh colliders' contacts where a call begins, and each vertex's weight from them
     /// (`Cloth::measure_contact_weights`; empty without contacts).
     pub start_contacts: Vec<crate::collide::Contact>,
@@ -130,7 +140,8 @@ pub(super) struct Rollback {
     pub(super) v: crate::aligned::AlignedVec3,
     histories: Option<Histories>,
     /// Self-collision's remembered pairs and sides (state: a snapshot carries them).
-    self_collision: crate::collide::self_collision::SavedMemory,
+    pub(super) self_collision: crate::collide::self_collision::SavedMemory,
+    mesh_from: f64,
     time: f64,
     steps: u64,
 }
@@ -154,6 +165,7 @@ impl Rollback {
             None => self.histories = Some(c.histories.clone()),
         }
         c.self_collision.save_memory(&mut self.self_collision);
+        self.mesh_from = c.mesh_from;
         self.time = c.time;
         self.steps = c.steps;
         Ok(())
@@ -166,6 +178,7 @@ impl Rollback {
             std::mem::swap(&mut c.histories, h);
         }
         c.self_collision.swap_memory(&mut self.self_collision);
+        c.mesh_from = self.mesh_from;
         c.time = self.time;
         c.steps = self.steps;
     }
@@ -206,8 +219,14 @@ impl Cloth {
         let friction = self.friction(h) | self.contact_friction(h);
         let limited = self.limit_collision_step() > 0;
         self.pins(h);
-        self.check(h, integrated_sound && !friction && !limited)?;
+        let carried = self.carry_through_meshes(h, plan.fraction) > 0;
+        let zoned = self.impact_zones(h) > 0;
+        self.check(h, integrated_sound && !friction && !limited && !carried && !zoned)?;
+        if zoned {
+            self.learn_stopped_sides();
+        }
         self.commit(h);
+        self.mesh_from = plan.fraction.unwrap_or(1.0);
         Ok(())
     }
 

@@ -27,6 +27,7 @@ impl Aabb {
     }
 
     /// The box of some points.
+    #[inline]
     pub fn of<'a>(points: impl IntoIterator<Item = &'a Vec3>) -> Aabb {
         let mut b = Aabb::empty();
         for p in points {
@@ -35,6 +36,7 @@ impl Aabb {
         b
     }
 
+    #[inline]
     pub fn grow(&mut self, p: &Vec3) {
         // Component by component (the generic `inf` / `sup` cost several times as much).
         self.min = Vec3::new(self.min.x.min(p.x), self.min.y.min(p.y), self.min.z.min(p.z));
@@ -49,6 +51,7 @@ impl Aabb {
     }
 
     /// The box grown by `r` on every side.
+    #[inline]
     pub fn inflated(&self, r: f64) -> Aabb {
         Aabb {
             min: self.min.add_scalar(-r),
@@ -56,6 +59,7 @@ impl Aabb {
         }
     }
 
+    #[inline]
     pub fn overlaps(&self, o: &Aabb) -> bool {
         // Every comparison made, none skipped: one branch, not six hard to predict.
         (self.min.x <= o.max.x)

@@ -38,6 +38,7 @@
 //! that have candidates.
 
 use super::bvh::{Aabb, Bvh};
+use super::ccd::{edge_passes_edge, start_sign, vertex_passes_triangle, Path};
 use super::contact::Contact;
 use super::geometry::{closest_on_segments, closest_on_triangle, edges_of, offset_from_triangle};
 use super::room::{Full, Room};
@@ -77,6 +78,8 @@ pub struct MeshCollider {
     edges: Vec<[u32; 2]>,
     edge_boxes: Vec<Aabb>,
     edge_bvh: Bvh,
+    /// The farthest any vertex travels over the current call, m.
+    travel: f64,
     /// Whether the boxes and normals are those of `start` and `target` at `reach`.
     fresh_at: f64,
     /// Coulomb friction coefficient.
@@ -84,6 +87,14 @@ pub struct MeshCollider {
     /// Its own margin, m, or the cloth's (`None`).
     pub margin: Option<f64>,
     cache: Candidates,
+}
+
+/// A passage of the cloth through a mesh collider in a step: the cloth vertices it takes (one,
+/// two or three, repeated to fill) and the mesh's displacement there over the step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshPassage {
+    pub cloth: [u32; 3],
+    pub carry: Vec3,
 }
 
 /// Each cloth vertex's, triangle's and edge's candidates (see the module docs), and which of
@@ -113,6 +124,11 @@ struct Candidates {
     /// Whether each cloth vertex touches the mesh at this substep (its edges then need no
     /// edge contact), and the vertices set.
     touching: Vec<bool>,
+    /// Whether each cloth vertex is inside the (closed) mesh at this substep (touching too).
+    inside: Vec<bool>,
+    /// Each cloth vertex's (unsigned) distance from its nearest candidate triangle at this
+    /// substep (infinite with none), for the continuous check's first cut.
+    distance: Vec<f64>,
     touched: Vec<u32>,
     /// Every list must be looked up again (the mesh moved, or the cloth changed).
     stale: bool,
@@ -239,6 +255,8 @@ impl MeshCollider {
             edges: Vec::new(),
             edge_boxes: Vec::new(),
             edge_bvh: Bvh::default(),
+            // Unknown until a call begins: the continuous check then cuts nothing by distance.
+            travel: f64::INFINITY,
             fresh_at: f64::NAN,
             friction: 0.0,
             margin: None,
@@ -337,6 +355,13 @@ impl MeshCollider {
         } else {
             self.velocity.copy_from_slice(&self.given_velocity);
         }
+        self.travel = self
+            .start
+            .iter()
+            .zip(&self.target)
+            .map(|(s, t)| (t - s).norm_squared())
+            .fold(0.0, f64::max)
+            .sqrt();
         self.refresh(reach);
     }
 
@@ -505,9 +530,12 @@ impl MeshCollider {
         c.nearest.resize(x.len(), NONE);
         for &i in &c.touched {
             c.touching[i as usize] = false;
+            c.inside[i as usize] = false;
         }
         c.touched.clear();
         c.touching.resize(x.len(), false);
+        c.inside.resize(x.len(), false);
+        c.distance.resize(x.len(), f64::INFINITY);
         let friction = self.friction;
         // Cloth vertex against the nearest mesh triangle.
         for &i in &self.cache.with_vertex {
@@ -535,10 +563,14 @@ impl MeshCollider {
             if let (Some(b), Some(slot)) = (&best, self.cache.nearest.get_mut(i)) {
                 *slot = b.1;
             }
+            if let Some(slot) = self.cache.distance.get_mut(i) {
+                *slot = best.as_ref().map_or(f64::INFINITY, |b| b.0);
+            }
             if let Some((d, t, w, r)) = best {
                 let (d, dir) = self.signed(t, d, w, &r);
                 if d < margin {
                     self.cache.touching[i] = true;
+                    self.cache.inside[i] = d < 0.0;
                     self.cache.touched.push(i as u32);
                     out.push(Contact {
                         idx: [i as u32, 0, 0, 0],
@@ -630,6 +662,111 @@ impl MeshCollider {
             }
         }
         Ok(())
+    }
+
+    /// The cloth's passages through this mesh over a step (continuous check, `ccd.rs`): the
+    /// cloth moving from `x0` to `x1` and the mesh from fraction `f0` to `f1` of the call, each
+    /// cloth vertex against its candidate triangles, each cloth triangle against its candidate
+    /// mesh vertices and each cloth edge against its candidate active edges. Each passage is
+    /// appended to `out` as the cloth vertices it takes and the mesh's displacement there over
+    /// the step (the mean of the mesh element's vertices'), which carries them.
+    #[allow(clippy::too_many_arguments)] // the cloth's arrays, the step's ends and the tolerance
+    pub(crate) fn passages(
+        &self,
+        x0: &[Vec3],
+        x1: &[Vec3],
+        cloth_triangles: &[[u32; 3]],
+        f0: f64,
+        f1: f64,
+        tolerance: f64,
+        out: &mut Vec<MeshPassage>,
+    ) {
+        let c = &self.cache;
+        // A closed mesh has an inside: a vertex found there is being pushed out, and its way
+        // out through the surface is not stopped (nor are its triangles' and edges').
+        let inside = |i: u32| self.closed && c.inside.get(i as usize).copied().unwrap_or(false);
+        let path = |i: u32| (x0[i as usize], x1[i as usize]);
+        let mesh_path = |m: u32| (self.at(m, f0), self.at(m, f1));
+        let carry = |ms: &[u32]| {
+            ms.iter()
+                .fold(Vec3::zeros(), |s, &m| s + (self.at(m, f1) - self.at(m, f0)))
+                / ms.len() as f64
+        };
+        // Swept boxes first: a passage needs the two elements' boxes over the step to meet.
+        let swept = |ps: &[(Vec3, Vec3)]| Aabb::of(ps.iter().flat_map(|p| [&p.0, &p.1])).inflated(tolerance);
+        // No part of the mesh moves farther than this in the step.
+        let travel = (f1 - f0).abs() * self.travel + tolerance;
+        for &i in &c.with_vertex {
+            let pi = path(i);
+            // A vertex farther from the mesh (where it starts, from where the mesh ends) than
+            // both can move in the step meets none of its triangles.
+            let reach = (pi.1 - pi.0).norm() + travel;
+            if c.distance.get(i as usize).is_none_or(|&d| d > reach) {
+                continue;
+            }
+            let own = swept(&[pi]);
+            for &t in &c.vertex[i as usize] {
+                let [a, b, m] = self.triangles[t as usize];
+                let p: Path = [mesh_path(a), mesh_path(b), mesh_path(m), pi];
+                if !own.overlaps(&swept(&p[..3])) {
+                    continue;
+                }
+                // Through a closed mesh's face from behind it (the faces wind outwards): on
+                // its way out.
+                if self.closed && start_sign(&p) < 0 {
+                    continue;
+                }
+                if vertex_passes_triangle(&p, tolerance).is_some() {
+                    out.push(MeshPassage {
+                        cloth: [i, i, i],
+                        carry: carry(&[a, b, m]),
+                    });
+                }
+            }
+        }
+        for &t in &c.with_triangle {
+            let tri = cloth_triangles[t as usize];
+            if tri.iter().any(|&i| inside(i)) {
+                continue;
+            }
+            let corners = tri.map(path);
+            let own = swept(&corners);
+            for &m in &c.triangle[t as usize] {
+                let q = mesh_path(m);
+                if !own.overlaps(&swept(&[q])) {
+                    continue;
+                }
+                let p: Path = [corners[0], corners[1], corners[2], q];
+                if vertex_passes_triangle(&p, tolerance).is_some() {
+                    out.push(MeshPassage {
+                        cloth: tri,
+                        carry: carry(&[m]),
+                    });
+                }
+            }
+        }
+        for &e in &c.with_edge {
+            let [i0, i1] = c.cloth_edges[e as usize];
+            if inside(i0) || inside(i1) {
+                continue;
+            }
+            let ends = [path(i0), path(i1)];
+            let own = swept(&ends);
+            for &m in &c.edge[e as usize] {
+                let [j0, j1] = self.edges[m as usize];
+                let other = [mesh_path(j0), mesh_path(j1)];
+                if !own.overlaps(&swept(&other)) {
+                    continue;
+                }
+                let p: Path = [ends[0], ends[1], other[0], other[1]];
+                if edge_passes_edge(&p, tolerance).is_some() {
+                    out.push(MeshPassage {
+                        cloth: [i0, i1, i1],
+                        carry: carry(&[j0, j1]),
+                    });
+                }
+            }
+        }
     }
 
     /// Looks up again the candidates of every cloth vertex that moved more than `skin / 2`
@@ -983,6 +1120,55 @@ mod tests {
         m.contacts(&cloth, &[[0, 2, 1]], 1.0, 0.01, 0.01, 1.0, &mut out)
             .expect("room for a test mesh");
         assert!(out.iter().any(|c| c.len == 3 && c.dir.y > 0.99), "{out:?}");
+    }
+
+    /// A bar that moves right through a cloth triangle within one step is found passing it
+    /// (a bar vertex through the triangle), with the bar's displacement to carry it by; the
+    /// same bar stopping short of the triangle is not.
+    #[test]
+    fn a_bar_through_a_cloth_triangle_in_one_step_is_a_passage() {
+        let (x, t) = bar(Vec3::new(0.3, 0.29, -1.0), Vec3::new(0.3, 0.29, 1.0), 0.002, 2);
+        let cloth = vec![
+            Vec3::new(-1.0, 0.305, -1.0),
+            Vec3::new(2.0, 0.305, -1.0),
+            Vec3::new(-1.0, 0.305, 2.0),
+        ];
+        let tris = [[0, 2, 1]];
+        for (rise, passes) in [(0.03, true), (0.01, false)] {
+            let mut m = MeshCollider::new(&x, &t, None).unwrap();
+            let moved: Vec<Vec3> = x.iter().map(|p| p + Vec3::new(0.0, rise, 0.0)).collect();
+            m.set(&moved, None).unwrap();
+            m.begin_call(0.01, 0.03);
+            m.contacts(&cloth, &tris, 1.0, 0.01, 0.01, 1.0, &mut Vec::new())
+                .expect("room for a test mesh");
+            let mut out = Vec::new();
+            m.passages(&cloth, &cloth, &tris, 0.0, 1.0, 1e-6, &mut out);
+            assert_eq!(!out.is_empty(), passes, "rise {rise}: {out:?}");
+            assert_eq!(out.iter().any(|p| p.cloth == [0, 2, 1]), passes, "{out:?}");
+            for p in &out {
+                // Through the triangle, or a bar edge through a cloth edge.
+                assert!(p.cloth.iter().all(|i| [0, 1, 2].contains(i)), "{p:?}");
+                assert!((p.carry - Vec3::new(0.0, rise, 0.0)).norm() < 1e-12, "{p:?}");
+            }
+        }
+    }
+
+    /// Through a closed mesh's surface inwards is a passage; outwards (a vertex found inside,
+    /// on its way out) is not.
+    #[test]
+    fn only_the_way_into_a_closed_mesh_is_a_passage() {
+        let (x, t) = uv_sphere(Vec3::zeros(), 0.5, 24, 12);
+        let mut m = MeshCollider::new(&x, &t, None).unwrap();
+        m.begin_call(1.0 / 30.0, 0.03);
+        let outside = vec![Vec3::new(0.0, 0.51, 0.0)];
+        let inside = vec![Vec3::new(0.0, 0.47, 0.0)];
+        for (from, to, passes) in [(&outside, &inside, true), (&inside, &outside, false)] {
+            m.contacts(from, &[], 1.0, 0.05, 0.02, 10.0, &mut Vec::new())
+                .expect("room for a test mesh");
+            let mut out = Vec::new();
+            m.passages(from, to, &[], 0.0, 1.0, 1e-6, &mut out);
+            assert_eq!(!out.is_empty(), passes, "{from:?} -> {to:?}: {out:?}");
+        }
     }
 
     /// A cloth lying on a mesh much finer than itself is held by its vertices' contacts alone:

@@ -6,6 +6,8 @@
 //! | `geometry.rs` | closest points and crossings of points, segments and triangles |
 //! | `intersections.rs` | counting self-intersections and vertices inside a mesh (tests, reports) |
 //! | `bvh.rs` | a bounding-volume hierarchy over boxes, refitted as things move |
+//! | `ccd.rs` | continuous collision: when a vertex passes a triangle, an edge an edge, in a step |
+//! | `impact_zones.rs` | the fail-safe after a step: vertices that would pass move as one |
 //! | `contact.rs` | the contact element: force, Jacobian blocks, friction |
 //! | `mesh.rs` | triangle-mesh colliders |
 //! | `neighbours.rs` | self-collision's pairs as the rest shape tells them: excluded, and rest-near |
@@ -15,8 +17,10 @@
 //! | `shapes.rs` | closed meshes of simple solids (scenes and tests) |
 
 pub mod bvh;
+pub mod ccd;
 pub mod contact;
 pub mod geometry;
+pub mod impact_zones;
 pub mod intersections;
 pub mod mesh;
 mod neighbours;

@@ -95,6 +95,11 @@ impl Exclusions {
         self.vt.len() + self.ee.len()
     }
 
+    /// The excluded triangles of every vertex as compressed rows (starts, entries).
+    pub(super) fn vertex_rows(&self) -> (&[u32], &[u32]) {
+        (&self.vt_start, &self.vt)
+    }
+
     pub(super) fn vertex_excludes(&self, p: u32, t: u32) -> bool {
         let (a, b) = (
             self.vt_start[p as usize] as usize,

@@ -30,6 +30,7 @@
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
 use super::geometry::{closest_on_segments, edges_of, offset_from_triangle};
+use super::impact_zones::{PairRef, Passage};
 use super::neighbours::{Exclusions, NearPairs};
 use super::ownership::Ownership;
 use super::room::{Full, Room};
@@ -57,6 +58,30 @@ pub const PAIRS_PER_VERTEX: usize = 1024;
 /// both).
 pub type Pair = (u32, u32, i8);
 
+/// What self-collision's impact zones did over many steps (`impact_zones.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ZoneTotals {
+    /// Steps in which some pair would have passed through another.
+    pub steps: u64,
+    /// Passages found (in the first round of each step).
+    pub passages: u64,
+    /// Free vertices moved with a zone, summed over the steps.
+    pub moved: u64,
+    /// Passages left after the zones (0: every listed pair was kept from passing).
+    pub unresolved: u64,
+}
+
+impl ZoneTotals {
+    pub(crate) fn add(&mut self, r: &super::impact_zones::ZoneReport) {
+        if r.passages > 0 {
+            self.steps += 1;
+        }
+        self.passages += r.passages as u64;
+        self.moved += r.moved as u64;
+        self.unresolved += r.unresolved as u64;
+    }
+}
+
 /// What self-collision remembers across steps, saved by a rollback.
 #[derive(Clone, Debug, Default)]
 pub struct SavedMemory {
@@ -78,6 +103,8 @@ pub struct SelfCollision {
     tri_bvh: Bvh,
     /// Which triangle owns each vertex and edge (the walk meets each pair once).
     owners: Ownership,
+    /// The triangles of each vertex (the impact zones' test of a pair already tangled).
+    vertex_triangles: crate::topology::Adjacency,
     /// Positions at the last look; empty before the first.
     looked_at: Vec<Vec3>,
     /// Vertex-triangle and edge-edge pairs, sorted, with their sides.
@@ -85,6 +112,8 @@ pub struct SelfCollision {
     pub(crate) edge_edge: Vec<Pair>,
     /// How many times the list was looked up again (for benchmarks).
     pub looks: u64,
+    /// What the impact zones did after the steps (`impact_zones.rs`).
+    pub zones: ZoneTotals,
     /// Pairs never tested: nearer than 2.2 thicknesses at rest (neighbours), per vertex and
     /// per edge, for the thickness they were found at.
     excluded: Exclusions,
@@ -300,8 +329,10 @@ impl Search<'_> {
 impl SelfCollision {
     /// Sets up the search for a cloth of these triangles.
     pub fn new(triangles: &[[u32; 3]]) -> SelfCollision {
+        let n = triangles.iter().flatten().max().map_or(0, |&m| m as usize + 1);
         SelfCollision {
             edges: edges_of(triangles),
+            vertex_triangles: crate::topology::Adjacency::triangles(n, triangles),
             ..SelfCollision::default()
         }
     }
@@ -676,6 +707,34 @@ impl SelfCollision {
     }
 
     /// Edge count (for checking a snapshot's pairs).
+    /// Sets the side of every pair in `stopped` to the sign it started its step with (the
+    /// impact zones kept it there).
+    pub(crate) fn relearn_sides(&mut self, stopped: &[Passage]) {
+        for p in stopped {
+            let pair = match p.pair {
+                PairRef::VertexTriangle(k) => self.vertex_triangle.get_mut(k as usize),
+                PairRef::EdgeEdge(k) => self.edge_edge.get_mut(k as usize),
+                PairRef::Neighbour => None,
+            };
+            if let Some(pair) = pair {
+                pair.2 = p.sign;
+            }
+        }
+    }
+
+    /// Each vertex's excluded triangles (neighbours at rest) as compressed rows.
+    pub(crate) fn excluded_rows(&self) -> (&[u32], &[u32]) {
+        self.excluded.vertex_rows()
+    }
+
+    pub(crate) fn vertex_triangles(&self) -> &crate::topology::Adjacency {
+        &self.vertex_triangles
+    }
+
+    pub(crate) fn edges(&self) -> &[[u32; 2]] {
+        &self.edges
+    }
+
     pub fn edge_count(&self) -> usize {
         self.edges.len()
     }
