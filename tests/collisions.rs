@@ -33,7 +33,15 @@ fn wavy_towel(thickness: f64, integrator: Integrator) -> fraccloth::Cloth {
 /// and piles up in folds over 5 s. Returns the most crossing triangle pairs at any frame, the
 /// pile's top at the end and the self-collision pairs in reach then.
 fn drop(thickness: f64, integrator: Integrator) -> (usize, f64, usize) {
+    drop_at(thickness, integrator, fraccloth::cloth::AUTO)
+}
+
+/// [`drop`] with `max_substep` given.
+fn drop_at(thickness: f64, integrator: Integrator, max_substep: f64) -> (usize, f64, usize) {
     let mut cloth = wavy_towel(thickness, integrator);
+    let mut config = cloth.config().clone();
+    config.max_substep = max_substep;
+    cloth.reconfigure(config).unwrap();
     let floor = Plane {
         point: Vec3::zeros(),
         normal: Vec3::y(),
@@ -87,7 +95,17 @@ fn towel_over_torus(around: u32, tube: u32) -> (Cloth, u32, fraccloth::collide::
 /// torus at any frame, and the towel rests on it (does not fall through).
 #[test]
 fn a_towel_on_a_turning_torus_stays_outside_it() {
+    // At the automatic step and at a fixed substep of 1/3000 s.
+    for max_substep in [fraccloth::cloth::AUTO, 1.0 / 3000.0] {
+        towel_on_a_turning_torus(max_substep);
+    }
+}
+
+fn towel_on_a_turning_torus(max_substep: f64) {
     let (mut cloth, id, (tx, tt)) = towel_over_torus(48, 16);
+    let mut config = cloth.config().clone();
+    config.max_substep = max_substep;
+    cloth.reconfigure(config).unwrap();
     cloth.set_collider_friction(id, 0.5).unwrap();
     let mut worst = 0;
     let mut posed = tx.clone();
@@ -107,7 +125,7 @@ fn a_towel_on_a_turning_torus_stays_outside_it() {
         .map(|p| p.y)
         .fold(f64::INFINITY, f64::min);
     let centre = cloth.positions()[12 * 25 + 12];
-    println!("inside: {worst}; lowest vertex {lowest:.3} m; centre {centre:?}");
+    println!("max_substep {max_substep}: inside: {worst}; lowest vertex {lowest:.3} m; centre {centre:?}");
     assert_eq!(worst, 0, "no cloth vertex inside the torus");
     assert!(vertices_inside(cloth.positions(), &posed, &tt) == 0);
     // Resting on the ring: the ring's top is at 0.05 m.
@@ -224,6 +242,17 @@ fn a_bar_between_two_rows_catches_the_towel_by_its_edges() {
         ..Model::underwater()
     };
     sweep_bar_catches(model, -0.31, 0.001);
+}
+
+/// The drop at a fixed substep of 1/3000 s (the brisk swing's fixed step) instead of the
+/// automatic one: no crossing either.
+#[test]
+fn the_drop_at_a_fixed_substep_does_not_cross_itself() {
+    let (worst, top, pairs) = drop_at(0.005, Integrator::SymplecticEuler, 1.0 / 3000.0);
+    println!("fixed 1/3000 s: {worst} self-intersections ({pairs} pairs, pile top {top:.3} m)");
+    assert!(top < 0.3, "the towel has landed: top at {top} m");
+    assert!(pairs > 0, "it folded onto itself");
+    assert_eq!(worst, 0);
 }
 
 /// The drop again with implicit Euler at the automatic step: the contacts' Jacobian blocks
