@@ -66,6 +66,33 @@ fn panel(
     Ok(())
 }
 
+/// The underwater swing of `width` x `height` at `frequency` Hz and `amplitude` m with
+/// `model`, at the automatic step (`collision_cost`'s scenes).
+fn swing(
+    width: u32,
+    height: u32,
+    frequency: f64,
+    amplitude: f64,
+    model: fraccloth::Model,
+) -> Result<fraccloth_tools::scenes::Scene, fraccloth::Error> {
+    use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
+    SceneSpec {
+        width,
+        height,
+        drive: Drive {
+            amplitude,
+            frequency,
+            ..Drive::of(SceneKind::Swing, Variant::Underwater)
+        },
+        dt: 1.0 / FPS,
+        max_substep: fraccloth::cloth::AUTO,
+        integrator: Integrator::SymplecticEuler,
+        model: Some(model),
+        ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
+    }
+    .build()
+}
+
 fn side(p: &Vec3) -> (f64, f64) {
     (p.z, p.y)
 }
@@ -178,22 +205,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // touching (`collision_cost` case 3): side view at 0.1, 1 and 2 s, with the substeps and
     // refused attempts of the frame drawn.
     use fraccloth::collide::shapes::uv_sphere;
-    use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
-    let spec = SceneSpec {
-        width: 61,
-        height: 41,
-        drive: Drive {
-            amplitude: 0.04,
-            frequency: 0.5,
-            ..Drive::of(SceneKind::Swing, Variant::Underwater)
-        },
-        dt: 1.0 / FPS,
-        max_substep: fraccloth::cloth::AUTO,
-        integrator: Integrator::SymplecticEuler,
-        model: Some(fraccloth::Model::underwater()),
-        ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
-    };
-    let mut scene = spec.build()?;
+    let mut scene = swing(61, 41, 0.5, 0.04, fraccloth::Model::underwater())?;
     let (bx, bt) = uv_sphere(Vec3::new(0.3, -0.3, 0.1), 0.1, 100, 51);
     scene.cloth.add_mesh_collider(&bx, &bt, None)?;
     let root = BitMapBackend::new("docs/collisions/ball.png", (1500, 450)).into_drawing_area();
@@ -228,24 +240,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     root.fill(&WHITE)?;
     let rows = root.split_evenly((2, 3));
     for (r, thickness) in [0.006, 0.0].into_iter().enumerate() {
-        let spec = SceneSpec {
-            width: 31,
-            height: 21,
-            drive: Drive {
-                amplitude: 0.08,
-                frequency: 2.0,
-                ..Drive::of(SceneKind::Swing, Variant::Underwater)
-            },
-            dt: 1.0 / FPS,
-            max_substep: fraccloth::cloth::AUTO,
-            integrator: Integrator::SymplecticEuler,
-            model: Some(fraccloth::Model {
-                self_collision_thickness: thickness,
-                ..fraccloth::Model::underwater()
-            }),
-            ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
+        let model = fraccloth::Model {
+            self_collision_thickness: thickness,
+            ..fraccloth::Model::underwater()
         };
-        let mut scene = spec.build()?;
+        let mut scene = swing(31, 21, 2.0, 0.08, model)?;
         let mut f = 0;
         for (k, until) in [30, 60, 120].into_iter().enumerate() {
             while f < until {

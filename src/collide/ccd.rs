@@ -155,6 +155,16 @@ pub fn start_sign(path: &Path) -> i8 {
 mod tests {
     use super::*;
 
+    /// Numbers uniform in [-1, 1) from `seed` (a linear congruential generator).
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        }
+    }
+
     fn still(p: Vec3) -> (Vec3, Vec3) {
         (p, p)
     }
@@ -211,13 +221,7 @@ mod tests {
 
     #[test]
     fn one_sign_is_never_claimed_for_a_cubic_with_a_root_in_the_step() {
-        let mut seed = 3_u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut rnd = uniform(3);
         let (mut claimed, mut rooted) = (0, 0);
         for _ in 0..20_000 {
             let k = [rnd(), 4.0 * rnd(), 4.0 * rnd(), 4.0 * rnd()];
@@ -271,13 +275,7 @@ mod tests {
     /// and the distance (where the scan sees a clear change of side over the face).
     #[test]
     fn passages_agree_with_a_fine_scan() {
-        let mut seed = 7_u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut rnd = uniform(7);
         let mut agreed = 0;
         for _ in 0..2000 {
             let mut v = || Vec3::new(rnd(), rnd(), rnd());

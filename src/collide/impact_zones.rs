@@ -333,6 +333,9 @@ fn move_zones(input: &ZoneInput, zones: &mut Zones, members: &[u32], x1: &mut [V
 mod tests {
     use super::*;
 
+    /// The masses of [`scene`]'s vertices.
+    const MASSES: [f64; 5] = [1.0, 1.0, 1.0, 1.0, 3.0];
+
     /// A triangle (0, 1, 2) over a vertex 3 below it, with an edge (3, 4) beside.
     fn scene() -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<[u32; 2]>) {
         let x0 = vec![
@@ -345,8 +348,10 @@ mod tests {
         (x0, vec![[0, 1, 2]], vec![[3, 4]])
     }
 
+    /// The zones' input for these tests: no edge pairs, no neighbour rows.
     fn input<'a>(
         x0: &'a [Vec3],
+        masses: &'a [f64],
         kinematic: &'a [bool],
         triangles: &'a [[u32; 3]],
         adjacency: &'a Adjacency,
@@ -355,7 +360,7 @@ mod tests {
     ) -> ZoneInput<'a> {
         ZoneInput {
             x0,
-            masses: &[1.0, 1.0, 1.0, 1.0, 3.0],
+            masses,
             kinematic,
             triangles,
             vertex_triangles: adjacency,
@@ -374,7 +379,7 @@ mod tests {
         // The vertex is below the triangle: side -1.
         let vt = [(3, 0, -1)];
         let adj = Adjacency::triangles(x0.len(), &tris);
-        let zi = input(&x0, &pinned, &tris, &adj, &edges, &vt);
+        let zi = input(&x0, &MASSES, &pinned, &tris, &adj, &edges, &vt);
         // The pinned triangle drops 3 cm; the vertex stays.
         let mut x1 = x0.clone();
         for p in &mut x1[..3] {
@@ -396,7 +401,7 @@ mod tests {
         let free = [false; 5];
         let vt = [(3, 0, 0)];
         let adj = Adjacency::triangles(x0.len(), &tris);
-        let zi = input(&x0, &free, &tris, &adj, &edges, &vt);
+        let zi = input(&x0, &MASSES, &free, &tris, &adj, &edges, &vt);
         // The vertex flies up through the triangle, which moves a little down.
         let mut x1 = x0.clone();
         x1[3] += Vec3::new(0.0, 0.0, 0.05);
@@ -422,7 +427,7 @@ mod tests {
         // geometry, and the vertex is still kept from going through.
         let vt = [(3, 0, 1)];
         let adj = Adjacency::triangles(x0.len(), &tris);
-        let zi = input(&x0, &free, &tris, &adj, &edges, &vt);
+        let zi = input(&x0, &MASSES, &free, &tris, &adj, &edges, &vt);
         let mut x1 = x0.clone();
         x1[3] += Vec3::new(0.0, 0.0, 0.05);
         let (mut moved, mut stopped) = (Vec::new(), Vec::new());
@@ -456,18 +461,7 @@ mod tests {
         let adj = Adjacency::triangles(x0.len(), &tris);
         let free = [false; 6];
         let vt = [(3, 0, 1)];
-        let zi = ZoneInput {
-            x0: &x0,
-            masses: &[1.0; 6],
-            kinematic: &free,
-            triangles: &tris,
-            vertex_triangles: &adj,
-            neighbours: (&[], &[]),
-            edges: &[],
-            vertex_triangle: &vt,
-            edge_edge: &[],
-            tolerance: 1e-9,
-        };
+        let zi = input(&x0, &[1.0; 6], &free, &tris, &adj, &[], &vt);
         let mut x1 = x0.clone();
         x1[3] -= Vec3::new(0.0, 0.0, 0.05);
         let proposed = x1.clone();
@@ -497,18 +491,7 @@ mod tests {
         let kinematic = [true, true, true, false, false, false, false, false];
         let vt = [(3, 0, -1), (3, 1, 1)];
         let adj = Adjacency::triangles(x0.len(), &tris);
-        let zi = ZoneInput {
-            x0: &x0,
-            masses: &[1.0; 8],
-            kinematic: &kinematic,
-            triangles: &tris,
-            vertex_triangles: &adj,
-            neighbours: (&[], &[]),
-            edges: &[],
-            vertex_triangle: &vt,
-            edge_edge: &[],
-            tolerance: 1e-9,
-        };
+        let zi = input(&x0, &[1.0; 8], &kinematic, &tris, &adj, &[], &vt);
         let mut x1 = x0.clone();
         for p in &mut x1[..3] {
             *p -= Vec3::new(0.0, 0.0, 0.03);
