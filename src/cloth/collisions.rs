@@ -4,10 +4,10 @@
 
 use super::Cloth;
 use crate::bytes::{ByteReader, ByteWriter};
-use crate::collide::impact_zones::{keep_from_passing, ZoneInput};
+use crate::collide::impact_zones::{keep_from_passing, ZoneInput, ZoneTotals};
 use crate::collide::mesh::{candidate_room, CANDIDATES_PER_VERTEX};
 use crate::collide::room::Full;
-use crate::collide::self_collision::{Pair, ZoneTotals};
+use crate::collide::self_collision::Pair;
 use crate::collide::{contact, Contact, MeshCollider};
 use crate::error::Error;
 use crate::math::Vec3;

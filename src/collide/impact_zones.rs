@@ -31,6 +31,30 @@ pub struct ZoneReport {
     pub unresolved: usize,
 }
 
+/// What the impact zones did over many steps (summed [`ZoneReport`]s).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ZoneTotals {
+    /// Steps in which some pair would have passed through another.
+    pub steps: u64,
+    /// Passages found (in the first round of each step).
+    pub passages: u64,
+    /// Free vertices moved with a zone, summed over the steps.
+    pub moved: u64,
+    /// Passages left after the zones (0: every listed pair was kept from passing).
+    pub unresolved: u64,
+}
+
+impl ZoneTotals {
+    pub(crate) fn add(&mut self, r: &ZoneReport) {
+        if r.passages > 0 {
+            self.steps += 1;
+        }
+        self.passages += r.passages as u64;
+        self.moved += r.moved as u64;
+        self.unresolved += r.unresolved as u64;
+    }
+}
+
 /// The step's geometry: where the vertices start and what the pairs are made of.
 pub struct ZoneInput<'a> {
     pub x0: &'a [Vec3],
@@ -170,26 +194,34 @@ impl ZoneInput<'_> {
         seen.dedup();
         for &p in seen.iter() {
             for &t in row(p) {
-                let [a, b, c] = self.triangles[t as usize];
-                if [a, b, c].contains(&p) {
-                    continue;
-                }
-                let vs = [a, b, c, p];
-                if vs.iter().all(|&i| x1[i as usize] == self.x0[i as usize]) {
-                    continue;
-                }
-                let path = self.path(x1, vs);
-                if vertex_passes_triangle(&path, self.tolerance).is_some()
-                    && !self.vertex_tangled(p, [a, b, c])
-                {
-                    out.push(Passage {
-                        vs,
-                        pair: PairRef::Neighbour,
-                        sign: start_sign(&path),
-                    });
+                if !self.triangles[t as usize].contains(&p) {
+                    out.extend(self.vertex_passage(x1, p, t, PairRef::Neighbour));
                 }
             }
         }
+    }
+
+    /// Whether any of `vs` moves in the step `x0 -> x1`.
+    fn moving(&self, x1: &[Vec3], vs: &[u32; 4]) -> bool {
+        vs.iter().any(|&i| x1[i as usize] != self.x0[i as usize])
+    }
+
+    /// Vertex `p`'s passage through triangle `t` in the step `x0 -> x1`, as `pair`: none if
+    /// they do not move, do not meet, or are tangled at the start.
+    fn vertex_passage(&self, x1: &[Vec3], p: u32, t: u32, pair: PairRef) -> Option<Passage> {
+        let tri = self.triangles[t as usize];
+        let vs = [tri[0], tri[1], tri[2], p];
+        if !self.moving(x1, &vs) {
+            return None;
+        }
+        let path = self.path(x1, vs);
+        (vertex_passes_triangle(&path, self.tolerance).is_some() && !self.vertex_tangled(p, tri)).then(|| {
+            Passage {
+                vs,
+                pair,
+                sign: start_sign(&path),
+            }
+        })
     }
 
     fn path(&self, x1: &[Vec3], vs: [u32; 4]) -> Path {
@@ -199,30 +231,17 @@ impl ZoneInput<'_> {
     /// The pairs that pass in the step `x0 -> x1`, as their four vertices.
     fn passages(&self, x1: &[Vec3], out: &mut Vec<Passage>) {
         out.clear();
-        let moving = |vs: &[u32; 4]| vs.iter().any(|&i| x1[i as usize] != self.x0[i as usize]);
         for (k, &(p, t, _)) in self.vertex_triangle.iter().enumerate() {
-            let [a, b, c] = self.triangles[t as usize];
-            let vs = [a, b, c, p];
-            if !moving(&vs) {
-                continue;
-            }
-            let path = self.path(x1, vs);
-            if vertex_passes_triangle(&path, self.tolerance).is_some() && !self.vertex_tangled(p, [a, b, c]) {
-                out.push(Passage {
-                    vs,
-                    pair: PairRef::VertexTriangle(k as u32),
-                    sign: start_sign(&path),
-                });
-            }
+            out.extend(self.vertex_passage(x1, p, t, PairRef::VertexTriangle(k as u32)));
         }
         for (k, &(e, f, _)) in self.edge_edge.iter().enumerate() {
-            let ([e0, e1], [f0, f1]) = (self.edges[e as usize], self.edges[f as usize]);
-            let vs = [e0, e1, f0, f1];
-            if !moving(&vs) {
+            let (edge, other) = (self.edges[e as usize], self.edges[f as usize]);
+            let vs = [edge[0], edge[1], other[0], other[1]];
+            if !self.moving(x1, &vs) {
                 continue;
             }
             let path = self.path(x1, vs);
-            if edge_passes_edge(&path, self.tolerance).is_some() && !self.edges_tangled([e0, e1], [f0, f1]) {
+            if edge_passes_edge(&path, self.tolerance).is_some() && !self.edges_tangled(edge, other) {
                 out.push(Passage {
                     vs,
                     pair: PairRef::EdgeEdge(k as u32),

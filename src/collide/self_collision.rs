@@ -58,30 +58,6 @@ pub const PAIRS_PER_VERTEX: usize = 1024;
 /// both).
 pub type Pair = (u32, u32, i8);
 
-/// What self-collision's impact zones did over many steps (`impact_zones.rs`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct ZoneTotals {
-    /// Steps in which some pair would have passed through another.
-    pub steps: u64,
-    /// Passages found (in the first round of each step).
-    pub passages: u64,
-    /// Free vertices moved with a zone, summed over the steps.
-    pub moved: u64,
-    /// Passages left after the zones (0: every listed pair was kept from passing).
-    pub unresolved: u64,
-}
-
-impl ZoneTotals {
-    pub(crate) fn add(&mut self, r: &super::impact_zones::ZoneReport) {
-        if r.passages > 0 {
-            self.steps += 1;
-        }
-        self.passages += r.passages as u64;
-        self.moved += r.moved as u64;
-        self.unresolved += r.unresolved as u64;
-    }
-}
-
 /// What self-collision remembers across steps, saved by a rollback.
 #[derive(Clone, Debug, Default)]
 pub struct SavedMemory {
@@ -113,7 +89,7 @@ pub struct SelfCollision {
     /// How many times the list was looked up again (for benchmarks).
     pub looks: u64,
     /// What the impact zones did after the steps (`impact_zones.rs`).
-    pub zones: ZoneTotals,
+    pub zones: super::impact_zones::ZoneTotals,
     /// Pairs never tested: nearer than 2.2 thicknesses at rest (neighbours), per vertex and
     /// per edge, for the thickness they were found at.
     excluded: Exclusions,
