@@ -56,8 +56,8 @@ pub use error::{Error, ErrorKind};
 pub use history::{HalfDerivative, History, Scheme};
 pub use integrate::Integrator;
 pub use model::{Model, RegularDrag, SpringDamping};
-/// Fewest particles for which a step uses more than one thread.
-pub use plumbing::parallel::MIN_PARALLEL;
+/// How many particles a cloth needs for its step to use more than one thread (by CPU).
+pub use plumbing::parallel::{min_parallel, MIN_PARALLEL, MIN_PARALLEL_AMD, MIN_PARALLEL_VARIABLE};
 /// The vector width the loops run at on this machine ("avx512", "avx2" or "baseline"; capped
 /// by the environment variable `FRACCLOTH_SIMD` for measurement).
 pub use plumbing::simd::level as simd_level;

@@ -836,7 +836,7 @@ mod tests {
     fn the_look_finds_the_same_pairs_on_two_threads() {
         let (x, rest, triangles) = folded_sheet(130, 125);
         assert!(
-            x.len() >= crate::parallel::MIN_PARALLEL,
+            x.len() >= crate::parallel::min_parallel(),
             "large enough for the pool"
         );
         let (thickness, reach) = (0.004, 0.008);

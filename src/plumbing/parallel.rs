@@ -5,8 +5,11 @@
 //! not depend on the number of threads. So the result is bitwise identical for any thread
 //! count: threads only change which core computes a chunk, never what is computed.
 //!
-//! Small cloths stay on the calling thread: below [`MIN_PARALLEL`] particles a step takes a
+//! Small cloths stay on the calling thread: below [`min_parallel`] particles a step takes a
 //! few tens of microseconds and handing chunks to other threads costs more than it saves.
+//! Where that crossover lies depends on the CPU: it is chosen by the CPU's maker, from
+//! measurements on each (docs/benchmarks.md), and [`MIN_PARALLEL_VARIABLE`] overrides it
+//! for measuring it on another machine.
 //! Threads come from rayon's current pool: the global pool (`RAYON_NUM_THREADS`), or a pool
 //! the host installs around the call, unless a cloth says otherwise ([`Threads`]).
 
@@ -23,13 +26,61 @@ pub const CHUNK: usize = 4096;
 pub const TILE: usize = 256;
 const _: () = assert!(CHUNK % TILE == 0);
 
-/// Fewest particles for which a step uses more than one thread (measured with
-/// `cargo run --release --example throughput`; see docs/benchmarks.md).
+/// Fewest particles for which a step uses more than one thread on an Intel CPU (measured with
+/// `cargo run --release --example throughput`; see docs/benchmarks.md), and on any CPU not
+/// measured: the largest of the thresholds, so a cloth of this many particles uses the pool on
+/// every CPU unless [`MIN_PARALLEL_VARIABLE`] says otherwise.
 pub const MIN_PARALLEL: usize = 16_000;
+
+/// Fewest particles for which a step uses more than one thread on an AMD CPU: two threads
+/// gain 1.25x from 6 500 particles on the AMD EPYC measured (`step_cycles`, docs/benchmarks.md,
+/// issue 36) and break even at 5 000.
+pub const MIN_PARALLEL_AMD: usize = 6_400;
+
+/// Environment variable that sets the fewest particles for which a step uses the pool (a
+/// whole number, read once), for measuring the crossover on a machine; the choice by CPU
+/// when unset or not a number.
+pub const MIN_PARALLEL_VARIABLE: &str = "FRACCLOTH_MIN_PARALLEL";
+
+/// Fewest particles for which a step uses more than one thread here: [`MIN_PARALLEL_AMD`] on
+/// an AMD CPU, [`MIN_PARALLEL`] on others, or [`MIN_PARALLEL_VARIABLE`] when it is set.
+/// The bits of a step never depend on it (only where its chunks run).
+pub fn min_parallel() -> usize {
+    static CHOSEN: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CHOSEN.get_or_init(|| {
+        let set = std::env::var(MIN_PARALLEL_VARIABLE).ok();
+        set.and_then(|s| s.trim().parse().ok())
+            .unwrap_or(if made_by_amd() {
+                MIN_PARALLEL_AMD
+            } else {
+                MIN_PARALLEL
+            })
+    })
+}
+
+/// Whether this CPU's vendor string (CPUID leaf 0) is AMD's.
+fn made_by_amd() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        // CPUID is on every x86-64 CPU; leaf 0 gives the vendor in ebx, edx, ecx.
+        #[allow(unused_unsafe)]
+        // SAFETY: the instruction exists on every x86-64 CPU and has no side effects.
+        let r = unsafe { std::arch::x86_64::__cpuid(0) };
+        let mut vendor = [0u8; 12];
+        vendor[..4].copy_from_slice(&r.ebx.to_le_bytes());
+        vendor[4..8].copy_from_slice(&r.edx.to_le_bytes());
+        vendor[8..].copy_from_slice(&r.ecx.to_le_bytes());
+        &vendor == b"AuthenticAMD"
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
 
 /// Whether a cloth of `n` particles should spread its passes over the pool.
 pub fn worth_it(n: usize) -> bool {
-    n >= MIN_PARALLEL && !ON_CALLER.with(Cell::get) && rayon::current_num_threads() > 1
+    n >= min_parallel() && !ON_CALLER.with(Cell::get) && rayon::current_num_threads() > 1
 }
 
 thread_local! {
@@ -45,7 +96,7 @@ pub const MAX_THREADS: u32 = 256;
 #[derive(Clone, Debug, Default)]
 pub enum Threads {
     /// rayon's current pool: the global one (`RAYON_NUM_THREADS`) or one the caller installed.
-    /// Cloths under [`MIN_PARALLEL`] particles stay on the calling thread. The default.
+    /// Cloths under [`min_parallel`] particles stay on the calling thread. The default.
     #[default]
     Shared,
     /// Every pass on the calling thread, whatever the cloth's size: for a host that runs
@@ -266,8 +317,36 @@ mod tests {
         assert_eq!(own.count(), 3);
         assert_eq!(own.run(rayon::current_num_threads), 3);
         assert!(own.run(|| worth_it(MIN_PARALLEL)));
+        assert!(min_parallel() <= MIN_PARALLEL || std::env::var(MIN_PARALLEL_VARIABLE).is_ok());
         assert!(Threads::with_count(MAX_THREADS + 1).is_err());
         assert_eq!(Threads::with_count(0).map(|t| t.count()), Ok(0));
+    }
+
+    /// The vendor read from CPUID is the one the kernel reports (Linux), and the threshold
+    /// follows it.
+    #[test]
+    fn the_threshold_follows_the_cpus_maker() {
+        let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
+            return;
+        };
+        let vendor = info
+            .lines()
+            .find_map(|l| l.strip_prefix("vendor_id"))
+            .map(|l| l.trim_start_matches([' ', '\t', ':']).trim());
+        let Some(vendor) = vendor else { return };
+        assert_eq!(
+            made_by_amd(),
+            vendor == "AuthenticAMD",
+            "CPUID against /proc/cpuinfo: {vendor}"
+        );
+        if std::env::var(MIN_PARALLEL_VARIABLE).is_err() {
+            let expected = if vendor == "AuthenticAMD" {
+                MIN_PARALLEL_AMD
+            } else {
+                MIN_PARALLEL
+            };
+            assert_eq!(min_parallel(), expected);
+        }
     }
 
     #[test]
