@@ -223,9 +223,11 @@ pub fn turning_forces(
         let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
         turning_chunked(ma, t, x, v, scratch, chunk, true, projected, normals, out);
     } else {
-        turning_serial(ma, t, x, v, scratch, projected, normals, out, coarse);
+        turning_serial_widest(ma, t, x, v, scratch, projected, normals, out, coarse);
     }
 }
+
+crate::simd_dispatch! { fn turning_serial_widest(ma: f64, t: &Topology, x: &[Vec3], v: &[Vec3], scratch: &mut TurningScratch, projected: &mut [f64], normals: &mut [Vec3], out: &mut [Vec3], coarse: Option<&mut super::coarse_water::CoarseWater>) => turning_serial }
 
 /// The passes on one thread, each face's sums scattered to its corners instead of each
 /// vertex gathering its faces'. A vertex's faces are listed in ascending order
@@ -234,6 +236,7 @@ pub fn turning_forces(
 /// bits, without the per-face arrays and the corner tests of the gather. (A face's corners are
 /// distinct: a mesh with a repeated corner is refused when built.)
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
+#[inline(always)]
 fn turning_serial(
     ma: f64,
     t: &Topology,
@@ -263,18 +266,21 @@ fn turning_serial(
         }
     }
     patches.clear();
-    patches.extend((0..n).map(|i| {
-        patch_turning(
-            sums[i],
-            rates[i],
-            t.patch_scale[i],
-            ma * areas[i],
-            &v[i],
-            &mut out[i],
-            &mut projected[i],
-            &mut normals[i],
-        )
-    }));
+    patches.resize(n, Vec3::zeros());
+    patch_range(
+        ma,
+        &areas[..],
+        &t.patch_scale[..],
+        sums,
+        rates,
+        v,
+        PatchOut {
+            o: out,
+            projected,
+            normals,
+            w: patches,
+        },
+    );
     if let Some(c) = coarse {
         let ps = &t.patch_scale;
         c.add_turning(|i| (ps[i] * sums[i], ps[i] * rates[i], ps[i]), v, out, patches);
@@ -454,9 +460,9 @@ fn turning_chunked(
             };
             let k = lo / split.chunk;
             if split.borders(k).is_empty() {
-                turning_chunk::<false>(ma, t, x, v, split, k, chunk);
+                turning_chunk_widest(ma, t, x, v, split, k, chunk);
             } else {
-                turning_chunk::<true>(ma, t, x, v, split, k, chunk);
+                turning_chunk_border_widest(ma, t, x, v, split, k, chunk);
             }
         });
     }
@@ -480,6 +486,35 @@ fn turning_chunked(
     });
 }
 
+crate::simd_dispatch! { fn turning_chunk_widest(ma: f64, t: &Topology, x: &[Vec3], v: &[Vec3], split: &TurningSplit, k: usize, c: Chunk<'_>) => turning_chunk_plain }
+crate::simd_dispatch! { fn turning_chunk_border_widest(ma: f64, t: &Topology, x: &[Vec3], v: &[Vec3], split: &TurningSplit, k: usize, c: Chunk<'_>) => turning_chunk_border }
+
+#[inline(always)]
+fn turning_chunk_plain(
+    ma: f64,
+    t: &Topology,
+    x: &[Vec3],
+    v: &[Vec3],
+    split: &TurningSplit,
+    k: usize,
+    c: Chunk<'_>,
+) {
+    turning_chunk::<false>(ma, t, x, v, split, k, c)
+}
+
+#[inline(always)]
+fn turning_chunk_border(
+    ma: f64,
+    t: &Topology,
+    x: &[Vec3],
+    v: &[Vec3],
+    split: &TurningSplit,
+    k: usize,
+    c: Chunk<'_>,
+) {
+    turning_chunk::<true>(ma, t, x, v, split, k, c)
+}
+
 /// One chunk's arrays (`lo` its first vertex).
 struct Chunk<'a> {
     lo: usize,
@@ -499,6 +534,7 @@ struct Chunk<'a> {
 /// the bits are theirs, but a large chunk's sums are read back while they are in cache. The
 /// border vertices' faces' gradients are left to the caller. `BORDER`: whether the chunk has
 /// border vertices (a chunk without skips the tests).
+#[inline(always)]
 fn turning_chunk<const BORDER: bool>(
     ma: f64,
     t: &Topology,
@@ -548,28 +584,37 @@ fn turning_chunk<const BORDER: bool>(
         } else {
             lo + ready[lo..hi].partition_point(|&r| r as usize <= summed)
         };
-        for i in done..upto.max(done) {
-            let j = i - lo;
-            let (big_n, big_ndot) = if BORDER && border[i] {
-                let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
-                for &f in vertex_triangles.row(i) {
-                    let (c, r) = face_and_rate(x, v, &triangles[f as usize]);
-                    big_n += c;
-                    big_ndot += r;
+        if upto > done {
+            // A border vertex's sums are its own faces', in its own order (its entries were
+            // skipped above); then every vertex of the range takes its patch's terms.
+            if BORDER {
+                let mine = split.borders(k);
+                let from = mine.partition_point(|&b| (b as usize) < done);
+                for &i in mine[from..].iter().take_while(|&&b| (b as usize) < upto) {
+                    let i = i as usize;
+                    let (mut big_n, mut big_ndot) = (Vec3::zeros(), Vec3::zeros());
+                    for &f in vertex_triangles.row(i) {
+                        let (c, r) = face_and_rate(x, v, &triangles[f as usize]);
+                        big_n += c;
+                        big_ndot += r;
+                    }
+                    (sums[i - lo], rates[i - lo]) = (big_n, big_ndot);
                 }
-                (big_n, big_ndot)
-            } else {
-                (sums[j], rates[j])
-            };
-            w[j] = patch_turning(
-                big_n,
-                big_ndot,
-                t.patch_scale[i],
-                ma * areas[i],
-                &v[i],
-                &mut out[j],
-                &mut projected[j],
-                &mut normals[j],
+            }
+            let r = done - lo..upto - lo;
+            patch_range(
+                ma,
+                &areas[done..upto],
+                &t.patch_scale[done..upto],
+                &sums[r.clone()],
+                &rates[r.clone()],
+                &v[done..upto],
+                PatchOut {
+                    o: &mut out[r.clone()],
+                    projected: &mut projected[r.clone()],
+                    normals: &mut normals[r.clone()],
+                    w: &mut w[r],
+                },
             );
         }
         done = done.max(upto);
@@ -623,6 +668,92 @@ fn patch_turning(
     let av = a.dot(v);
     *o -= k * (av * adot + adot.dot(v) * a);
     (k * av * scale) * v
+}
+
+/// What [`patch_range`] writes for its vertices: their forces (subtracted from), projected-area
+/// ratios, unit normals and `w`.
+struct PatchOut<'a> {
+    o: &'a mut [Vec3],
+    projected: &'a mut [f64],
+    normals: &'a mut [Vec3],
+    w: &'a mut [Vec3],
+}
+
+/// Vertices per block of [`patch_range`]: one AVX-512 vector of f64.
+const PATCH_BLOCK: usize = 8;
+
+/// [`patch_turning`] for every vertex of a range (`areas`, `scale`, `sums`, `rates`, `v` and
+/// the outputs all of the range's length; `ma` the normal added mass per area), in blocks of
+/// [`PATCH_BLOCK`] vertices whose components are laid out side by side so that the square
+/// roots and divisions run a vector at a time. The same operations in the same order as
+/// [`patch_turning`] (a unit test compares them bit for bit), so the same bits.
+#[inline(always)]
+fn patch_range(
+    ma: f64,
+    areas: &[f64],
+    scale: &[f64],
+    sums: &[Vec3],
+    rates: &[Vec3],
+    v: &[Vec3],
+    out: PatchOut<'_>,
+) {
+    const B: usize = PATCH_BLOCK;
+    let PatchOut {
+        o,
+        projected,
+        normals,
+        w,
+    } = out;
+    let m = o.len();
+    let (areas, scale, sums, rates, v) = (&areas[..m], &scale[..m], &sums[..m], &rates[..m], &v[..m]);
+    let (projected, normals, w) = (&mut projected[..m], &mut normals[..m], &mut w[..m]);
+    let whole = m / B * B;
+    for q in (0..whole).step_by(B) {
+        let side = |a: &[Vec3], c: usize| -> [f64; B] { std::array::from_fn(|l| a[q + l][c]) };
+        let n: [[f64; B]; 3] = std::array::from_fn(|c| side(sums, c));
+        let nd: [[f64; B]; 3] = std::array::from_fn(|c| side(rates, c));
+        let vv: [[f64; B]; 3] = std::array::from_fn(|c| side(v, c));
+        let mut oo: [[f64; B]; 3] = std::array::from_fn(|c| side(o, c));
+        let sc: [f64; B] = std::array::from_fn(|l| scale[q + l]);
+        let k: [f64; B] = std::array::from_fn(|l| ma * areas[q + l]);
+        let (mut nr, mut ww) = ([[0.0; B]; 3], [[0.0; B]; 3]);
+        let mut pr = [0.0; B];
+        for l in 0..B {
+            let len = (n[0][l] * n[0][l] + n[1][l] * n[1][l] + n[2][l] * n[2][l]).sqrt();
+            for c in 0..3 {
+                nr[c][l] = if len > 0.0 { n[c][l] / len } else { n[c][l] };
+            }
+            let a = [sc[l] * n[0][l], sc[l] * n[1][l], sc[l] * n[2][l]];
+            let ad = [sc[l] * nd[0][l], sc[l] * nd[1][l], sc[l] * nd[2][l]];
+            pr[l] = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            let av = a[0] * vv[0][l] + a[1] * vv[1][l] + a[2] * vv[2][l];
+            let adv = ad[0] * vv[0][l] + ad[1] * vv[1][l] + ad[2] * vv[2][l];
+            let kw = k[l] * av * sc[l];
+            for c in 0..3 {
+                oo[c][l] -= k[l] * (av * ad[c] + adv * a[c]);
+                ww[c][l] = kw * vv[c][l];
+            }
+        }
+        for l in 0..B {
+            let i = q + l;
+            o[i] = Vec3::new(oo[0][l], oo[1][l], oo[2][l]);
+            normals[i] = Vec3::new(nr[0][l], nr[1][l], nr[2][l]);
+            w[i] = Vec3::new(ww[0][l], ww[1][l], ww[2][l]);
+            projected[i] = pr[l];
+        }
+    }
+    for i in whole..m {
+        w[i] = patch_turning(
+            sums[i],
+            rates[i],
+            scale[i],
+            ma * areas[i],
+            &v[i],
+            &mut o[i],
+            &mut projected[i],
+            &mut normals[i],
+        );
+    }
 }
 
 /// The gradients of `W . c` at a face's corners b and c (`W` the sum of its corners' `w`).
@@ -857,6 +988,57 @@ mod tests {
                         "ratios, {w}x{h} {scrambled} chunk {chunk}"
                     );
                 }
+            }
+        }
+    }
+
+    /// The blocks of [`patch_range`] give [`patch_turning`]'s bits, vertex by vertex, for
+    /// ranges of every length round the block size, with some patches folded flat (zero sums).
+    #[test]
+    fn patch_blocks_keep_the_bits() {
+        let mut r = crate::testing::numbers(5);
+        let mut v3 = || Vec3::new(r(), r(), r());
+        for m in 0..=2 * PATCH_BLOCK + 3 {
+            let sums: Vec<Vec3> = (0..m)
+                .map(|i| if i % 5 == 2 { Vec3::zeros() } else { v3() })
+                .collect();
+            let (rates, v, o): (Vec<Vec3>, Vec<Vec3>, Vec<Vec3>) = (
+                (0..m).map(|_| v3()).collect(),
+                (0..m).map(|_| v3()).collect(),
+                (0..m).map(|_| v3()).collect(),
+            );
+            let scale: Vec<f64> = (0..m).map(|i| 1.5 + sums[i].x).collect();
+            let areas: Vec<f64> = (0..m).map(|i| 2.0 + rates[i].y).collect();
+            let (mut go, mut gp, mut gn, mut gw) = (
+                o.clone(),
+                vec![0.0; m],
+                vec![Vec3::zeros(); m],
+                vec![Vec3::zeros(); m],
+            );
+            let out = PatchOut {
+                o: &mut go,
+                projected: &mut gp,
+                normals: &mut gn,
+                w: &mut gw,
+            };
+            patch_range(8.0, &areas, &scale, &sums, &rates, &v, out);
+            for i in 0..m {
+                let (mut o1, mut p1, mut n1) = (o[i], 0.0, Vec3::zeros());
+                let w1 = patch_turning(
+                    sums[i],
+                    rates[i],
+                    scale[i],
+                    8.0 * areas[i],
+                    &v[i],
+                    &mut o1,
+                    &mut p1,
+                    &mut n1,
+                );
+                let bits = |a: &Vec3| a.map(f64::to_bits);
+                assert_eq!(bits(&go[i]), bits(&o1), "force, range {m} vertex {i}");
+                assert_eq!(bits(&gn[i]), bits(&n1), "normal, range {m} vertex {i}");
+                assert_eq!(bits(&gw[i]), bits(&w1), "w, range {m} vertex {i}");
+                assert_eq!(gp[i].to_bits(), p1.to_bits(), "ratio, range {m} vertex {i}");
             }
         }
     }

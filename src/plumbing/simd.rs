@@ -67,14 +67,18 @@ pub fn level() -> &'static str {
 #[doc(hidden)]
 macro_rules! simd_dispatch {
     ($vis:vis fn $name:ident ( $($p:ident : $t:ty),* $(,)? ) $(-> $ret:ty)? => $body:ident) => {
+        // As many arguments as the body it dispatches to has.
+        #[allow(clippy::too_many_arguments)]
         $vis fn $name($($p: $t),*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx512f")]
+                #[allow(clippy::too_many_arguments)]
                 unsafe fn wide512($($p: $t),*) $(-> $ret)? {
                     $body($($p),*)
                 }
                 #[target_feature(enable = "avx2,fma")]
+                #[allow(clippy::too_many_arguments)]
                 unsafe fn wide256($($p: $t),*) $(-> $ret)? {
                     $body($($p),*)
                 }
