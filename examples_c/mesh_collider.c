@@ -6,6 +6,7 @@
  * collider id, how many towel vertices ended inside the box (0), the lowest and highest towel
  * heights, and the statuses of calls with bad input. Usage: mesh_collider */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include "fraccloth.h"
@@ -105,6 +106,17 @@ int main(void) {
         if (xyz[3 * i + 1] > hi) hi = xyz[3 * i + 1];
     }
     printf("inside %d\n", worst_inside);
+
+    /* What the continuous check did: every output written, any may be NULL. */
+    uint64_t zone_steps = UINT64_MAX, passages = UINT64_MAX, moved = UINT64_MAX;
+    uint64_t unresolved = UINT64_MAX, carried = UINT64_MAX;
+    FcStatus st = fc_cloth_get_collision_stats(cloth, &zone_steps, &passages, &moved, &unresolved, &carried);
+    printf("collision_stats %d %llu %llu %llu %llu %llu\n", (int)st, (unsigned long long)zone_steps,
+           (unsigned long long)passages, (unsigned long long)moved, (unsigned long long)unresolved,
+           (unsigned long long)carried);
+    printf("collision_stats_null %d %d\n",
+           (int)fc_cloth_get_collision_stats(cloth, NULL, NULL, NULL, NULL, NULL),
+           (int)fc_cloth_get_collision_stats(NULL, &zone_steps, NULL, NULL, NULL, NULL));
     printf("heights %.4f %.4f\n", lo, hi);
 
     /* Bad input: statuses, and nothing changes. */

@@ -716,6 +716,26 @@ FcStatus fc_cloth_get_step_stats(const FcCloth *cloth,
                                  double *estimate);
 
 /**
+ * Reads what the continuous collision check did since the cloth was made (steps that a
+ * refused call undid included): `zone_steps`, the steps in which a self-collision pair would
+ * have passed through another; `passages`, how many such passages were found; `zone_moved`,
+ * the free vertices moved with an impact zone (summed over steps); `unresolved`, passages
+ * still there when the zones stopped (0: the cloth never went through itself where its pairs
+ * were listed); `mesh_carried`, cloth vertices a mesh collider carried rather than let pass
+ * through it (summed over steps). All 0 for a cloth without self-collision or mesh colliders.
+ * Any output may be NULL.
+ *
+ * # Safety
+ * `cloth` NULL or live; outputs NULL or writable.
+ */
+FcStatus fc_cloth_get_collision_stats(const FcCloth *cloth,
+                                      uint64_t *zone_steps,
+                                      uint64_t *passages,
+                                      uint64_t *zone_moved,
+                                      uint64_t *unresolved,
+                                      uint64_t *mesh_carried);
+
+/**
  * Whether an implicit step whose solver stops at `solver_max_iterations` above
  * `solver_tolerance` is accepted (`accept` non-zero: the step returns `FC_OK`; read
  * `fc_cloth_get_solver_stats`) or refused (0, the default: `FC_ERROR_NOT_CONVERGED`, the

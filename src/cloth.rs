@@ -162,6 +162,9 @@ pub struct Cloth {
     /// Where the mesh colliders were (a fraction of the call's travel) when the last accepted
     /// step of this call ended: where the next step's continuous check starts them.
     mesh_from: f64,
+    /// Cloth vertices the mesh colliders carried (kept from passing through them), summed
+    /// over the steps since the cloth was made.
+    mesh_carried: u64,
     /// The half-derivative memories the model's terms and pair elements read.
     histories: Histories,
     time: f64,
@@ -219,6 +222,7 @@ impl Cloth {
             mesh_slots: Vec::new(),
             self_collision,
             mesh_from: 0.0,
+            mesh_carried: 0,
             histories: Histories::new(&config.model, config.scheme, &topology)?,
             time: 0.0,
             steps: 0,

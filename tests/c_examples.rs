@@ -198,6 +198,26 @@ fn mesh_collider_example_keeps_the_towel_outside_the_box() {
         FcStatus::FC_ERROR_INVALID_ARGUMENT as i32
     );
     assert_eq!(status("step_after"), FcStatus::FC_OK as i32);
+    // The continuous check's totals: every output written, nothing left crossing, at least
+    // as many passages as steps that had one; NULL outputs accepted, a NULL cloth refused.
+    let stats: Vec<u64> = field(&out, "collision_stats")
+        .iter()
+        .map(|s| s.parse().unwrap())
+        .collect();
+    assert_eq!(stats[0], FcStatus::FC_OK as u64, "{stats:?}");
+    assert!(
+        stats[1..].iter().all(|&v| v != u64::MAX),
+        "every output written: {stats:?}"
+    );
+    assert_eq!(stats[4], 0, "no passage left unresolved: {stats:?}");
+    assert!(stats[2] >= stats[1], "passages >= steps with one: {stats:?}");
+    assert_eq!(
+        field(&out, "collision_stats_null"),
+        vec![
+            (FcStatus::FC_OK as i32).to_string(),
+            (FcStatus::FC_ERROR_NULL_ARGUMENT as i32).to_string()
+        ]
+    );
     assert_eq!(status("removed"), FcStatus::FC_OK as i32);
     assert_eq!(status("after_remove"), FcStatus::FC_ERROR_OUT_OF_RANGE as i32);
 }

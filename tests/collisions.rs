@@ -146,7 +146,7 @@ fn towel_on_a_turning_torus(max_substep: f64) {
 /// m/s, then holds it there for `hold` frames. Returns the bar's z at the end, the bottom row's
 /// mean z and how many of its vertices are past the bar, and the mean z of the row nearest the
 /// bar's height.
-fn sweep_bar(model: Model, y: f64, half_width: f64, speed: f64, hold: usize) -> (f64, f64, usize, f64) {
+fn sweep_bar(model: Model, y: f64, half_width: f64, speed: f64, hold: usize) -> (f64, f64, usize, f64, u64) {
     let mut cloth = fraccloth_tools::scenes::collision_towel_with(
         21,
         21,
@@ -181,13 +181,13 @@ fn sweep_bar(model: Model, y: f64, half_width: f64, speed: f64, hold: usize) -> 
     let row = &cloth.positions()[near * 21..(near + 1) * 21];
     let (bottom_z, row_z) = (mean_z(bottom), mean_z(row));
     println!("bar at {speed} m/s, y {y}, z = {z:.3}: bottom row mean z {bottom_z:.3}, {behind} of it past the bar; row {near} mean z {row_z:.3}");
-    (z, bottom_z, behind, row_z)
+    (z, bottom_z, behind, row_z, cloth.mesh_carried())
 }
 
 /// [`sweep_bar`] at 0.1 m/s: the bar caught the towel: no vertex of the bottom row past the
 /// bar, the row carried to within 3 cm of it.
 fn sweep_bar_catches(model: Model, y: f64, half_width: f64) {
-    let (z, mean_z, behind, _) = sweep_bar(model, y, half_width, 0.1, 0);
+    let (z, mean_z, behind, _, _) = sweep_bar(model, y, half_width, 0.1, 0);
     assert_eq!(behind, 0, "no vertex of the bottom row slipped past the bar");
     assert!(
         mean_z < z + 0.03,
@@ -223,7 +223,11 @@ fn fast_thin_bars_catch_the_towel() {
         ..Model::underwater()
     };
     for (model, y, half_width) in [(thin, -0.3, 0.002), (between, -0.31, 0.001)] {
-        let (z, _, _, row_z) = sweep_bar(model, y, half_width, 1.0, 30);
+        let (z, _, _, row_z, carried) = sweep_bar(model, y, half_width, 1.0, 30);
+        assert!(
+            carried > 0,
+            "1 m/s, bar at y {y}: the mesh carried vertices (its count says so)"
+        );
         assert!(
             (row_z - z).abs() < 0.03,
             "1 m/s, bar at y {y}: the row at the bar hangs on it: {row_z} vs bar {z}"

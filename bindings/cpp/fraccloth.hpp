@@ -105,6 +105,16 @@ struct StepStats {
     double estimate = 0.0;  ///< automatic step: the substep estimate, s (0 with a fixed step)
 };
 
+/// What the continuous collision check did since the cloth was made
+/// (`fc_cloth_get_collision_stats`).
+struct CollisionStats {
+    uint64_t zone_steps = 0;    ///< steps in which a self-collision pair would have passed
+    uint64_t passages = 0;      ///< passages found
+    uint64_t zone_moved = 0;    ///< free vertices moved with an impact zone, summed over steps
+    uint64_t unresolved = 0;    ///< passages left (0: never through itself where pairs were listed)
+    uint64_t mesh_carried = 0;  ///< cloth vertices a mesh collider carried, summed over steps
+};
+
 /// One simulated cloth. Move-only; the handle is freed by the destructor.
 class Cloth {
 public:
@@ -170,6 +180,12 @@ public:
     StepStats step_stats() const {
         StepStats s;
         check(fc_cloth_get_step_stats(handle_, &s.substeps, &s.retries, &s.estimate));
+        return s;
+    }
+    CollisionStats collision_stats() const {
+        CollisionStats s;
+        check(fc_cloth_get_collision_stats(handle_, &s.zone_steps, &s.passages, &s.zone_moved,
+                                           &s.unresolved, &s.mesh_carried));
         return s;
     }
     /// Accept (true) or refuse (false, the default) implicit steps whose solver did not converge.

@@ -76,9 +76,16 @@ impl Cloth {
     }
 
     /// What self-collision's impact zones did since the cloth was made (the step's fail-safe:
-    /// `collide::impact_zones`).
+    /// `collide::impact_zones`), steps a refused call undid included.
     pub fn self_collision_zones(&self) -> ZoneTotals {
         self.self_collision.zones
+    }
+
+    /// Cloth vertices the mesh colliders carried since the cloth was made (each vertex counted
+    /// once a step it was carried in): the continuous check's fail-safe against passing
+    /// through a moving mesh. Steps a refused call undid are counted too.
+    pub fn mesh_carried(&self) -> u64 {
+        self.mesh_carried
     }
 
     /// How many times self-collision looked its pairs up again since the cloth was made.

@@ -219,7 +219,9 @@ impl Cloth {
         let friction = self.friction(h) | self.contact_friction(h);
         let limited = self.limit_collision_step() > 0;
         self.pins(h);
-        let carried = self.carry_through_meshes(h, plan.fraction) > 0;
+        let carried = self.carry_through_meshes(h, plan.fraction);
+        self.mesh_carried += carried as u64;
+        let carried = carried > 0;
         let zoned = self.impact_zones(h) > 0;
         self.check(h, integrated_sound && !friction && !limited && !carried && !zoned)?;
         if zoned {

@@ -510,6 +510,42 @@ pub unsafe extern "C" fn fc_cloth_get_step_stats(
     })
 }
 
+/// Reads what the continuous collision check did since the cloth was made (steps that a
+/// refused call undid included): `zone_steps`, the steps in which a self-collision pair would
+/// have passed through another; `passages`, how many such passages were found; `zone_moved`,
+/// the free vertices moved with an impact zone (summed over steps); `unresolved`, passages
+/// still there when the zones stopped (0: the cloth never went through itself where its pairs
+/// were listed); `mesh_carried`, cloth vertices a mesh collider carried rather than let pass
+/// through it (summed over steps). All 0 for a cloth without self-collision or mesh colliders.
+/// Any output may be NULL.
+///
+/// # Safety
+/// `cloth` NULL or live; outputs NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn fc_cloth_get_collision_stats(
+    cloth: *const FcCloth,
+    zone_steps: *mut u64,
+    passages: *mut u64,
+    zone_moved: *mut u64,
+    unresolved: *mut u64,
+    mesh_carried: *mut u64,
+) -> FcStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let cloth = unsafe { handle(cloth) }?;
+        let zones = cloth.self_collision_zones();
+        // SAFETY: each output is NULL or writable, as the caller promises.
+        unsafe {
+            put(zone_steps, zones.steps);
+            put(passages, zones.passages);
+            put(zone_moved, zones.moved);
+            put(unresolved, zones.unresolved);
+            put(mesh_carried, cloth.mesh_carried());
+        }
+        Ok(())
+    })
+}
+
 /// Whether an implicit step whose solver stops at `solver_max_iterations` above
 /// `solver_tolerance` is accepted (`accept` non-zero: the step returns `FC_OK`; read
 /// `fc_cloth_get_solver_stats`) or refused (0, the default: `FC_ERROR_NOT_CONVERGED`, the

@@ -27,6 +27,7 @@ __all__ = [
     "FcClothDesc",
     "SolverStats",
     "StepStats",
+    "CollisionStats",
     "MAX_SUBSTEP_AUTO",
     "PRESET_FRACTIONAL_PAPER",
     "PRESET_REGULAR_VISCOUS_NORMAL",
@@ -130,6 +131,7 @@ _c = ctypes
 _P = ctypes.c_void_p
 _F3 = ctypes.POINTER(ctypes.c_float)
 _U32P = ctypes.POINTER(ctypes.c_uint32)
+_U64P = ctypes.POINTER(ctypes.c_uint64)
 _D3 = ctypes.POINTER(ctypes.c_double)
 _SIGNATURES = {
     "fc_last_error_message": (_c.c_char_p, []),
@@ -169,6 +171,7 @@ _SIGNATURES = {
     "fc_cloth_set_solver": (_c.c_int, [_P, _c.c_double, _c.c_uint32]),
     "fc_cloth_get_solver_stats": (_c.c_int, [_P, _U32P, _D3]),
     "fc_cloth_get_step_stats": (_c.c_int, [_P, _U32P, _U32P, _D3]),
+    "fc_cloth_get_collision_stats": (_c.c_int, [_P, _U64P, _U64P, _U64P, _U64P, _U64P]),
     "fc_cloth_set_solver_accept_unconverged": (_c.c_int, [_P, _c.c_int32]),
     "fc_cloth_snapshot_size": (_c.c_size_t, [_P]),
     "fc_cloth_save_snapshot": (_c.c_int, [_P, _P, _c.c_size_t, _c.POINTER(_c.c_size_t)]),
@@ -340,6 +343,20 @@ class StepStats(NamedTuple):
     substeps: int
     retries: int
     estimate: float
+
+
+class CollisionStats(NamedTuple):
+    """What the continuous collision check did since the cloth was made: ``zone_steps`` (steps
+    in which a self-collision pair would have passed through another), ``passages`` found,
+    ``zone_moved`` (free vertices moved with an impact zone, summed over steps), ``unresolved``
+    (passages left: 0 means the cloth never went through itself where its pairs were listed) and
+    ``mesh_carried`` (cloth vertices a mesh collider carried rather than let through)."""
+
+    zone_steps: int
+    passages: int
+    zone_moved: int
+    unresolved: int
+    mesh_carried: int
 
 
 class SolverStats(NamedTuple):
@@ -564,6 +581,12 @@ class Cloth:
         n, r, e = ctypes.c_uint32(), ctypes.c_uint32(), ctypes.c_double()
         _check(library.fc_cloth_get_step_stats(self._h, ctypes.byref(n), ctypes.byref(r), ctypes.byref(e)))
         return StepStats(n.value, r.value, e.value)
+
+    def collision_stats(self) -> CollisionStats:
+        """What the continuous collision check did since the cloth was made."""
+        out = [ctypes.c_uint64() for _ in range(5)]
+        _check(library.fc_cloth_get_collision_stats(self._h, *(ctypes.byref(o) for o in out)))
+        return CollisionStats(*(o.value for o in out))
 
     def set_solver_accept_unconverged(self, accept: bool) -> None:
         """Accept (True) or refuse (False, the default) implicit steps that stop at the

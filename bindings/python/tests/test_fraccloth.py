@@ -312,6 +312,9 @@ def test_triangle_mesh_collider_and_self_collision():
         inside = (np.abs(x[:, 0]) < 0.1) & (np.abs(x[:, 2]) < 0.1) & (np.abs(x[:, 1] - 0.029) < 0.05)
         assert not inside.any()
         assert x[:, 1].max() < top + 0.03 and x[:, 1].min() < top - 0.05
+        stats = cloth.collision_stats()
+        assert isinstance(stats, fraccloth.CollisionStats)
+        assert stats.unresolved == 0 and stats.passages >= stats.zone_steps
         with pytest.raises(fraccloth.Error) as e:
             cloth.add_mesh_collider(box, [[0, 1, 99]])
         assert e.value.status == 3
