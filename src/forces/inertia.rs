@@ -458,12 +458,7 @@ fn turning_chunked(
                 projected,
                 normals,
             };
-            let k = lo / split.chunk;
-            if split.borders(k).is_empty() {
-                turning_chunk_widest(ma, t, x, v, split, k, chunk);
-            } else {
-                turning_chunk_border_widest(ma, t, x, v, split, k, chunk);
-            }
+            turning_chunk_widest(ma, t, x, v, split, lo / split.chunk, chunk);
         });
     }
     if split.borders.is_empty() {
@@ -486,11 +481,11 @@ fn turning_chunked(
     });
 }
 
-crate::simd_dispatch! { fn turning_chunk_widest(ma: f64, t: &Topology, x: &[Vec3], v: &[Vec3], split: &TurningSplit, k: usize, c: Chunk<'_>) => turning_chunk_plain }
-crate::simd_dispatch! { fn turning_chunk_border_widest(ma: f64, t: &Topology, x: &[Vec3], v: &[Vec3], split: &TurningSplit, k: usize, c: Chunk<'_>) => turning_chunk_border }
+crate::simd_dispatch! { fn turning_chunk_widest(ma: f64, t: &Topology, x: &[Vec3], v: &[Vec3], split: &TurningSplit, k: usize, c: Chunk<'_>) => turning_chunk_any }
 
+/// [`turning_chunk`] for chunk `k`, with the border tests where it has border vertices.
 #[inline(always)]
-fn turning_chunk_plain(
+fn turning_chunk_any(
     ma: f64,
     t: &Topology,
     x: &[Vec3],
@@ -499,20 +494,11 @@ fn turning_chunk_plain(
     k: usize,
     c: Chunk<'_>,
 ) {
-    turning_chunk::<false>(ma, t, x, v, split, k, c)
-}
-
-#[inline(always)]
-fn turning_chunk_border(
-    ma: f64,
-    t: &Topology,
-    x: &[Vec3],
-    v: &[Vec3],
-    split: &TurningSplit,
-    k: usize,
-    c: Chunk<'_>,
-) {
-    turning_chunk::<true>(ma, t, x, v, split, k, c)
+    if split.borders(k).is_empty() {
+        turning_chunk::<false>(ma, t, x, v, split, k, c)
+    } else {
+        turning_chunk::<true>(ma, t, x, v, split, k, c)
+    }
 }
 
 /// One chunk's arrays (`lo` its first vertex).
