@@ -129,6 +129,59 @@ fn steps_do_not_allocate() {
             scheme.name()
         );
     }
+    // Self-collision's impact zones reuse their buffers: a step with a passage allocates
+    // nothing once they have grown, where fresh buffers allocate (the union-find).
+    {
+        use fraccloth::collide::impact_zones::{keep_from_passing, ZoneInput, ZoneScratch};
+        use fraccloth::Vec3;
+        // A pinned triangle dropping 3 cm through a free vertex 1 cm below it.
+        let x0 = [
+            Vec3::new(0.0, 0.0, 0.01),
+            Vec3::new(1.0, 0.0, 0.01),
+            Vec3::new(0.0, 1.0, 0.01),
+            Vec3::new(0.2, 0.2, 0.0),
+        ];
+        let (tris, masses, pinned) = ([[0u32, 1, 2]], [1.0; 4], [true, true, true, false]);
+        let adjacency = fraccloth::topology::Adjacency::triangles(4, &tris);
+        let pairs = [(3u32, 0u32, -1i8)];
+        let input = ZoneInput {
+            x0: &x0,
+            masses: &masses,
+            kinematic: &pinned,
+            triangles: &tris,
+            vertex_triangles: &adjacency,
+            neighbours: (&[], &[]),
+            edges: &[],
+            vertex_triangle: &pairs,
+            edge_edge: &[],
+            tolerance: 1e-9,
+        };
+        let (mut moved, mut stopped, mut scratch) = (Vec::new(), Vec::new(), ZoneScratch::default());
+        let zone_step = |scratch: &mut ZoneScratch, moved: &mut Vec<u32>, stopped: &mut Vec<_>| {
+            let mut x1: [Vec3; 4] = x0;
+            for p in &mut x1[..3] {
+                *p -= Vec3::new(0.0, 0.0, 0.03);
+            }
+            let report = keep_from_passing(&input, &mut x1, moved, stopped, scratch).expect("room");
+            assert_eq!((report.passages, report.moved, report.unresolved), (1, 1, 0));
+        };
+        zone_step(&mut scratch, &mut moved, &mut stopped);
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for _ in 0..10 {
+            zone_step(&mut scratch, &mut moved, &mut stopped);
+        }
+        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert_eq!(
+            during, 0,
+            "impact zones: {during} allocations in 10 steps with a passage"
+        );
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        zone_step(&mut ZoneScratch::default(), &mut moved, &mut stopped);
+        assert!(
+            ALLOCATIONS.load(Ordering::Relaxed) > before,
+            "fresh buffers allocate"
+        );
+    }
     // The counter does count: building a cloth allocates.
     let before = ALLOCATIONS.load(Ordering::Relaxed);
     let _ = SceneSpec::paper(SceneKind::Swing, Variant::Fractional)

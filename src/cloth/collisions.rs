@@ -309,12 +309,14 @@ impl Cloth {
     /// (`collide::impact_zones`): a free vertex that would pass through a triangle of the
     /// cloth, or an edge through an edge, in this step moves as one with the others of its
     /// zone (with a pinned row that presses it, or at their shared momentum), its velocity its
-    /// new displacement over the step. Returns how many vertices were moved.
-    pub(super) fn impact_zones(&mut self, h: f64) -> usize {
+    /// new displacement over the step. Returns how many vertices were moved, or an
+    /// out-of-memory error (the state left unchanged) when the zones' union-find, one number
+    /// a vertex, cannot be allocated the first time a step needs it.
+    pub(super) fn impact_zones(&mut self, h: f64) -> Result<usize, Error> {
         let thickness = self.config.model.self_collision_thickness;
         let sc = &self.self_collision;
         if thickness <= 0.0 || (sc.vertex_triangle.is_empty() && sc.edge_edge.is_empty()) {
-            return 0;
+            return Ok(0);
         }
         let super::step::StepScratch {
             carried,
@@ -323,6 +325,7 @@ impl Cloth {
             v_new,
             zone_moved,
             zone_stopped,
+            zones,
             ..
         } = &mut self.scratch;
         // Vertices a mesh carried this step are held like pins.
@@ -347,13 +350,18 @@ impl Cloth {
             edge_edge: &sc.edge_edge,
             tolerance: PASSAGE_TOLERANCE * thickness,
         };
-        let report = keep_from_passing(&input, x_new, zone_moved, zone_stopped);
+        let n = input.x0.len();
+        let report = keep_from_passing(&input, x_new, zone_moved, zone_stopped, zones).map_err(|_| {
+            Error::out_of_memory(format!(
+                "self-collision's impact zones: their union-find of {n} vertices cannot be allocated; state left unchanged"
+            ))
+        })?;
         for &i in zone_moved.iter() {
             let i = i as usize;
             v_new[i] = (x_new[i] - self.x[i]) / h;
         }
         self.self_collision.zones.add(&report);
-        report.moved
+        Ok(report.moved)
     }
 
     /// After a step the impact zones changed, once it is accepted: a pair kept from passing

@@ -116,6 +116,8 @@ pub(super) struct StepScratch {
     pub kinematic: Vec<bool>,
     /// The passages they stopped (`collide::impact_zones`).
     pub zone_stopped: Vec<crate::collide::impact_zones::Passage>,
+    /// The impact zones' own buffers (their union-find, the passages of a round).
+    pub zones: crate::collide::impact_zones::ZoneScratch,
     /// The mesh colliders' contacts where a call begins, and each vertex's weight from them
     /// (`Cloth::measure_contact_weights`; empty without contacts).
     pub start_contacts: Vec<crate::collide::Contact>,
@@ -222,7 +224,7 @@ impl Cloth {
         let carried = self.carry_through_meshes(h, plan.fraction);
         self.mesh_carried += carried as u64;
         let carried = carried > 0;
-        let zoned = self.impact_zones(h) > 0;
+        let zoned = self.impact_zones(h)? > 0;
         self.check(h, integrated_sound && !friction && !limited && !carried && !zoned)?;
         if zoned {
             self.learn_stopped_sides();

@@ -99,18 +99,28 @@ pub struct Passage {
     pub sign: i8,
 }
 
-/// Union-find over the vertices.
-struct Zones {
+/// The buffers [`keep_from_passing`] reuses from step to step: once grown, a step with
+/// passages allocates nothing (and the union-find's, one number a vertex, is reserved
+/// fallibly).
+#[derive(Clone, Debug, Default)]
+pub struct ZoneScratch {
+    passing: Vec<Passage>,
+    members: Vec<u32>,
+    seen: Vec<u32>,
     parent: Vec<u32>,
+    sums: Vec<ZoneSums>,
 }
 
-impl Zones {
-    fn new(n: usize) -> Zones {
-        Zones {
-            parent: (0..n as u32).collect(),
-        }
-    }
+/// Per zone root: the sums of its free vertices' mass-weighted displacements and masses, and of
+/// its kinematic vertices' displacements and count.
+type ZoneSums = (u32, Vec3, f64, Vec3, f64);
 
+/// Union-find over the vertices.
+struct Zones<'a> {
+    parent: &'a mut [u32],
+}
+
+impl Zones<'_> {
     fn root(&mut self, mut i: u32) -> u32 {
         while self.parent[i as usize] != i {
             let p = self.parent[i as usize];
@@ -262,28 +272,38 @@ pub fn keep_from_passing(
     x1: &mut [Vec3],
     moved: &mut Vec<u32>,
     stopped: &mut Vec<Passage>,
-) -> ZoneReport {
+    scratch: &mut ZoneScratch,
+) -> Result<ZoneReport, std::collections::TryReserveError> {
     moved.clear();
     stopped.clear();
-    let mut passing = Vec::new();
-    input.passages(x1, &mut passing);
-    let (mut members, mut seen) = (Vec::new(), Vec::new());
+    let ZoneScratch {
+        passing,
+        members,
+        seen,
+        parent,
+        sums,
+    } = scratch;
+    input.passages(x1, passing);
+    members.clear();
     let mut report = ZoneReport {
         passages: passing.len(),
         ..ZoneReport::default()
     };
     if passing.is_empty() {
-        return report;
+        return Ok(report);
     }
     let n = input.x0.len();
-    let mut zones = Zones::new(n);
+    parent.clear();
+    parent.try_reserve(n)?;
+    parent.extend(0..n as u32);
+    let mut zones = Zones { parent };
     for _ in 0..MAX_ROUNDS {
         let mut joined = false;
-        for p in &passing {
+        for p in passing.iter() {
             joined |= zones.join(p.vs);
             members.extend_from_slice(&p.vs);
         }
-        stopped.extend_from_slice(&passing);
+        stopped.extend_from_slice(passing);
         if !joined {
             // Every passage is inside a zone already moved as one: zones whose kinematic
             // vertices move apart. Nothing more a translation can do.
@@ -291,9 +311,9 @@ pub fn keep_from_passing(
         }
         members.sort_unstable();
         members.dedup();
-        move_zones(input, &mut zones, &members, x1);
-        input.passages(x1, &mut passing);
-        input.neighbour_passages(x1, &members, &mut seen, &mut passing);
+        move_zones(input, &mut zones, members, sums, x1);
+        input.passages(x1, passing);
+        input.neighbour_passages(x1, members, seen, passing);
         if passing.is_empty() {
             break;
         }
@@ -301,13 +321,19 @@ pub fn keep_from_passing(
     report.unresolved = passing.len();
     moved.extend(members.iter().copied().filter(|&i| !input.kinematic[i as usize]));
     report.moved = moved.len();
-    report
+    Ok(report)
 }
 
 /// Moves every zone touching `members` by its translation (module docs).
-fn move_zones(input: &ZoneInput, zones: &mut Zones, members: &[u32], x1: &mut [Vec3]) {
+fn move_zones(
+    input: &ZoneInput,
+    zones: &mut Zones,
+    members: &[u32],
+    sums: &mut Vec<ZoneSums>,
+    x1: &mut [Vec3],
+) {
     // Per root: sums of (mass-weighted free, kinematic) displacements and their weights.
-    let mut sums: Vec<(u32, Vec3, f64, Vec3, f64)> = Vec::new();
+    sums.clear();
     for &i in members {
         let r = zones.root(i);
         let k = match sums.binary_search_by_key(&r, |s| s.0) {
@@ -405,7 +431,14 @@ mod tests {
             *p -= Vec3::new(0.0, 0.0, 0.03);
         }
         let mut moved = Vec::new();
-        let report = keep_from_passing(&zi, &mut x1, &mut moved, &mut Vec::new());
+        let report = keep_from_passing(
+            &zi,
+            &mut x1,
+            &mut moved,
+            &mut Vec::new(),
+            &mut ZoneScratch::default(),
+        )
+        .expect("room");
         assert_eq!(report.passages, 1);
         assert_eq!(report.unresolved, 0);
         assert_eq!(moved, vec![3]);
@@ -430,7 +463,14 @@ mod tests {
         let momentum = |x: &[Vec3]| (0..4).map(|i| x[i] - x0[i]).sum::<Vec3>();
         let before = momentum(&x1);
         let mut moved = Vec::new();
-        let report = keep_from_passing(&zi, &mut x1, &mut moved, &mut Vec::new());
+        let report = keep_from_passing(
+            &zi,
+            &mut x1,
+            &mut moved,
+            &mut Vec::new(),
+            &mut ZoneScratch::default(),
+        )
+        .expect("room");
         assert_eq!((report.passages, report.unresolved), (1, 0));
         assert_eq!(moved, vec![0, 1, 2, 3]);
         assert!((momentum(&x1) - before).norm() < 1e-15);
@@ -450,7 +490,14 @@ mod tests {
         let mut x1 = x0.clone();
         x1[3] += Vec3::new(0.0, 0.0, 0.05);
         let (mut moved, mut stopped) = (Vec::new(), Vec::new());
-        let report = keep_from_passing(&zi, &mut x1, &mut moved, &mut stopped);
+        let report = keep_from_passing(
+            &zi,
+            &mut x1,
+            &mut moved,
+            &mut stopped,
+            &mut ZoneScratch::default(),
+        )
+        .expect("room");
         assert_eq!((report.passages, report.unresolved), (1, 0));
         assert_eq!(
             stopped,
@@ -484,7 +531,14 @@ mod tests {
         let mut x1 = x0.clone();
         x1[3] -= Vec3::new(0.0, 0.0, 0.05);
         let proposed = x1.clone();
-        let report = keep_from_passing(&zi, &mut x1, &mut Vec::new(), &mut Vec::new());
+        let report = keep_from_passing(
+            &zi,
+            &mut x1,
+            &mut Vec::new(),
+            &mut Vec::new(),
+            &mut ZoneScratch::default(),
+        )
+        .expect("room");
         assert_eq!(report, ZoneReport::default());
         assert_eq!(x1, proposed);
         // With the far corner above the triangle's plane, nothing pierces it: stopped.
@@ -493,7 +547,14 @@ mod tests {
         let zi = ZoneInput { x0: &untangled, ..zi };
         let mut x1 = untangled.clone();
         x1[3] -= Vec3::new(0.0, 0.0, 0.05);
-        let report = keep_from_passing(&zi, &mut x1, &mut Vec::new(), &mut Vec::new());
+        let report = keep_from_passing(
+            &zi,
+            &mut x1,
+            &mut Vec::new(),
+            &mut Vec::new(),
+            &mut ZoneScratch::default(),
+        )
+        .expect("room");
         assert_eq!((report.passages, report.unresolved), (1, 0));
     }
 
@@ -516,7 +577,14 @@ mod tests {
             *p -= Vec3::new(0.0, 0.0, 0.03);
         }
         let mut moved = Vec::new();
-        let report = keep_from_passing(&zi, &mut x1, &mut moved, &mut Vec::new());
+        let report = keep_from_passing(
+            &zi,
+            &mut x1,
+            &mut moved,
+            &mut Vec::new(),
+            &mut ZoneScratch::default(),
+        )
+        .expect("room");
         assert_eq!(report.passages, 1);
         assert_eq!(report.unresolved, 0);
         assert_eq!(moved, vec![3, 5, 6, 7]);
