@@ -26,15 +26,16 @@ pub const CHUNK: usize = 4096;
 pub const TILE: usize = 256;
 const _: () = assert!(CHUNK % TILE == 0);
 
-/// Fewest particles for which a step uses more than one thread on an Intel CPU (measured with
-/// `cargo run --release --example throughput`; see docs/benchmarks.md), and on any CPU not
-/// measured: the largest of the thresholds, so a cloth of this many particles uses the pool on
-/// every CPU unless [`MIN_PARALLEL_VARIABLE`] says otherwise.
+/// Fewest particles for which a step uses more than one thread on a CPU not made by AMD (an
+/// Intel Xeon): the threshold chosen at stop 15 with `cargo run --release --example
+/// throughput` (docs/benchmarks.md), not yet measured lower on an Intel Xeon. The largest of
+/// the thresholds, so a cloth of this many particles uses the pool on every CPU unless
+/// [`MIN_PARALLEL_VARIABLE`] says otherwise.
 pub const MIN_PARALLEL: usize = 16_000;
 
-/// Fewest particles for which a step uses more than one thread on an AMD CPU: two threads
-/// gain 1.25x from 6 500 particles on the AMD EPYC measured (`step_cycles`, docs/benchmarks.md,
-/// issue 36) and break even at 5 000.
+/// Fewest particles for which a step uses more than one thread on an AMD CPU: on the AMD EPYC
+/// measured (Zen 4, `step_cycles`, docs/benchmarks.md, stop 45) two threads gain 1.22-1.27x at
+/// 6 400 particles (80 x 80) and break even at about 5 000.
 pub const MIN_PARALLEL_AMD: usize = 6_400;
 
 /// Environment variable that sets the fewest particles for which a step uses the pool (a
