@@ -107,6 +107,9 @@ int main(int argc, char** argv) try {
     // The preset's automatic step chose the substeps of that call.
     const fraccloth::StepStats steps = cloth.step_stats();
     require(steps.substeps >= 1 && steps.estimate > 0.0, "step stats");
+    // What the continuous collision check did: nothing left passing through.
+    const fraccloth::CollisionStats hits = cloth.collision_stats();
+    require(hits.unresolved == 0 && hits.passages >= hits.zone_steps, "collision stats");
     cloth.remove_collider(capsule);
 
     cloth.write_obj(dir + "/tour.obj");
