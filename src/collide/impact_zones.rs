@@ -417,6 +417,16 @@ mod tests {
         }
     }
 
+    /// [`keep_from_passing`] with fresh buffers.
+    fn zones(
+        zi: &ZoneInput,
+        x1: &mut [Vec3],
+        moved: &mut Vec<u32>,
+        stopped: &mut Vec<Passage>,
+    ) -> ZoneReport {
+        keep_from_passing(zi, x1, moved, stopped, &mut ZoneScratch::default()).expect("room for the zones")
+    }
+
     #[test]
     fn a_pinned_triangle_carries_the_vertex_it_would_push_through() {
         let (x0, tris, edges) = scene();
@@ -431,14 +441,7 @@ mod tests {
             *p -= Vec3::new(0.0, 0.0, 0.03);
         }
         let mut moved = Vec::new();
-        let report = keep_from_passing(
-            &zi,
-            &mut x1,
-            &mut moved,
-            &mut Vec::new(),
-            &mut ZoneScratch::default(),
-        )
-        .expect("room");
+        let report = zones(&zi, &mut x1, &mut moved, &mut Vec::new());
         assert_eq!(report.passages, 1);
         assert_eq!(report.unresolved, 0);
         assert_eq!(moved, vec![3]);
@@ -463,14 +466,7 @@ mod tests {
         let momentum = |x: &[Vec3]| (0..4).map(|i| x[i] - x0[i]).sum::<Vec3>();
         let before = momentum(&x1);
         let mut moved = Vec::new();
-        let report = keep_from_passing(
-            &zi,
-            &mut x1,
-            &mut moved,
-            &mut Vec::new(),
-            &mut ZoneScratch::default(),
-        )
-        .expect("room");
+        let report = zones(&zi, &mut x1, &mut moved, &mut Vec::new());
         assert_eq!((report.passages, report.unresolved), (1, 0));
         assert_eq!(moved, vec![0, 1, 2, 3]);
         assert!((momentum(&x1) - before).norm() < 1e-15);
@@ -490,14 +486,7 @@ mod tests {
         let mut x1 = x0.clone();
         x1[3] += Vec3::new(0.0, 0.0, 0.05);
         let (mut moved, mut stopped) = (Vec::new(), Vec::new());
-        let report = keep_from_passing(
-            &zi,
-            &mut x1,
-            &mut moved,
-            &mut stopped,
-            &mut ZoneScratch::default(),
-        )
-        .expect("room");
+        let report = zones(&zi, &mut x1, &mut moved, &mut stopped);
         assert_eq!((report.passages, report.unresolved), (1, 0));
         assert_eq!(
             stopped,
@@ -531,14 +520,7 @@ mod tests {
         let mut x1 = x0.clone();
         x1[3] -= Vec3::new(0.0, 0.0, 0.05);
         let proposed = x1.clone();
-        let report = keep_from_passing(
-            &zi,
-            &mut x1,
-            &mut Vec::new(),
-            &mut Vec::new(),
-            &mut ZoneScratch::default(),
-        )
-        .expect("room");
+        let report = zones(&zi, &mut x1, &mut Vec::new(), &mut Vec::new());
         assert_eq!(report, ZoneReport::default());
         assert_eq!(x1, proposed);
         // With the far corner above the triangle's plane, nothing pierces it: stopped.
@@ -547,14 +529,7 @@ mod tests {
         let zi = ZoneInput { x0: &untangled, ..zi };
         let mut x1 = untangled.clone();
         x1[3] -= Vec3::new(0.0, 0.0, 0.05);
-        let report = keep_from_passing(
-            &zi,
-            &mut x1,
-            &mut Vec::new(),
-            &mut Vec::new(),
-            &mut ZoneScratch::default(),
-        )
-        .expect("room");
+        let report = zones(&zi, &mut x1, &mut Vec::new(), &mut Vec::new());
         assert_eq!((report.passages, report.unresolved), (1, 0));
     }
 
@@ -577,14 +552,7 @@ mod tests {
             *p -= Vec3::new(0.0, 0.0, 0.03);
         }
         let mut moved = Vec::new();
-        let report = keep_from_passing(
-            &zi,
-            &mut x1,
-            &mut moved,
-            &mut Vec::new(),
-            &mut ZoneScratch::default(),
-        )
-        .expect("room");
+        let report = zones(&zi, &mut x1, &mut moved, &mut Vec::new());
         assert_eq!(report.passages, 1);
         assert_eq!(report.unresolved, 0);
         assert_eq!(moved, vec![3, 5, 6, 7]);
