@@ -100,6 +100,26 @@ fn front(p: &Vec3) -> (f64, f64) {
     (p.x, p.y)
 }
 
+/// A side view of `cloth` titled with `label`, the time `when` and how many of its triangle
+/// pairs cross.
+fn crossings_panel(
+    area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    label: &str,
+    when: &str,
+    cloth: &Cloth,
+    range: ((f64, f64), (f64, f64)),
+) -> Result<(), Box<dyn std::error::Error>> {
+    let n = self_intersections(cloth.positions(), &cloth.topology().triangles);
+    panel(
+        area,
+        &format!("{label}, {when}: {n} crossing pairs"),
+        cloth,
+        None,
+        side,
+        range,
+    )
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all("docs/collisions")?;
     let floor = Collider::Plane(Plane {
@@ -121,18 +141,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 cloth.step(1.0 / FPS)?;
                 f += 1;
             }
-            let n = self_intersections(cloth.positions(), &cloth.topology().triangles);
             let label = if thickness > 0.0 {
                 "self-collision 5 mm"
             } else {
                 "no self-collision"
             };
-            panel(
+            let when = format!("{:.1} s", f as f64 / FPS);
+            crossings_panel(
                 &rows[3 * r + k],
-                &format!("{label}, {:.1} s: {n} crossing pairs", f as f64 / FPS),
+                label,
+                &when,
                 &cloth,
-                None,
-                side,
                 ((-0.35, 0.35), (-0.02, 0.65)),
             )?;
         }
@@ -251,18 +270,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 f += 1;
                 scene.run_until(f as f64 / FPS)?;
             }
-            let n = self_intersections(scene.cloth.positions(), &scene.cloth.topology().triangles);
             let label = if thickness > 0.0 {
                 "2 Hz 8 cm, self-collision 6 mm"
             } else {
                 "2 Hz 8 cm, no self-collision"
             };
-            panel(
+            let when = format!("{:.0} s", f as f64 / FPS);
+            crossings_panel(
                 &rows[3 * r + k],
-                &format!("{label}, {:.0} s: {n} crossing pairs", f as f64 / FPS),
+                label,
+                &when,
                 &scene.cloth,
-                None,
-                side,
                 ((-0.25, 0.25), (-0.45, 0.05)),
             )?;
         }

@@ -381,8 +381,11 @@ mod tests {
     /// The masses of [`scene`]'s vertices.
     const MASSES: [f64; 5] = [1.0, 1.0, 1.0, 1.0, 3.0];
 
+    /// Positions, triangles, edges and the triangles' adjacency.
+    type Scene = (Vec<Vec3>, Vec<[u32; 3]>, Vec<[u32; 2]>, Adjacency);
+
     /// A triangle (0, 1, 2) over a vertex 3 below it, with an edge (3, 4) beside.
-    fn scene() -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<[u32; 2]>) {
+    fn scene() -> Scene {
         let x0 = vec![
             Vec3::new(0.0, 0.0, 0.01),
             Vec3::new(1.0, 0.0, 0.01),
@@ -390,7 +393,25 @@ mod tests {
             Vec3::new(0.2, 0.2, 0.0),
             Vec3::new(0.2, 0.2, -0.5),
         ];
-        (x0, vec![[0, 1, 2]], vec![[3, 4]])
+        let tris = vec![[0, 1, 2]];
+        let adj = Adjacency::triangles(x0.len(), &tris);
+        (x0, tris, vec![[3, 4]], adj)
+    }
+
+    /// A proposed step with the triangle (vertices 0, 1, 2) dropped 3 cm, the rest left.
+    fn triangle_down(x0: &[Vec3]) -> Vec<Vec3> {
+        let mut x1 = x0.to_vec();
+        for p in &mut x1[..3] {
+            *p -= Vec3::new(0.0, 0.0, 0.03);
+        }
+        x1
+    }
+
+    /// [`scene`]'s proposed step with vertex 3 flying 5 cm up, through the triangle.
+    fn vertex_up(x0: &[Vec3]) -> Vec<Vec3> {
+        let mut x1 = x0.to_vec();
+        x1[3] += Vec3::new(0.0, 0.0, 0.05);
+        x1
     }
 
     /// The zones' input for these tests: no edge pairs, no neighbour rows.
@@ -429,17 +450,13 @@ mod tests {
 
     #[test]
     fn a_pinned_triangle_carries_the_vertex_it_would_push_through() {
-        let (x0, tris, edges) = scene();
+        let (x0, tris, edges, adj) = scene();
         let pinned = [true, true, true, false, false];
         // The vertex is below the triangle: side -1.
         let vt = [(3, 0, -1)];
-        let adj = Adjacency::triangles(x0.len(), &tris);
         let zi = input(&x0, &MASSES, &pinned, &tris, &adj, &edges, &vt);
         // The pinned triangle drops 3 cm; the vertex stays.
-        let mut x1 = x0.clone();
-        for p in &mut x1[..3] {
-            *p -= Vec3::new(0.0, 0.0, 0.03);
-        }
+        let mut x1 = triangle_down(&x0);
         let mut moved = Vec::new();
         let report = zones(&zi, &mut x1, &mut moved, &mut Vec::new());
         assert_eq!(report.passages, 1);
@@ -452,14 +469,12 @@ mod tests {
 
     #[test]
     fn free_vertices_keep_their_momentum_and_stop_passing() {
-        let (x0, tris, edges) = scene();
+        let (x0, tris, edges, adj) = scene();
         let free = [false; 5];
         let vt = [(3, 0, 0)];
-        let adj = Adjacency::triangles(x0.len(), &tris);
         let zi = input(&x0, &MASSES, &free, &tris, &adj, &edges, &vt);
         // The vertex flies up through the triangle, which moves a little down.
-        let mut x1 = x0.clone();
-        x1[3] += Vec3::new(0.0, 0.0, 0.05);
+        let mut x1 = vertex_up(&x0);
         for p in &mut x1[..3] {
             *p -= Vec3::new(0.0, 0.0, 0.001);
         }
@@ -476,15 +491,13 @@ mod tests {
 
     #[test]
     fn a_passage_is_stopped_whatever_side_the_pair_remembers_and_its_start_sign_reported() {
-        let (x0, tris, edges) = scene();
+        let (x0, tris, edges, adj) = scene();
         let free = [false; 5];
         // Remembered above (+1), though it starts below (-1): the memory is wrong, not the
         // geometry, and the vertex is still kept from going through.
         let vt = [(3, 0, 1)];
-        let adj = Adjacency::triangles(x0.len(), &tris);
         let zi = input(&x0, &MASSES, &free, &tris, &adj, &edges, &vt);
-        let mut x1 = x0.clone();
-        x1[3] += Vec3::new(0.0, 0.0, 0.05);
+        let mut x1 = vertex_up(&x0);
         let (mut moved, mut stopped) = (Vec::new(), Vec::new());
         let report = zones(&zi, &mut x1, &mut moved, &mut stopped);
         assert_eq!((report.passages, report.unresolved), (1, 0));
@@ -547,10 +560,7 @@ mod tests {
         let vt = [(3, 0, -1), (3, 1, 1)];
         let adj = Adjacency::triangles(x0.len(), &tris);
         let zi = input(&x0, &[1.0; 8], &kinematic, &tris, &adj, &[], &vt);
-        let mut x1 = x0.clone();
-        for p in &mut x1[..3] {
-            *p -= Vec3::new(0.0, 0.0, 0.03);
-        }
+        let mut x1 = triangle_down(&x0);
         let mut moved = Vec::new();
         let report = zones(&zi, &mut x1, &mut moved, &mut Vec::new());
         assert_eq!(report.passages, 1);
