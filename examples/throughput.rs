@@ -77,6 +77,12 @@ struct Config {
 fn configs() -> Vec<Config> {
     vec![
         Config {
+            name: "underwater preset, symplectic",
+            variant: Variant::Underwater,
+            scheme: Scheme::DEFAULT,
+            integrator: Integrator::SymplecticEuler,
+        },
+        Config {
             name: "fractional SOE, symplectic",
             variant: Variant::Fractional,
             scheme: Scheme::DEFAULT,
