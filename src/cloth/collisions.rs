@@ -314,8 +314,15 @@ impl Cloth {
     /// a vertex, cannot be allocated the first time a step needs it.
     pub(super) fn impact_zones(&mut self, h: f64) -> Result<usize, Error> {
         let thickness = self.config.model.self_collision_thickness;
+        if thickness <= 0.0 {
+            return Ok(0);
+        }
+        let tolerance = PASSAGE_TOLERANCE * thickness;
+        self.self_collision
+            .watch_guard(&self.x, &self.scratch.x_new, tolerance);
         let sc = &self.self_collision;
-        if thickness <= 0.0 || (sc.vertex_triangle.is_empty() && sc.edge_edge.is_empty()) {
+        let guard = sc.guarded();
+        if guard.is_empty() && sc.vertex_triangle.is_empty() && sc.edge_edge.is_empty() {
             return Ok(0);
         }
         let super::step::StepScratch {
@@ -348,7 +355,8 @@ impl Cloth {
             edges: sc.edges(),
             vertex_triangle: &sc.vertex_triangle,
             edge_edge: &sc.edge_edge,
-            tolerance: PASSAGE_TOLERANCE * thickness,
+            tolerance,
+            guard,
         };
         let n = input.x0.len();
         let report = keep_from_passing(&input, x_new, zone_moved, zone_stopped, zones).map_err(|_| {

@@ -11,7 +11,7 @@ use crate::math::Vec3;
 const LEAF: usize = 4;
 
 /// An axis-aligned box.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Aabb {
     pub min: Vec3,
     pub max: Vec3,

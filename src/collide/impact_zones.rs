@@ -79,6 +79,11 @@ pub struct ZoneInput<'a> {
     pub edge_edge: &'a [Pair],
     /// How near the points must come at a coplanar instant to meet, m.
     pub tolerance: f64,
+    /// Edge-edge neighbour pairs `(edge, edge)` (near each other at rest, so never listed,
+    /// sharing no vertex) checked like the listed pairs, at every round: across a fold the
+    /// parallel diagonals of two adjacent cells pass through each other with no listed pair
+    /// passing (`SelfCollision::guarded`: those that might in this step).
+    pub guard: &'a [(u32, u32)],
 }
 
 /// A pair, by its place in its list (or a neighbour pair, in none).
@@ -245,20 +250,29 @@ impl ZoneInput<'_> {
             out.extend(self.vertex_passage(x1, p, t, PairRef::VertexTriangle(k as u32)));
         }
         for (k, &(e, f, _)) in self.edge_edge.iter().enumerate() {
-            let (edge, other) = (self.edges[e as usize], self.edges[f as usize]);
-            let vs = [edge[0], edge[1], other[0], other[1]];
-            if !self.moving(x1, &vs) {
-                continue;
-            }
-            let path = self.path(x1, vs);
-            if edge_passes_edge(&path, self.tolerance).is_some() && !self.edges_tangled(edge, other) {
-                out.push(Passage {
-                    vs,
-                    pair: PairRef::EdgeEdge(k as u32),
-                    sign: start_sign(&path),
-                });
-            }
+            out.extend(self.edge_passage(x1, e, f, PairRef::EdgeEdge(k as u32)));
         }
+        for &(e, f) in self.guard {
+            out.extend(self.edge_passage(x1, e, f, PairRef::Neighbour));
+        }
+    }
+
+    /// Edge `e`'s passage through edge `f` in the step `x0 -> x1`, as `pair`: none if they do
+    /// not move, do not meet, or are tangled at the start.
+    fn edge_passage(&self, x1: &[Vec3], e: u32, f: u32, pair: PairRef) -> Option<Passage> {
+        let (edge, other) = (self.edges[e as usize], self.edges[f as usize]);
+        let vs = [edge[0], edge[1], other[0], other[1]];
+        if !self.moving(x1, &vs) {
+            return None;
+        }
+        let path = self.path(x1, vs);
+        (edge_passes_edge(&path, self.tolerance).is_some() && !self.edges_tangled(edge, other)).then(|| {
+            Passage {
+                vs,
+                pair,
+                sign: start_sign(&path),
+            }
+        })
     }
 }
 
@@ -431,6 +445,7 @@ mod tests {
             triangles,
             vertex_triangles: adjacency,
             neighbours: (&[], &[]),
+            guard: &[],
             edges,
             vertex_triangle: vt,
             edge_edge: &[],
@@ -446,6 +461,44 @@ mod tests {
         stopped: &mut Vec<Passage>,
     ) -> ZoneReport {
         keep_from_passing(zi, x1, moved, stopped, &mut ZoneScratch::default()).expect("room for the zones")
+    }
+
+    /// An edge-edge pair that is not listed (neighbours at rest) but guarded passes through
+    /// in a step: the zones stop it, as a listed pair's; not guarded, nothing is checked.
+    #[test]
+    fn a_guarded_neighbour_edge_pair_is_kept_from_passing() {
+        let x0 = vec![
+            Vec3::new(-1.0, 0.0, 0.01),
+            Vec3::new(1.0, 0.0, 0.01),
+            Vec3::new(0.0, -1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        let edges = [[0u32, 1], [2, 3]];
+        let (masses, kinematic) = ([1.0; 4], [false; 4]);
+        let adjacency = Adjacency::triangles(4, &[]);
+        let step = |guard: &[(u32, u32)]| {
+            let zi = ZoneInput {
+                guard,
+                ..input(&x0, &masses, &kinematic, &[], &adjacency, &edges, &[])
+            };
+            // The first edge dropped 3 cm, through the second.
+            let mut x1 = x0.clone();
+            for p in &mut x1[..2] {
+                *p -= Vec3::new(0.0, 0.0, 0.03);
+            }
+            let (mut moved, mut stopped) = (Vec::new(), Vec::new());
+            let report = zones(&zi, &mut x1, &mut moved, &mut stopped);
+            (report, x1, stopped)
+        };
+        let (report, x1, stopped) = step(&[(0, 1)]);
+        assert_eq!(report.passages, 1);
+        assert_eq!(report.unresolved, 0);
+        assert_eq!(stopped[0].pair, PairRef::Neighbour);
+        // One zone, moved by its momentum: the first edge still above the second.
+        assert!(x1[0].z > x1[2].z && x1[1].z > x1[3].z, "{x1:?}");
+        let (report, x1, _) = step(&[]);
+        assert_eq!(report.passages, 0);
+        assert!(x1[0].z < x1[2].z, "unguarded, it passes");
     }
 
     #[test]

@@ -108,6 +108,16 @@ impl Exclusions {
         self.vt[a..b].binary_search(&t).is_ok()
     }
 
+    /// Every excluded edge pair `(e, f)`, e < f (those sharing a vertex included), by `e` and
+    /// then `f` ascending.
+    pub(super) fn edge_pairs(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        (0..self.ee_start.len().saturating_sub(1)).flat_map(move |e| {
+            self.ee[self.ee_start[e] as usize..self.ee_start[e + 1] as usize]
+                .iter()
+                .map(move |&f| (e as u32, f))
+        })
+    }
+
     pub(super) fn edge_excludes(&self, e: u32, f: u32) -> bool {
         let (a, b) = (
             self.ee_start[e as usize] as usize,
