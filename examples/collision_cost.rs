@@ -13,8 +13,8 @@ use std::time::Instant;
 
 use fraccloth::collide::intersections::self_intersections;
 use fraccloth::collide::shapes::uv_sphere;
-use fraccloth::{Integrator, Model, Vec3};
-use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
+use fraccloth::{Model, Vec3};
+use fraccloth_tools::scenes::SceneSpec;
 
 const FPS: f64 = 30.0;
 
@@ -31,24 +31,11 @@ struct Case {
 
 /// (wall seconds, substeps a frame, looks a frame, most crossing pairs, contacts at the end).
 fn bake(c: Case) -> (f64, f64, f64, usize, usize) {
-    let drive = Drive {
-        amplitude: c.amplitude,
-        frequency: c.frequency,
-        ..Drive::of(SceneKind::Swing, Variant::Underwater)
+    let model = Model {
+        self_collision_thickness: c.thickness,
+        ..Model::underwater()
     };
-    let spec = SceneSpec {
-        width: c.width,
-        height: c.height,
-        drive,
-        dt: 1.0 / FPS,
-        max_substep: fraccloth::cloth::AUTO,
-        integrator: Integrator::SymplecticEuler,
-        model: Some(Model {
-            self_collision_thickness: c.thickness,
-            ..Model::underwater()
-        }),
-        ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
-    };
+    let spec = SceneSpec::underwater_swing(c.width, c.height, c.frequency, c.amplitude, model);
     let mut scene = spec.build().expect("scene");
     if c.mesh {
         // A 10k-triangle ball of 10 cm radius the towel's lower half swings into.

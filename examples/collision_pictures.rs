@@ -75,22 +75,7 @@ fn swing(
     amplitude: f64,
     model: fraccloth::Model,
 ) -> Result<fraccloth_tools::scenes::Scene, fraccloth::Error> {
-    use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
-    SceneSpec {
-        width,
-        height,
-        drive: Drive {
-            amplitude,
-            frequency,
-            ..Drive::of(SceneKind::Swing, Variant::Underwater)
-        },
-        dt: 1.0 / FPS,
-        max_substep: fraccloth::cloth::AUTO,
-        integrator: Integrator::SymplecticEuler,
-        model: Some(model),
-        ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
-    }
-    .build()
+    fraccloth_tools::scenes::SceneSpec::underwater_swing(width, height, frequency, amplitude, model).build()
 }
 
 fn side(p: &Vec3) -> (f64, f64) {

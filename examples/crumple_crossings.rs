@@ -11,8 +11,8 @@
 use fraccloth::collide::geometry::closest_on_triangle;
 use fraccloth::collide::intersections::crossing_pairs;
 use fraccloth::collide::self_collision::EXCLUDED;
-use fraccloth::{Integrator, Model, Vec3};
-use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
+use fraccloth::{Model, Vec3};
+use fraccloth_tools::scenes::SceneSpec;
 
 const THICKNESS: f64 = 0.004;
 const FPS: f64 = 30.0;
@@ -25,24 +25,11 @@ fn to_triangle(rest: &[Vec3], p: u32, t: &[u32; 3]) -> f64 {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let drive = Drive {
-        amplitude: 0.08,
-        frequency: 2.0,
-        ..Drive::of(SceneKind::Swing, Variant::Underwater)
+    let model = Model {
+        self_collision_thickness: THICKNESS,
+        ..Model::underwater()
     };
-    let spec = SceneSpec {
-        width: 61,
-        height: 41,
-        drive,
-        dt: 1.0 / FPS,
-        max_substep: fraccloth::cloth::AUTO,
-        integrator: Integrator::SymplecticEuler,
-        model: Some(Model {
-            self_collision_thickness: THICKNESS,
-            ..Model::underwater()
-        }),
-        ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
-    };
+    let spec = SceneSpec::underwater_swing(61, 41, 2.0, 0.08, model);
     let mut scene = spec.build()?;
     let tris = scene.cloth.topology().triangles.clone();
     let rest = scene.cloth.topology().rest_positions.clone();

@@ -400,24 +400,15 @@ fn brisk_swing_with(
     integrator: Integrator,
     max_substep: f64,
 ) -> (usize, usize) {
-    use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
-    let drive = Drive {
-        amplitude,
-        frequency: 2.0,
-        ..Drive::of(SceneKind::Swing, Variant::Underwater)
+    use fraccloth_tools::scenes::SceneSpec;
+    let model = Model {
+        self_collision_thickness: thickness,
+        ..Model::underwater()
     };
     let spec = SceneSpec {
-        width,
-        height,
-        drive,
-        dt: 1.0 / FPS,
         max_substep,
         integrator,
-        model: Some(Model {
-            self_collision_thickness: thickness,
-            ..Model::underwater()
-        }),
-        ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
+        ..SceneSpec::underwater_swing(width, height, 2.0, amplitude, model)
     };
     let mut scene = spec.build().unwrap();
     let tris = scene.cloth.topology().triangles.clone();
@@ -590,22 +581,8 @@ fn a_colliders_own_margin_keeps_the_cloth_further_off() {
 #[test]
 fn a_towel_against_a_fine_ball_bakes_without_a_refused_frame() {
     use fraccloth::collide::shapes::uv_sphere;
-    use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
-    let drive = Drive {
-        amplitude: 0.04,
-        frequency: 0.5,
-        ..Drive::of(SceneKind::Swing, Variant::Underwater)
-    };
-    let spec = SceneSpec {
-        width: 61,
-        height: 41,
-        drive,
-        dt: 1.0 / FPS,
-        max_substep: fraccloth::cloth::AUTO,
-        integrator: Integrator::SymplecticEuler,
-        model: Some(Model::underwater()),
-        ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
-    };
+    use fraccloth_tools::scenes::SceneSpec;
+    let spec = SceneSpec::underwater_swing(61, 41, 0.5, 0.04, Model::underwater());
     let mut scene = spec.build().unwrap();
     let (centre, radius) = (Vec3::new(0.3, -0.3, 0.1), 0.1);
     let (x, t) = uv_sphere(centre, radius, 100, 51);

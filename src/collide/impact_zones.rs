@@ -225,17 +225,33 @@ impl ZoneInput<'_> {
     /// they do not move, do not meet, or are tangled at the start.
     fn vertex_passage(&self, x1: &[Vec3], p: u32, t: u32, pair: PairRef) -> Option<Passage> {
         let tri = self.triangles[t as usize];
-        let vs = [tri[0], tri[1], tri[2], p];
+        self.passage(
+            x1,
+            [tri[0], tri[1], tri[2], p],
+            pair,
+            vertex_passes_triangle,
+            || self.vertex_tangled(p, tri),
+        )
+    }
+
+    /// The passage of the four vertices `vs` in the step `x0 -> x1` by the test `meets`, as
+    /// `pair`: none if they do not move, do not meet, or are `tangled` at the start.
+    fn passage(
+        &self,
+        x1: &[Vec3],
+        vs: [u32; 4],
+        pair: PairRef,
+        meets: fn(&Path, f64) -> Option<f64>,
+        tangled: impl FnOnce() -> bool,
+    ) -> Option<Passage> {
         if !self.moving(x1, &vs) {
             return None;
         }
         let path = self.path(x1, vs);
-        (vertex_passes_triangle(&path, self.tolerance).is_some() && !self.vertex_tangled(p, tri)).then(|| {
-            Passage {
-                vs,
-                pair,
-                sign: start_sign(&path),
-            }
+        (meets(&path, self.tolerance).is_some() && !tangled()).then(|| Passage {
+            vs,
+            pair,
+            sign: start_sign(&path),
         })
     }
 
@@ -261,18 +277,13 @@ impl ZoneInput<'_> {
     /// not move, do not meet, or are tangled at the start.
     fn edge_passage(&self, x1: &[Vec3], e: u32, f: u32, pair: PairRef) -> Option<Passage> {
         let (edge, other) = (self.edges[e as usize], self.edges[f as usize]);
-        let vs = [edge[0], edge[1], other[0], other[1]];
-        if !self.moving(x1, &vs) {
-            return None;
-        }
-        let path = self.path(x1, vs);
-        (edge_passes_edge(&path, self.tolerance).is_some() && !self.edges_tangled(edge, other)).then(|| {
-            Passage {
-                vs,
-                pair,
-                sign: start_sign(&path),
-            }
-        })
+        self.passage(
+            x1,
+            [edge[0], edge[1], other[0], other[1]],
+            pair,
+            edge_passes_edge,
+            || self.edges_tangled(edge, other),
+        )
     }
 }
 

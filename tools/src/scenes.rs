@@ -350,6 +350,26 @@ impl SceneSpec {
         }
     }
 
+    /// The underwater towel at `width` x `height` swung `amplitude` m at `frequency` Hz with
+    /// `model` (the underwater preset, changed: self-collision, say), symplectic Euler at the
+    /// automatic step, one call a 30 fps frame: the collision harnesses' and tests' scene.
+    pub fn underwater_swing(width: u32, height: u32, frequency: f64, amplitude: f64, model: Model) -> Self {
+        Self {
+            width,
+            height,
+            drive: Drive {
+                amplitude,
+                frequency,
+                ..Drive::of(SceneKind::Swing, Variant::Underwater)
+            },
+            dt: 1.0 / 30.0,
+            max_substep: fraccloth::cloth::AUTO,
+            integrator: Integrator::SymplecticEuler,
+            model: Some(model),
+            ..Self::paper(SceneKind::Swing, Variant::Underwater)
+        }
+    }
+
     /// Grid spacing, m.
     pub fn spacing(&self) -> f64 {
         self.kind.extent().0 / f64::from(self.width.max(2) - 1)
