@@ -119,7 +119,7 @@ pub struct SelfCollision {
 /// 7.1 mm apart, a skin of 6 mm; 3 mm at 1.5 mm: 2.1 mm apart, 1.8 mm).
 pub const GUARD_SKIN: f64 = 0.85;
 
-/// Which of the guard pairs' rest distances sets the skin (the twentieth nearest of every
+/// Which of the guard pairs' rest distances sets the skin (the fifth nearest of every
 /// hundred): a mesh's few nearest pairs are checked at every step rather than making every
 /// pair's skin theirs.
 pub const GUARD_QUANTILE: f64 = 0.05;
