@@ -784,8 +784,8 @@ impl SelfCollision {
 
     /// Readies [`SelfCollision::guarded`] for the step `x0 -> x1`, where two points meet
     /// within `tolerance`. The guard keeps the box of every displacement from its watch's
-    /// positions since it measured its pairs there (grown by each step's end; a step's start
-    /// is an earlier step's end, or the watch's positions themselves). A pair measured at
+    /// positions since it measured its pairs there (grown by each step's start and end). A
+    /// pair measured at
     /// least the skin ([`GUARD_SKIN`]) apart stays at least that less the box's diagonal
     /// apart at any instant since (two points' displacements, and those of the points of a
     /// straight path between, lie in the box), so while that is above the tolerance it cannot
@@ -799,8 +799,11 @@ impl SelfCollision {
         }
         let skin = self.guard_skin;
         let within = |b: &Aabb| (b.max - b.min).norm() < skin - tolerance;
+        // Both ends: a step's start is usually an earlier step's end, but the host may have
+        // moved the cloth between steps (`set_positions`, a loaded snapshot).
         let grown = |base: &[Vec3], mut b: Aabb| {
-            for (q, o) in x1.iter().zip(base) {
+            for ((p, q), o) in x0.iter().zip(x1).zip(base) {
+                b.grow(&(p - o));
                 b.grow(&(q - o));
             }
             b
