@@ -138,6 +138,23 @@ int main(void) {
     printf("thick_create_output %s\n", refused == NULL ? "none" : "written");
     printf("thick_set_desc %d\n", (int)fc_cloth_set_desc(cloth, &thick));
     printf("step_after %d\n", (int)fc_cloth_step(cloth, 1.0 / 30.0));
+    /* A thickness in spacings: 0.3 of this 2 cm grid is 6 mm, read back in metres (the
+     * relative field 0); ten spacings are refused as ten spacings in metres are. */
+    FcClothDesc relative = desc;
+    relative.self_collision_thickness = 0.0;
+    relative.self_collision_relative = 0.3;
+    FcCloth *by_spacing = NULL;
+    printf("relative_create %d\n", (int)fc_cloth_create_grid(&relative, &by_spacing));
+    FcClothDesc back = fc_cloth_desc_default();
+    if (by_spacing && fc_cloth_get_desc(by_spacing, &back) == FC_OK)
+        printf("relative_back %.6f %.1f\n", back.self_collision_thickness, back.self_collision_relative);
+    fc_cloth_destroy(by_spacing);
+    relative.self_collision_relative = 10.0;
+    by_spacing = NULL;
+    printf("relative_thick %d\n", (int)fc_cloth_create_grid(&relative, &by_spacing));
+    relative.self_collision_relative = -0.3;
+    printf("relative_negative %d\n", (int)fc_cloth_create_grid(&relative, &by_spacing));
+    printf("relative_output %s\n", by_spacing == NULL ? "none" : "written");
     free(xyz);
     fc_cloth_destroy(cloth);
     return 0;

@@ -77,14 +77,25 @@ fn check_dt(dt: f64) -> Result<(), Error> {
     }
 }
 
-/// Checks every setting of `config` for a cloth of width `width` (m) and resolves an added mass
-/// given as a coefficient into kg/m^2, once ([`crate::model::Water::added_mass_coefficient`]).
-fn checked_config(mut config: ClothConfig, width: f64) -> Result<ClothConfig, Error> {
+/// Checks every setting of `config` for the cloth `topology` and resolves, once, an added mass
+/// given as a coefficient into kg/m^2 ([`crate::model::Water::added_mass_coefficient`], by the
+/// cloth's width) and a self-collision thickness given in spacings into metres
+/// ([`crate::model::Model::self_collision_relative`], by the cloth's spacing).
+fn checked_config(mut config: ClothConfig, topology: &Topology) -> Result<ClothConfig, Error> {
     config.model.validate()?;
     let water = &mut config.model.water;
-    water.added_mass = water.added_mass_for(config.model.water_density, width);
+    water.added_mass = water.added_mass_for(config.model.water_density, topology.width());
     water.added_mass_coefficient = 0.0;
     check_non_negative("added_mass (with added_mass_coefficient)", water.added_mass)?;
+    let m = &mut config.model;
+    if m.self_collision_relative != 0.0 {
+        m.self_collision_thickness += m.self_collision_relative * topology.spacing;
+        m.self_collision_relative = 0.0;
+        check_non_negative(
+            "self_collision_thickness (with self_collision_relative)",
+            m.self_collision_thickness,
+        )?;
+    }
     check_positive("max_speed", config.max_speed)?;
     if config.max_speed >= MAX_COORDINATE {
         return Err(Error::invalid(format!(
@@ -183,7 +194,7 @@ pub struct Cloth {
 impl Cloth {
     /// Builds a cloth at rest in its rest positions.
     pub fn new(topology: Topology, config: ClothConfig) -> Result<Self, Error> {
-        let config = checked_config(config, topology.width())?;
+        let config = checked_config(config, &topology)?;
         let n = topology.vertex_count();
         let memories = forces::memories(&config.model);
         let scheme = if memories.particles {
@@ -247,7 +258,7 @@ impl Cloth {
     /// history (fractional terms; rotation-invariant fractional springs) must need the same
     /// histories as the one the cloth was built with. All or nothing: on an error nothing changes.
     pub fn reconfigure(&mut self, config: ClothConfig) -> Result<(), Error> {
-        let config = checked_config(config, self.topology.width())?;
+        let config = checked_config(config, &self.topology)?;
         let old = &self.config;
         if config.scheme != old.scheme {
             return Err(Error::invalid(format!(

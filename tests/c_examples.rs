@@ -198,6 +198,18 @@ fn mesh_collider_example_keeps_the_towel_outside_the_box() {
         FcStatus::FC_ERROR_INVALID_ARGUMENT as i32
     );
     assert_eq!(status("step_after"), FcStatus::FC_OK as i32);
+    // A thickness given in spacings comes back in metres, and a bad one is refused.
+    assert_eq!(status("relative_create"), FcStatus::FC_OK as i32);
+    assert_eq!(field(&out, "relative_back"), vec!["0.006000", "0.0"]);
+    assert_eq!(
+        status("relative_thick"),
+        FcStatus::FC_ERROR_INVALID_ARGUMENT as i32
+    );
+    assert_eq!(
+        status("relative_negative"),
+        FcStatus::FC_ERROR_INVALID_ARGUMENT as i32
+    );
+    assert_eq!(field(&out, "relative_output"), vec!["none"]);
     // The continuous check's totals: every output written, nothing left crossing, at least
     // as many passages as steps that had one; NULL outputs accepted, a NULL cloth refused.
     let stats: Vec<u64> = field(&out, "collision_stats")

@@ -690,3 +690,56 @@ fn a_margin_that_reaches_the_whole_mesh_is_refused_not_a_memory_blow_up() {
         cloth.step(1.0 / FPS).unwrap();
     }
 }
+
+/// A thickness given in spacings (`Model::self_collision_relative`) is resolved once, when the
+/// cloth is built, into metres by the cloth's spacing: 0.4 of a 1 cm grid is 4 mm, of a 2 cm
+/// grid 8 mm, of a jittered triangle mesh 0.4 of its spacing; added to a thickness in metres;
+/// kept, not added again, when the cloth is reconfigured with its own model; a negative one and
+/// one past what the mesh takes are refused.
+#[test]
+fn a_thickness_in_spacings_is_resolved_by_the_cloths_spacing() {
+    use fraccloth::topology::GridSpec;
+    use fraccloth::ClothConfig;
+    let grid = |spacing: f64| {
+        GridSpec {
+            width: 21,
+            height: 31,
+            spacing,
+            total_mass: 0.24,
+        }
+        .build()
+        .unwrap()
+    };
+    let config = |relative: f64, thickness: f64| ClothConfig {
+        model: Model {
+            self_collision_relative: relative,
+            self_collision_thickness: thickness,
+            ..Model::underwater()
+        },
+        ..ClothConfig::default()
+    };
+    let resolved = |t: fraccloth::Topology, relative: f64, thickness: f64| {
+        Cloth::new(t, config(relative, thickness)).map(|c| {
+            assert_eq!(c.model().self_collision_relative, 0.0);
+            c.model().self_collision_thickness
+        })
+    };
+    let near = |a: f64, b: f64| (a - b).abs() < 1e-12;
+    assert!(near(resolved(grid(0.01), 0.4, 0.0).unwrap(), 0.004));
+    assert!(near(resolved(grid(0.02), 0.4, 0.0).unwrap(), 0.008));
+    assert!(near(resolved(grid(0.02), 0.4, 0.001).unwrap(), 0.009));
+    let jittered = fraccloth_tools::scenes::jittered_mesh(&grid(0.01), 21, 1.0, 7).unwrap();
+    let spacing = jittered.spacing;
+    assert!(spacing > 0.009 && spacing < 0.011, "{spacing}");
+    assert!(near(resolved(jittered, 0.4, 0.0).unwrap(), 0.4 * spacing));
+    // Reconfigured with its own (resolved) model: the same thickness, not twice it.
+    let mut cloth = Cloth::new(grid(0.01), config(0.4, 0.0)).unwrap();
+    cloth.step(1.0 / FPS).unwrap();
+    cloth.reconfigure(cloth.config().clone()).unwrap();
+    assert!(near(cloth.model().self_collision_thickness, 0.004));
+    // Refused: negative, and ten spacings (the message names the field).
+    let e = resolved(grid(0.01), -0.4, 0.0).unwrap_err();
+    assert!(e.message.contains("self_collision_relative"), "{}", e.message);
+    let e = resolved(grid(0.01), 10.0, 0.0).unwrap_err();
+    assert!(e.message.contains("self_collision_relative"), "{}", e.message);
+}

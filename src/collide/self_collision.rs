@@ -428,7 +428,7 @@ impl SelfCollision {
             (None, _) => {
                 let mean = mean_edge(rest, &self.edges);
                 Err(Error::invalid(format!(
-                    "self_collision_thickness {:.4} m is too large for this mesh, whose edges are {:.4} m long on average: \
+                    "self_collision_thickness {:.4} m (with self_collision_relative times the spacing added) is too large for this mesh, whose edges are {:.4} m long on average: \
                      the neighbours it would leave out or list pass {} a vertex; use a thickness of at most about {:.4} m \
                      (1.5 mean edge lengths), or a coarser mesh",
                     radius / EXCLUDED,

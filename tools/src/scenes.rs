@@ -271,6 +271,9 @@ pub struct SceneSpec {
     /// Build the cloth as an irregular triangle mesh ([`jittered_mesh`]) instead of the grid:
     /// the same vertices in the same order, moved and triangulated at random.
     pub jittered: bool,
+    /// Self-collision thickness in the cloth's spacings (`Model::self_collision_relative`)
+    /// added to the model's; 0 adds none.
+    pub self_collision: f64,
 }
 
 /// A grid's vertices (same order, edges kept straight) moved by up to 15 % of the spacing in
@@ -347,6 +350,7 @@ impl SceneSpec {
             model: None,
             max_substep: 0.0,
             jittered: false,
+            self_collision: 0.0,
         }
     }
 
@@ -425,6 +429,7 @@ impl SceneSpec {
             model = own;
         }
         model.current = self.drive.current;
+        model.self_collision_relative += self.self_collision;
         model.stretch_stiffness *= self.stiffness_scale;
         model.shear_stiffness *= self.stiffness_scale;
         model.bend_stiffness *= self.stiffness_scale;

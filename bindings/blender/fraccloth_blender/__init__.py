@@ -212,6 +212,7 @@ class FracclothSettings(bpy.types.PropertyGroup):
     collider_shape: bpy.props.EnumProperty(name="Collider shape", items=COLLIDER_ITEMS, default="MESH",
                                            description="How collider objects are seen: their own mesh every frame, or a fitted sphere, capsule or plane (faster)")
     self_collision: bpy.props.FloatProperty(name="Self-collision", description="Distance the cloth keeps from itself, m (0 = off); a few mm for a cloth of 1-2 cm spacing", default=0.0, min=0.0, soft_max=0.02, precision=4)
+    self_collision_spacings: bpy.props.FloatProperty(name="Self-collision (spacings)", description="Distance the cloth keeps from itself in the mesh's spacings, added to Self-collision (0 = none): one value for any resolution, 0.3-0.5 keeps a fold apart without touching neighbours", default=0.0, min=0.0, soft_max=1.0, precision=2)
     self_friction: bpy.props.FloatProperty(name="Self friction", description="How much the cloth grips itself where it touches (0 = slippery)", default=0.0, min=0.0, soft_max=1.0)
     use_scene_range: bpy.props.BoolProperty(name="Scene frame range", default=True,
                                             description="Bake the scene's frame range; off: the range below")
@@ -446,6 +447,7 @@ def describe(s, scene=None):
     desc.coarse_length = s.coarse_length if s.coarse_added_mass > 0.0 else 0.0
     desc.collision_margin = s.collision_margin
     desc.self_collision_thickness = s.self_collision
+    desc.self_collision_relative = s.self_collision_spacings
     desc.self_collision_friction = s.self_friction
     fractional = s.damping_mode in ("FRACTIONAL", "STRAIN") and s.spring_damping > 0.0 or s.history_drag > 0.0
     if fractional and s.history == "OFF":
@@ -798,7 +800,8 @@ class FRACCLOTH_PT_panel(bpy.types.Panel):
             ("Water", ("water_density", "entrained_mass", "added_mass", "coarse_added_mass", "coarse_length", "form_drag",
                        "form_drag_scale", "skin_drag", "history_drag",
                        "viscous_drag", "normal_drag", "current")),
-            ("Colliders", ("collider_shape", "friction", "collision_margin", "self_collision", "self_friction")),
+            ("Colliders", ("collider_shape", "friction", "collision_margin", "self_collision", "self_collision_spacings",
+                           "self_friction")),
             ("Solver", ("history", "integrator", "auto_step", "time_step")),
             ("Cache", ("use_scene_range", "frame_start", "frame_end", "cache_format", "cache_path")),
         ):

@@ -327,6 +327,22 @@ def test_a_long_object_is_a_capsule_that_holds_the_cloth(addon, tmp_path):
     assert closest < r + margin, closest  # it did reach the bar (contacts act at the vertices)
 
 
+def test_a_self_collision_in_spacings_is_resolved_by_the_meshs_spacing(addon, tmp_path):
+    """The panel's "Self-collision (spacings)" reaches the library, which turns it into metres
+    by the mesh's spacing (the side of a square of two of its triangles' mean area: here the
+    quads' mean area), added to the thickness in metres."""
+    cloth, _ = make_scene(tmp_path, "PC2")
+    s = cloth.fraccloth
+    s.self_collision, s.self_collision_spacings = 0.001, 0.4
+    assert addon.describe(s).self_collision_relative == pytest.approx(0.4)
+    built, _, _, _ = addon.build_cloth(bpy.context, cloth, [])
+    quads = cloth.data.polygons
+    spacing = (sum(p.area for p in quads) / len(quads)) ** 0.5
+    got = built.desc
+    assert got.self_collision_relative == 0.0
+    assert got.self_collision_thickness == pytest.approx(0.001 + 0.4 * spacing, rel=1e-3)
+
+
 def test_an_armature_animated_mesh_collider_pushes_the_cloth(addon, tmp_path):
     """A box skinned to a bone, the bone animated (the object itself never moves): the add-on
     reads the evaluated mesh every frame, the box rises through where the cloth hangs, pushes it

@@ -289,6 +289,21 @@ def test_the_underwater_preset_steps_once_per_frame_with_the_automatic_step():
         assert cloth.step_stats() == fraccloth.StepStats(34, 0, 0.0)
 
 
+def test_self_collision_thickness_in_spacings():
+    """A thickness given in spacings comes back in metres: 0.25 of a 2 cm grid is 5 mm."""
+    desc = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
+    desc.width, desc.height, desc.spacing = 21, 21, 0.02
+    desc.self_collision_relative = 0.25
+    with fraccloth.Cloth.grid(desc) as cloth:
+        back = cloth.desc
+        assert abs(back.self_collision_thickness - 0.005) < 1e-9
+        assert back.self_collision_relative == 0.0
+    desc.self_collision_relative = -1.0
+    with pytest.raises(fraccloth.Error) as e:
+        fraccloth.Cloth.grid(desc)
+    assert "self_collision_relative" in str(e.value)
+
+
 def test_triangle_mesh_collider_and_self_collision():
     """A towel falls onto a box mesh moved each step: no vertex ends inside the box; bad
     meshes raise with the library's status."""
