@@ -69,6 +69,8 @@ fn main() {
     }
     // Bending stiffness as a multiple of the preset's (its bend springs' k).
     model.bend_stiffness *= num("bend", 1.0);
+    model.stretch_stiffness *= num("stretch", 1.0);
+    model.shear_stiffness *= num("stretch", 1.0);
     model.water.history_drag = num("history", model.water.history_drag);
     if let Some(mode) = get("mode") {
         model.spring_damping_mode = match mode.as_str() {

@@ -28,3 +28,7 @@ bake current-face-0.3 --scene current --current 0,0,0.3
 bake kelp-still --scene kelp --seconds 20
 bake kelp-along-0.3 --scene kelp --current 0.3,0,0 --seconds 20
 bake kelp-face-0.1 --scene kelp --current 0,0,0.1 --seconds 20
+# Fast motion (stop 47): a pinned edge shaken at 2 m/s and a 2 m/s current face on bake (they
+# were refused within the first frames before the water a stretched patch carries was bounded).
+bake swing-2hz-16cm --frequency 2 --amplitude 0.16 --seconds 4
+bake current-face-2 --scene current --current 0,0,2 --seconds 4
