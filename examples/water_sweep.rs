@@ -11,7 +11,7 @@
 //! `max_substep` automatic; with `dt=0.0333`, frames), `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
 //! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag), `scale=` (its smoothing length, m),
 //! `skin=` (N s/m^3), `coarse=` (coarse added mass, kg/m^2) and `coarse_len=` [0.2] (its patch spacing, m), `damping=` (spring damping), `dscale=S,H,B` (its multiple per family: stretch, shear, bend), `bend=` (the bend springs' stiffness, times the
-//! preset's), `mode=velocity|fractional|strain|none` (what the
+//! preset's), `stretch=` (the stretch and shear springs' stiffness, times the preset's), `mode=velocity|fractional|strain|none` (what the
 //! springs damp), `history=` (history drag per area, N s^1/2/m^3; the SOE history is kept).
 
 use fraccloth::{Integrator, Model, Vec3};
