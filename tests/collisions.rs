@@ -206,12 +206,12 @@ fn a_bar_thinner_than_the_spacing_catches_the_towel() {
     sweep_bar_catches(model, -0.3, 0.002);
 }
 
-/// The same bars swept at 1 and 2 m/s, too fast for the penalty to stop the towel within the
-/// margin, then held for a second: the continuous check carries what would pass through
+/// The same bars swept at 1 and 2 m/s (the thinner at 5 m/s too), too fast for the penalty to
+/// stop the towel within the margin, then held for a second (half a second at 5 m/s): the continuous check carries what would pass through
 /// (`MeshCollider::passages`), so the row at the bar's height hangs on it (within 3 cm of it).
 /// Without it both bars left that row where it hung at 1 m/s (mean z -0.019 and +0.003 with
 /// the bar at -0.100). At 2 m/s the step was refused as unstable until stop 47 bounded the
-/// water a stretched patch carries (`tests/fast_water.rs`, docs/underwater.md).
+/// water a stretched patch carries (docs/underwater.md, "Fast motion").
 #[test]
 fn fast_thin_bars_catch_the_towel() {
     let thin = Model {
@@ -222,6 +222,12 @@ fn fast_thin_bars_catch_the_towel() {
         collision_margin: 0.003,
         ..Model::underwater()
     };
+    // The 4 mm bar at 5 m/s too: one frame's sweep, then half a second held.
+    let (z, _, _, row_z, _) = sweep_bar(thin, -0.3, 0.002, 5.0, 15);
+    assert!(
+        (row_z - z).abs() < 0.03,
+        "5 m/s: the row at the bar hangs on it: {row_z} vs bar {z}"
+    );
     for speed in [1.0, 2.0] {
         for (model, y, half_width) in [(thin, -0.3, 0.002), (between, -0.31, 0.001)] {
             let (z, _, _, row_z, carried) = sweep_bar(model, y, half_width, speed, 30);

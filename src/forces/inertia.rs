@@ -1016,6 +1016,17 @@ mod tests {
             .collect()
     }
 
+    /// Asserts that `got` are Lagrange's terms of the water's kinetic energy at `x`, `v`.
+    fn assert_lagranges(got: &[Vec3], t: &Topology, m: &Model, x: &[Vec3], v: &[Vec3]) {
+        check::lagranges_terms(
+            got,
+            x,
+            v,
+            |y| water_energy(t, m, y, v),
+            |y, j| inertias(t, m, y)[j].apply(&v[j]),
+        );
+    }
+
     /// The water's kinetic energy.
     fn water_energy(t: &Topology, m: &Model, x: &[Vec3], v: &[Vec3]) -> f64 {
         inertias(t, m, x)
@@ -1043,13 +1054,7 @@ mod tests {
         let mut rest = vec![0.0; x.len()];
         patch_normals(&t.rest_positions, &t, &mut n, &mut rest);
         assert!(rest.iter().all(|r| (r - 1.0).abs() < 1e-12), "{rest:?}");
-        check::lagranges_terms(
-            &got,
-            &x,
-            &v,
-            |y| water_energy(&t, &m, y, &v),
-            |y, j| inertias(&t, &m, y)[j].apply(&v[j]),
-        );
+        assert_lagranges(&got, &t, &m, &x, &v);
         // Nothing without normal added mass.
         let (none, _, _) = check::turning_of(&Model::fractional(), &t, &x, &v, None);
         assert!(none.iter().all(|f| *f == Vec3::zeros()));
@@ -1071,13 +1076,7 @@ mod tests {
                 "{stretch}: {over} of {} patches past the bound",
                 y.len()
             );
-            check::lagranges_terms(
-                &got,
-                &y,
-                &v,
-                |z| water_energy(&t, &m, z, &v),
-                |z, j| inertias(&t, &m, z)[j].apply(&v[j]),
-            );
+            assert_lagranges(&got, &t, &m, &y, &v);
         }
     }
 
