@@ -139,9 +139,9 @@ pub const CARRIED_SPAN: f64 = 0.5;
 /// projected-area ratio `q = p^2` ([`patch_normals`]). `q` itself up to [`CARRIED_FULL`]: a
 /// patch that folds carries less, down to none. Past it the growth saturates,
 /// `f = F + S r / sqrt(1 + r^2)`, `r = (q - F) / S` (`F` [`CARRIED_FULL`], `S`
-/// [`CARRIED_SPAN`]): the same value, slope and curvature at `F` (a kink in the curvature
-/// where the cloth sits, near its rest area, made the free cloth's energy drift by a fifth
-/// more with symplectic Euler), never above `F + S`. Without the bound the water's kinetic
+/// [`CARRIED_SPAN`]): the same value, slope and curvature at `F` (with the bound at 1, where
+/// the cloth sits, a kink in the curvature made the free cloth's energy drift by a fifth more
+/// with symplectic Euler), never above `F + S`. Without the bound the water's kinetic
 /// energy grew without limit as a patch stretched, so a cloth dragged through the water fast
 /// enough (a pinned edge or a collider at 1.5-2 m/s, a current of 2 m/s face on) was pulled
 /// apart by its own carried water faster than its springs hold it: a stretched patch carries
@@ -159,18 +159,22 @@ pub fn carried(q: f64) -> f64 {
 #[cold]
 #[inline(never)]
 fn carried_saturating(q: f64) -> f64 {
+    saturating(q).0
+}
+
+/// [`carried`]'s `f(q)` past [`CARRIED_FULL`] and its slope `f'(q)`.
+#[inline(always)]
+fn saturating(q: f64) -> (f64, f64) {
     let r = (q - CARRIED_FULL) / CARRIED_SPAN;
-    CARRIED_FULL + CARRIED_SPAN * r / (1.0 + r * r).sqrt()
+    let d = 1.0 + r * r;
+    let s = d.sqrt();
+    (CARRIED_FULL + CARRIED_SPAN * r / s, 1.0 / (d * s))
 }
 
 /// `h = f(q) / q` and `dh/dq` for [`carried`]'s `f`, past [`CARRIED_FULL`] (where `h` < 1).
 #[inline(always)]
 fn carried_past(q: f64) -> (f64, f64) {
-    let r = (q - CARRIED_FULL) / CARRIED_SPAN;
-    let d = 1.0 + r * r;
-    let s = d.sqrt();
-    let f = CARRIED_FULL + CARRIED_SPAN * r / s;
-    let slope = 1.0 / (d * s);
+    let (f, slope) = saturating(q);
     (f / q, (slope * q - f) / (q * q))
 }
 
