@@ -156,6 +156,7 @@ fn steps_do_not_allocate() {
             edge_edge: &[],
             tolerance: 1e-9,
             guard: &[],
+            guard_vertices: &[],
         };
         let (mut moved, mut stopped, mut scratch) = (Vec::new(), Vec::new(), ZoneScratch::default());
         let zone_step = |scratch: &mut ZoneScratch, moved: &mut Vec<u32>, stopped: &mut Vec<_>| {

@@ -319,10 +319,14 @@ impl Cloth {
         }
         let tolerance = PASSAGE_TOLERANCE * thickness;
         self.self_collision
-            .watch_guard(&self.x, &self.scratch.x_new, tolerance);
+            .watch_guard(&self.x, &self.scratch.x_new, &self.topology.triangles, tolerance);
         let sc = &self.self_collision;
-        let guard = sc.guarded();
-        if guard.is_empty() && sc.vertex_triangle.is_empty() && sc.edge_edge.is_empty() {
+        let (guard, guard_vertices) = sc.guarded();
+        if guard.is_empty()
+            && guard_vertices.is_empty()
+            && sc.vertex_triangle.is_empty()
+            && sc.edge_edge.is_empty()
+        {
             return Ok(0);
         }
         let super::step::StepScratch {
@@ -357,6 +361,7 @@ impl Cloth {
             edge_edge: &sc.edge_edge,
             tolerance,
             guard,
+            guard_vertices,
         };
         let n = input.x0.len();
         let report = keep_from_passing(&input, x_new, zone_moved, zone_stopped, zones).map_err(|_| {

@@ -84,6 +84,10 @@ pub struct ZoneInput<'a> {
     /// parallel diagonals of two adjacent cells pass through each other with no listed pair
     /// passing (`SelfCollision::guarded`: those that might in this step).
     pub guard: &'a [(u32, u32)],
+    /// Vertex-triangle neighbour pairs `(vertex, triangle)` (near each other at rest, the
+    /// vertex not the triangle's) checked the same way: a vertex folded through a triangle
+    /// beside it (`SelfCollision::guarded`).
+    pub guard_vertices: &'a [(u32, u32)],
 }
 
 /// A pair, by its place in its list (or a neighbour pair, in none).
@@ -271,6 +275,9 @@ impl ZoneInput<'_> {
         for &(e, f) in self.guard {
             out.extend(self.edge_passage(x1, e, f, PairRef::Neighbour));
         }
+        for &(p, t) in self.guard_vertices {
+            out.extend(self.vertex_passage(x1, p, t, PairRef::Neighbour));
+        }
     }
 
     /// Edge `e`'s passage through edge `f` in the step `x0 -> x1`, as `pair`: none if they do
@@ -457,6 +464,7 @@ mod tests {
             vertex_triangles: adjacency,
             neighbours: (&[], &[]),
             guard: &[],
+            guard_vertices: &[],
             edges,
             vertex_triangle: vt,
             edge_edge: &[],
@@ -510,6 +518,41 @@ mod tests {
         let (report, x1, _) = step(&[]);
         assert_eq!(report.passages, 0);
         assert!(x1[0].z < x1[2].z, "unguarded, it passes");
+    }
+
+    /// A vertex-triangle pair that is not listed but guarded (a vertex folded through a
+    /// triangle beside it) passes through in a step: the zones stop it; not guarded, it passes.
+    #[test]
+    fn a_guarded_neighbour_vertex_triangle_pair_is_kept_from_passing() {
+        let x0 = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.2, 0.2, 0.01),
+        ];
+        let tris = [[0u32, 1, 2]];
+        let (masses, kinematic) = ([1.0; 4], [false; 4]);
+        let adjacency = Adjacency::triangles(4, &tris);
+        let step = |guard_vertices: &[(u32, u32)]| {
+            let zi = ZoneInput {
+                guard_vertices,
+                ..input(&x0, &masses, &kinematic, &tris, &adjacency, &[], &[])
+            };
+            // The vertex dropped 3 cm, through the triangle.
+            let mut x1 = x0.clone();
+            x1[3].z -= 0.03;
+            let (mut moved, mut stopped) = (Vec::new(), Vec::new());
+            let report = zones(&zi, &mut x1, &mut moved, &mut stopped);
+            (report, x1, stopped)
+        };
+        let (report, x1, stopped) = step(&[(3, 0)]);
+        assert_eq!(report.passages, 1);
+        assert_eq!(report.unresolved, 0);
+        assert_eq!(stopped[0].pair, PairRef::Neighbour);
+        assert!(x1[3].z > x1[0].z, "{x1:?}");
+        let (report, x1, _) = step(&[]);
+        assert_eq!(report.passages, 0);
+        assert!(x1[3].z < x1[0].z, "unguarded, it passes");
     }
 
     #[test]

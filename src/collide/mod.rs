@@ -7,6 +7,7 @@
 //! | `intersections.rs` | counting self-intersections and vertices inside a mesh (tests, reports) |
 //! | `bvh.rs` | a bounding-volume hierarchy over boxes, refitted as things move |
 //! | `ccd.rs` | continuous collision: when a vertex passes a triangle, an edge an edge, in a step |
+//! | `guard.rs` | neighbour pairs never listed, watched for passing through each other |
 //! | `impact_zones.rs` | the fail-safe after a step: vertices that would pass move as one |
 //! | `contact.rs` | the contact element: force, Jacobian blocks, friction |
 //! | `mesh.rs` | triangle-mesh colliders |
@@ -20,6 +21,7 @@ pub mod bvh;
 pub mod ccd;
 pub mod contact;
 pub mod geometry;
+pub mod guard;
 pub mod impact_zones;
 pub mod intersections;
 pub mod mesh;

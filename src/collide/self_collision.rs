@@ -30,6 +30,7 @@
 use super::bvh::{Aabb, Bvh};
 use super::contact::Contact;
 use super::geometry::{closest_on_segments, edges_of, offset_from_triangle};
+use super::guard::Guard;
 use super::impact_zones::{PairRef, Passage};
 use super::neighbours::{Exclusions, NearPairs};
 use super::ownership::Ownership;
@@ -95,34 +96,12 @@ pub struct SelfCollision {
     excluded: Exclusions,
     /// The pairs of triangles near each other at rest, tested directly.
     near: NearPairs,
-    /// The excluded edge-edge pairs that share no vertex (each `(e, f)`, e < f): neighbours
-    /// the proximity search leaves out, whose passage through each other the impact zones'
-    /// continuous check watches at every step. Across a 1 cm grid's cells, the parallel
-    /// diagonals of two adjacent quads, 7.1 mm apart at rest (under the 8.8 mm exclusion of a
-    /// 4 mm thickness): a fold across the row pulls one through the other with no listed pair
-    /// passing (`examples/crumple_crossings.rs`, docs/collisions.md).
-    guard: Vec<(u32, u32)>,
-    /// The guard's watch: positions when it last measured its pairs (empty before), the box of
-    /// the displacements since, and the pairs then nearer than the skin (ascending). A cache:
-    /// which pairs a step checks never changes what it finds ([`SelfCollision::watch_guard`]).
-    guard_base: Vec<Vec3>,
-    guard_box: Aabb,
-    guard_close: Vec<(u32, u32)>,
-    /// The watch's skin, m ([`GUARD_SKIN`]).
-    guard_skin: f64,
+    /// The neighbour pairs the proximity search leaves out, whose passage through each other
+    /// the impact zones' continuous check watches ([`Guard`]).
+    guard: Guard,
 }
 
-/// The guard's skin against its pairs' rest distances: a pair nearer than this fraction of
-/// the [`GUARD_QUANTILE`] of the rest distances, where the guard last measured it, is checked
-/// at every step; the others once the cloth has deformed by the skin since. Below the rest
-/// distance, so an undeformed cloth checks almost none (a 1 cm grid at 4 mm: its diagonals
-/// 7.1 mm apart, a skin of 6 mm; 3 mm at 1.5 mm: 2.1 mm apart, 1.8 mm).
-pub const GUARD_SKIN: f64 = 0.85;
-
-/// Which of the guard pairs' rest distances sets the skin (the fifth nearest of every
-/// hundred): a mesh's few nearest pairs are checked at every step rather than making every
-/// pair's skin theirs.
-pub const GUARD_QUANTILE: f64 = 0.05;
+pub use super::guard::{GUARD_QUANTILE, GUARD_SKIN};
 
 /// Distance between vertex `p` and triangle `t` of positions `x`, with the weights and the
 /// vector from the triangle's closest point to `p`.
@@ -381,44 +360,35 @@ impl SelfCollision {
                     let (a, b) = (edges[e as usize], edges[f as usize]);
                     !a.iter().any(|v| b.contains(v))
                 };
-                // The guard's pairs, and room for its watch: a step allocates none of it.
-                let count = excluded.edge_pairs().filter(apart).count();
-                let (mut guard, mut close, mut base) = (Vec::new(), Vec::new(), Vec::new());
-                guard
-                    .try_reserve_exact(count)
-                    .and_then(|()| close.try_reserve_exact(count))
-                    .and_then(|()| base.try_reserve_exact(if count > 0 { rest.len() } else { 0 }))
-                    .map_err(|_| {
-                        Error::out_of_memory(format!(
-                            "self-collision at a thickness of {} m: its neighbour edge pairs cannot be allocated",
-                            radius / EXCLUDED
-                        ))
-                    })?;
-                guard.extend(excluded.edge_pairs().filter(apart));
-                // The skin, from the pairs' rest distances.
-                let mut apart_at_rest = Vec::new();
-                apart_at_rest.try_reserve_exact(count).map_err(|_| {
-                    Error::out_of_memory(
-                        "self-collision: its neighbour edge pairs' rest distances cannot be allocated",
-                    )
-                })?;
-                let edges = &self.edges;
-                apart_at_rest.extend(
-                    guard
-                        .iter()
-                        .map(|&(e, f)| edge_edge(rest, &edges[e as usize], &edges[f as usize]).0),
-                );
-                let k = ((count as f64 * GUARD_QUANTILE) as usize).min(count.saturating_sub(1));
-                let quantile = if count > 0 {
-                    *apart_at_rest.select_nth_unstable_by(k, f64::total_cmp).1
-                } else {
-                    0.0
+                // The guard's pairs: excluded edge pairs and vertex-triangle pairs that share
+                // no vertex.
+                let oom = |_| {
+                    Error::out_of_memory(format!(
+                        "self-collision at a thickness of {} m: its neighbour pairs cannot be allocated",
+                        radius / EXCLUDED
+                    ))
                 };
-                self.guard_skin = GUARD_SKIN * quantile;
+                let (vt_start, vt_rows) = excluded.vertex_rows();
+                let vertex_pairs = || {
+                    (0..rest.len()).flat_map(move |p| {
+                        vt_rows[vt_start[p] as usize..vt_start[p + 1] as usize]
+                            .iter()
+                            .filter(move |&&t| !triangles[t as usize].contains(&(p as u32)))
+                            .map(move |&t| (p as u32, t))
+                    })
+                };
+                let (mut edge_pairs, mut guard_vt) = (Vec::new(), Vec::new());
+                edge_pairs
+                    .try_reserve_exact(excluded.edge_pairs().filter(apart).count())
+                    .map_err(oom)?;
+                guard_vt.try_reserve_exact(vertex_pairs().count()).map_err(oom)?;
+                edge_pairs.extend(excluded.edge_pairs().filter(apart));
+                guard_vt.extend(vertex_pairs());
+                let guard = Guard::new(rest, &self.edges, triangles, edge_pairs, guard_vt)?;
                 self.owners = owners;
                 self.excluded = excluded;
                 self.near = near;
-                (self.guard, self.guard_close, self.guard_base) = (guard, close, base);
+                self.guard = guard;
                 Ok(())
             }
             (None, Some(Full::Memory)) => Err(Error::out_of_memory(format!(
@@ -585,10 +555,7 @@ impl SelfCollision {
         if self.looked_at.len() != x.len() {
             return true;
         }
-        let mut b = Aabb::empty();
-        for (p, q) in x.iter().zip(&self.looked_at) {
-            b.grow(&(p - q));
-        }
+        let b = Aabb::empty().grown_by_differences(x, &self.looked_at);
         let c = 0.5 * (b.min + b.max);
         let limit = 0.25 * skin * skin;
         // No displacement is further from the box's centre than its half diagonal: while that
@@ -720,7 +687,7 @@ impl SelfCollision {
     pub(crate) fn look_again(&mut self) {
         self.looked_at.clear();
         // The guard's watch too: its skin is the thickness's.
-        self.guard_base.clear();
+        self.guard.forget();
     }
 
     /// Copies what self-collision remembers (the pairs with their sides, and where it last
@@ -776,62 +743,17 @@ impl SelfCollision {
         &self.vertex_triangles
     }
 
-    /// The guarded neighbour pairs (`guard`) that might pass in the step `x0 -> x1`, for the
-    /// impact zones to check, after [`SelfCollision::watch_guard`] for the same step.
-    pub(crate) fn guarded(&self) -> &[(u32, u32)] {
-        &self.guard_close
+    /// The guarded neighbour pairs that might pass in the step `x0 -> x1`, for the impact zones
+    /// to check, after [`SelfCollision::watch_guard`] for the same step: edge pairs, and
+    /// vertex-triangle pairs ([`Guard`]).
+    pub(crate) fn guarded(&self) -> super::guard::PairLists<'_> {
+        self.guard.close()
     }
 
     /// Readies [`SelfCollision::guarded`] for the step `x0 -> x1`, where two points meet
-    /// within `tolerance`. The guard keeps the box of every displacement from its watch's
-    /// positions since it measured its pairs there (grown by each step's start and end). A
-    /// pair measured at
-    /// least the skin ([`GUARD_SKIN`]) apart stays at least that less the box's diagonal
-    /// apart at any instant since (two points' displacements, and those of the points of a
-    /// straight path between, lie in the box), so while that is above the tolerance it cannot
-    /// meet and is not checked; when the cloth has deformed further, the pairs are measured
-    /// again at `x0`. Every pair that can meet is always in the list, so the step finds the
-    /// same passages as a check of every pair would.
-    pub(crate) fn watch_guard(&mut self, x0: &[Vec3], x1: &[Vec3], tolerance: f64) {
-        if self.guard.is_empty() {
-            self.guard_close.clear();
-            return;
-        }
-        let skin = self.guard_skin;
-        let within = |b: &Aabb| (b.max - b.min).norm() < skin - tolerance;
-        // Both ends: a step's start is usually an earlier step's end, but the host may have
-        // moved the cloth between steps (`set_positions`, a loaded snapshot).
-        let grown = |base: &[Vec3], mut b: Aabb| {
-            for ((p, q), o) in x0.iter().zip(x1).zip(base) {
-                b.grow(&(p - o));
-                b.grow(&(q - o));
-            }
-            b
-        };
-        if self.guard_base.len() == x0.len() {
-            self.guard_box = grown(&self.guard_base, self.guard_box);
-            if within(&self.guard_box) {
-                return;
-            }
-        }
-        self.guard_base.clear();
-        self.guard_base.extend_from_slice(x0);
-        let mut start = Aabb::empty();
-        start.grow(&Vec3::zeros());
-        self.guard_box = grown(&self.guard_base, start);
-        if within(&self.guard_box) {
-            let (edges, close) = (&self.edges, &mut self.guard_close);
-            close.clear();
-            close.extend(
-                self.guard
-                    .iter()
-                    .filter(|(e, f)| edge_edge(x0, &edges[*e as usize], &edges[*f as usize]).0 < skin),
-            );
-        } else {
-            // A step that deforms the cloth by more than the skin: every pair.
-            self.guard_base.clear();
-            self.guard_close.clone_from(&self.guard);
-        }
+    /// within `tolerance` ([`Guard::watch`]).
+    pub(crate) fn watch_guard(&mut self, x0: &[Vec3], x1: &[Vec3], triangles: &[[u32; 3]], tolerance: f64) {
+        self.guard.watch(x0, x1, &self.edges, triangles, tolerance);
     }
 
     pub(crate) fn edges(&self) -> &[[u32; 2]] {
@@ -957,60 +879,86 @@ mod tests {
         assert_eq!(sc.edge_edge, ee);
     }
 
-    /// The guard's watch leaves out of a step's check only neighbour edge pairs that stay
-    /// further apart than the tolerance throughout the step (sampled along the straight paths).
-    /// The sheet is squeezed across its rows a little every step (its rows 10 -> 2.2 mm apart
-    /// over the run, so the pairs come nearer by far more than any one step moves them), with
-    /// noise and now and then a large step. A tolerance of 5 mm (the skin is 6 mm) makes
-    /// pairs come within it, so the test can fail: it does when the watch bounds each step's
-    /// own motion instead of the motion since it measured (checked). The watch still skips
-    /// pairs, and some watched pairs come within the tolerance.
+    /// The guard's watch leaves out of a step's check only neighbour pairs (edge pairs and
+    /// vertex-triangle pairs) that stay further apart than the tolerance throughout the step
+    /// (sampled along the straight paths). The sheet is squeezed across its rows a little
+    /// every step (its rows 10 -> 2.2 mm apart over the run, so the pairs come nearer by far
+    /// more than any one step moves them, the upper rows faster half the time), with noise
+    /// and now and then a large step. A tolerance of 5 mm (the skin is 6 mm) makes pairs come
+    /// within it, so the test can fail: it does when the watch bounds each step's own motion
+    /// instead of the motion since it measured, or when its box leaves out vertices (both
+    /// checked). The watch still skips pairs, and some watched pairs of both kinds come within
+    /// the tolerance.
     #[test]
     fn the_guard_watch_leaves_out_only_pairs_that_cannot_meet() {
         let (_, rest, triangles) = folded_sheet(12, 9);
         let (thickness, tolerance) = (0.004, 0.005);
         let mut sc = SelfCollision::new(&triangles);
         sc.prepare(&rest, &triangles, thickness).expect("prepared");
+        let (edge_pairs, vertex_pairs) = (sc.guard.pairs().0.to_vec(), sc.guard.pairs().1.to_vec());
         assert!(
-            sc.guard.len() > 100,
-            "a 1 cm grid has neighbour edge pairs at 4 mm"
+            edge_pairs.len() > 100 && vertex_pairs.len() > 100,
+            "a 1 cm grid has neighbour pairs at 4 mm: {} {}",
+            edge_pairs.len(),
+            vertex_pairs.len()
         );
         let mut r = crate::testing::numbers(3);
         let mut x0 = rest.clone();
-        let (mut skipped, mut met) = (0usize, 0usize);
+        let (mut skipped, mut met) = (0usize, [0usize; 2]);
+        // The least distance of a pair's points along the step's straight paths.
+        let least = |x0: &[Vec3], x1: &[Vec3], vs: &[u32], d: &dyn Fn(&[Vec3]) -> f64| {
+            let mut xs = x0.to_vec();
+            (0..=32)
+                .map(|k| {
+                    let s = f64::from(k) / 32.0;
+                    for &i in vs {
+                        let i = i as usize;
+                        xs[i] = x0[i] + s * (x1[i] - x0[i]);
+                    }
+                    d(&xs)
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
         for step in 0..300 {
             let noise = if step % 60 == 59 { 0.003 } else { 0.00002 };
             let x1: Vec<Vec3> = x0
                 .iter()
-                .map(|p| Vec3::new(p.x, p.y * 0.995, p.z) + noise * Vec3::new(r(), r(), r()))
+                .map(|p| {
+                    let squeeze = if p.y > 0.05 && step % 40 < 20 { 0.99 } else { 0.995 };
+                    Vec3::new(p.x, p.y * squeeze, p.z) + noise * Vec3::new(r(), r(), r())
+                })
                 .collect();
-            sc.watch_guard(&x0, &x1, tolerance);
-            let watched = sc.guarded().to_vec();
-            skipped += sc.guard.len() - watched.len();
-            for &(e, f) in &sc.guard {
+            sc.watch_guard(&x0, &x1, &triangles, tolerance);
+            let (watched_e, watched_v) = (sc.guarded().0.to_vec(), sc.guarded().1.to_vec());
+            skipped += edge_pairs.len() + vertex_pairs.len() - watched_e.len() - watched_v.len();
+            for &(e, f) in &edge_pairs {
                 let (a, b) = (sc.edges[e as usize], sc.edges[f as usize]);
-                let mut xs = x0.clone();
-                let least = (0..=32)
-                    .map(|k| {
-                        let s = f64::from(k) / 32.0;
-                        for &i in a.iter().chain(&b) {
-                            let i = i as usize;
-                            xs[i] = x0[i] + s * (x1[i] - x0[i]);
-                        }
-                        edge_edge(&xs, &a, &b).0
-                    })
-                    .fold(f64::INFINITY, f64::min);
-                if least < tolerance {
+                let vs = [a[0], a[1], b[0], b[1]];
+                if least(&x0, &x1, &vs, &|xs| edge_edge(xs, &a, &b).0) < tolerance {
                     assert!(
-                        watched.contains(&(e, f)),
-                        "step {step}: pair {e}, {f} came within {least} m unwatched"
+                        watched_e.contains(&(e, f)),
+                        "step {step}: edges {e}, {f} met unwatched"
                     );
-                    met += 1;
+                    met[0] += 1;
+                }
+            }
+            for &(p, t) in &vertex_pairs {
+                let tri = triangles[t as usize];
+                let vs = [p, tri[0], tri[1], tri[2]];
+                if least(&x0, &x1, &vs, &|xs| vertex_triangle(xs, p, &tri).0) < tolerance {
+                    assert!(
+                        watched_v.contains(&(p, t)),
+                        "step {step}: vertex {p}, triangle {t} met unwatched"
+                    );
+                    met[1] += 1;
                 }
             }
             x0 = x1;
         }
-        assert!(skipped > 0 && met > 0, "skipped {skipped}, met {met}");
+        assert!(
+            skipped > 0 && met[0] > 0 && met[1] > 0,
+            "skipped {skipped}, met {met:?}"
+        );
     }
 
     /// On a sheet large enough for the pool (its walk split into tasks and the near pairs into
