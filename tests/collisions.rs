@@ -472,6 +472,19 @@ fn the_2_hz_swing_with_self_collision_never_crosses_itself() {
     assert_eq!(worst, 0, "no triangle pair crosses at any frame");
 }
 
+/// The brisk crumple at the towel's own size (61 x 41, 2 Hz, 8 cm, self-collision 4 mm, 4 s at
+/// the automatic step; `collision_cost` case 1, `examples/crumple_crossings.rs`): no triangle
+/// pair crosses at any frame. Before the guard held the neighbour vertex-triangle pairs (a
+/// vertex folded through the triangle beside it, `collide/guard.rs`) it crossed at two frames,
+/// 4 pairs each.
+#[test]
+fn the_towel_sized_crumple_never_crosses_itself() {
+    let (worst, pairs) = brisk_swing(61, 41, 0.08, 0.004, 120);
+    println!("2 Hz 8 cm swing, 61 x 41: {worst} crossing pairs at worst, up to {pairs} vertex-triangle pairs in reach");
+    assert!(pairs > 0, "the crumple brings the cloth within reach of itself");
+    assert_eq!(worst, 0, "no triangle pair crosses at any frame");
+}
+
 /// A refused step call leaves a cloth with collisions exactly as it was, self-collision's
 /// remembered pairs and sides included (the snapshot bytes are the same), whether the call
 /// had many substeps or one.
