@@ -21,6 +21,9 @@
 //! near parallel) forgets its side: it may go round the border of a fold. Together with the step limit (no
 //! vertex moves more than half the thickness in a step, `Cloth::limit_collision_step`) no pair can cross
 //! unnoticed. The sides are the only state self-collision keeps (snapshots carry them).
+//! Neighbours left out of the list (edge pairs and vertex-triangle pairs nearer than the
+//! exclusion at rest) are watched by the [`Guard`], whose pairs the impact zones check when
+//! they might pass through each other.
 //!
 //! Forces: the vertex or edge point is pushed along the remembered side's normal (outside the
 //! triangle's interior, along the line between the closest points) with the model's
