@@ -482,6 +482,20 @@ mod tests {
         keep_from_passing(zi, x1, moved, stopped, &mut ZoneScratch::default()).expect("room for the zones")
     }
 
+    /// A step `step(guarded)` of a neighbour pair dropped through each other: guarded, one
+    /// passage found and stopped; not guarded, none found. The positions after each.
+    fn stopped_only_when_guarded(
+        step: impl Fn(bool) -> (ZoneReport, Vec<Vec3>, Vec<Passage>),
+    ) -> (Vec<Vec3>, Vec<Vec3>) {
+        let (report, guarded, stopped) = step(true);
+        assert_eq!(report.passages, 1);
+        assert_eq!(report.unresolved, 0);
+        assert_eq!(stopped[0].pair, PairRef::Neighbour);
+        let (report, unguarded, _) = step(false);
+        assert_eq!(report.passages, 0);
+        (guarded, unguarded)
+    }
+
     /// An edge-edge pair that is not listed (neighbours at rest) but guarded passes through
     /// in a step: the zones stop it, as a listed pair's; not guarded, nothing is checked.
     #[test]
@@ -509,15 +523,11 @@ mod tests {
             let report = zones(&zi, &mut x1, &mut moved, &mut stopped);
             (report, x1, stopped)
         };
-        let (report, x1, stopped) = step(&[(0, 1)]);
-        assert_eq!(report.passages, 1);
-        assert_eq!(report.unresolved, 0);
-        assert_eq!(stopped[0].pair, PairRef::Neighbour);
+        let (x1, unguarded) =
+            stopped_only_when_guarded(|guarded| step(if guarded { &[(0, 1)] } else { &[] }));
         // One zone, moved by its momentum: the first edge still above the second.
         assert!(x1[0].z > x1[2].z && x1[1].z > x1[3].z, "{x1:?}");
-        let (report, x1, _) = step(&[]);
-        assert_eq!(report.passages, 0);
-        assert!(x1[0].z < x1[2].z, "unguarded, it passes");
+        assert!(unguarded[0].z < unguarded[2].z, "unguarded, it passes");
     }
 
     /// A vertex-triangle pair that is not listed but guarded (a vertex folded through a
@@ -545,14 +555,10 @@ mod tests {
             let report = zones(&zi, &mut x1, &mut moved, &mut stopped);
             (report, x1, stopped)
         };
-        let (report, x1, stopped) = step(&[(3, 0)]);
-        assert_eq!(report.passages, 1);
-        assert_eq!(report.unresolved, 0);
-        assert_eq!(stopped[0].pair, PairRef::Neighbour);
+        let (x1, unguarded) =
+            stopped_only_when_guarded(|guarded| step(if guarded { &[(3, 0)] } else { &[] }));
         assert!(x1[3].z > x1[0].z, "{x1:?}");
-        let (report, x1, _) = step(&[]);
-        assert_eq!(report.passages, 0);
-        assert!(x1[3].z < x1[0].z, "unguarded, it passes");
+        assert!(unguarded[3].z < unguarded[0].z, "unguarded, it passes");
     }
 
     #[test]
