@@ -402,8 +402,7 @@ mod tests {
             .collect()
     }
 
-    /// The tree walked against itself finds every overlapping pair exactly once, whatever
-    /// the number of tasks it is split into, before and after a refit.
+    /// A box grown by differences in one call is the box grown by each, a NaN passed over.
     #[test]
     fn growing_by_differences_is_growing_point_by_point() {
         let mut r = crate::testing::numbers(11);
@@ -427,6 +426,8 @@ mod tests {
         assert_eq!(Aabb::empty().grown_by_differences(&[], &[]), Aabb::empty());
     }
 
+    /// The tree walked against itself finds every overlapping pair exactly once, whatever
+    /// the number of tasks it is split into, before and after a refit.
     #[test]
     fn self_overlaps_match_brute_force() {
         for n in [0usize, 1, 3, 5, 700] {
