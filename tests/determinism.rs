@@ -11,7 +11,7 @@ use std::path::Path;
 
 use fraccloth::history::Scheme;
 use fraccloth::topology::grid_index;
-use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, RegularDrag, Vec3};
+use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, Model, RegularDrag, Vec3};
 use fraccloth_tools::scenes::{SceneKind, SceneSpec, Variant};
 
 fn fnv(cloth: &Cloth) -> u64 {
@@ -63,7 +63,51 @@ fn cases() -> Vec<(String, Box<dyn Fn() -> Cloth + Sync>)> {
         }
     }
     v.push(("large-131x129-soe-symplectic".into(), Box::new(large)));
+    // The underwater preset (normal added mass: the turning forces' grid path on one thread,
+    // the pool's chunks on two and eight), at the towel's size and past the pool's threshold.
+    v.push((
+        "swing-underwater-61x41-auto".into(),
+        Box::new(|| {
+            let spec = SceneSpec::underwater_swing(61, 41, 1.0, 0.04, Model::underwater());
+            let mut s = spec.build().unwrap();
+            s.run_until(0.5).unwrap();
+            s.cloth
+        }),
+    ));
+    v.push((
+        "large-131x129-underwater-symplectic".into(),
+        Box::new(large_underwater),
+    ));
     v
+}
+
+fn large_underwater() -> Cloth {
+    let (w, h) = (131u32, 129u32);
+    let t = GridSpec {
+        width: w,
+        height: h,
+        spacing: 0.01,
+        total_mass: 0.24 / 2501.0 * f64::from(w * h),
+    }
+    .build()
+    .unwrap();
+    let mut model = Model::underwater();
+    model.current = Vec3::new(0.05, 0.0, 0.2);
+    let mut c = Cloth::new(
+        t,
+        ClothConfig {
+            model,
+            integrator: Integrator::SymplecticEuler,
+            ..ClothConfig::default()
+        },
+    )
+    .unwrap();
+    let top: Vec<u32> = (0..w).map(|i| grid_index(w, i, 0)).collect();
+    c.set_pinned(&top).unwrap();
+    for _ in 0..30 {
+        c.step(5e-4).unwrap();
+    }
+    c
 }
 
 fn large() -> Cloth {

@@ -216,6 +216,8 @@ pub struct TurningScratch {
     sums: Vec<Vec3>,
     rates: Vec<Vec3>,
     patches: Vec<Vec3>,
+    /// A grid's rows of vertices and of cells, in component arrays ([`super::turning_grid`]).
+    rows: Vec<f64>,
     /// How the pool's path splits the cloth.
     split: TurningSplit,
 }
@@ -289,9 +291,43 @@ pub fn turning_forces(
         // Four chunks a thread, so that the pool can even out uneven chunks.
         let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
         turning_chunked(ma, t, x, v, scratch, chunk, true, projected, normals, out);
+    } else if let (Some(size), None) = (t.grid_faces, coarse.as_ref()) {
+        let TurningScratch {
+            sums,
+            rates,
+            patches,
+            rows,
+            ..
+        } = scratch;
+        let buffers = super::turning_grid::GridBuffers {
+            rows,
+            sums,
+            rates,
+            patches,
+        };
+        turning_grid_widest(ma, t, size, x, v, buffers, projected, normals, out);
     } else {
         turning_serial_widest(ma, t, x, v, scratch, projected, normals, out, coarse);
     }
+}
+
+crate::simd_dispatch! { fn turning_grid_widest(ma: f64, t: &Topology, size: (usize, usize), x: &[Vec3], v: &[Vec3], buffers: super::turning_grid::GridBuffers<'_>, projected: &mut [f64], normals: &mut [Vec3], out: &mut [Vec3]) => turning_grid_body }
+
+/// [`super::turning_grid::turning_grid`], for the dispatch.
+#[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
+#[inline(always)]
+fn turning_grid_body(
+    ma: f64,
+    t: &Topology,
+    size: (usize, usize),
+    x: &[Vec3],
+    v: &[Vec3],
+    buffers: super::turning_grid::GridBuffers<'_>,
+    projected: &mut [f64],
+    normals: &mut [Vec3],
+    out: &mut [Vec3],
+) {
+    super::turning_grid::turning_grid(ma, t, size, x, v, buffers, projected, normals, out);
 }
 
 crate::simd_dispatch! { fn turning_serial_widest(ma: f64, t: &Topology, x: &[Vec3], v: &[Vec3], scratch: &mut TurningScratch, projected: &mut [f64], normals: &mut [Vec3], out: &mut [Vec3], coarse: Option<&mut super::coarse_water::CoarseWater>) => turning_serial }
@@ -304,7 +340,7 @@ crate::simd_dispatch! { fn turning_serial_widest(ma: f64, t: &Topology, x: &[Vec
 /// distinct: a mesh with a repeated corner is refused when built.)
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 #[inline(always)]
-fn turning_serial(
+pub(super) fn turning_serial(
     ma: f64,
     t: &Topology,
     x: &[Vec3],
@@ -804,11 +840,11 @@ fn patch_turning(
 
 /// What [`patch_range`] writes for its vertices: their forces (subtracted from), projected-area
 /// ratios, unit normals and `w`.
-struct PatchOut<'a> {
-    o: &'a mut [Vec3],
-    projected: &'a mut [f64],
-    normals: &'a mut [Vec3],
-    w: &'a mut [Vec3],
+pub(super) struct PatchOut<'a> {
+    pub o: &'a mut [Vec3],
+    pub projected: &'a mut [f64],
+    pub normals: &'a mut [Vec3],
+    pub w: &'a mut [Vec3],
 }
 
 /// Vertices per block of [`patch_range`]: one AVX-512 vector of f64.
@@ -820,7 +856,7 @@ const PATCH_BLOCK: usize = 8;
 /// roots and divisions run a vector at a time. The same operations in the same order as
 /// [`patch_turning`] (a unit test compares them bit for bit), so the same bits.
 #[inline(always)]
-fn patch_range(
+pub(super) fn patch_range(
     ma: f64,
     areas: &[f64],
     scale: &[f64],

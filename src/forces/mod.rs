@@ -10,6 +10,7 @@
 //! | `elements.rs` | the list of pair elements (springs, strain springs): what each remembers, how its forces are summed, its damping block |
 //! | `strain.rs` | the rotation-invariant fractional spring: D^{1/2} of each spring's elongation |
 //! | `inertia.rs` | a particle's inertia: its mass and the water it carries (the mass matrix, its inverse, its energy) |
+//! | `turning_grid.rs` | the carried water's turning forces on a grid, gathered by each vertex (the same bits as `inertia.rs`'s scatter) |
 //! | `memories.rs` | which half-derivative histories a model keeps, derived from what its terms read |
 //! | `terms.rs` | the list of per-particle terms, what each reads, its Jacobian block |
 //! | `jacobian.rs` | the linearised forces of the implicit integrator |
@@ -32,6 +33,7 @@ mod springs;
 mod strain;
 pub(crate) mod terms;
 mod tiles;
+mod turning_grid;
 mod wide_drag;
 
 // The public face: the colliders, a particle's inertia and weight, what a model remembers,

@@ -33,6 +33,11 @@ pub struct Topology {
     pub patch_scale: Vec<f64>,
     /// Grid size (columns, rows) when the cloth was built from a grid.
     pub grid: Option<(u32, u32)>,
+    /// `(columns, rows)` when the triangles are those [`crate::topology::GridSpec`] makes of
+    /// such a grid (every cell `(i, j)` split into `[a, c, b]` and `[b, c, d]`, `a = (i, j)`,
+    /// `b = (i + 1, j)`, `c = (i, j + 1)`, `d = (i + 1, j + 1)`, cell after cell, row after
+    /// row): then a pass may find a vertex's faces from its place in the grid.
+    pub grid_faces: Option<(usize, usize)>,
     /// The cloth's spacing, m: a grid's own; for a mesh the side of a square of two of its
     /// triangles' mean rest area (a grid's spacing for a triangulated grid, jittered or not;
     /// 0 without triangles). What `Model::bend_reference_spacing` compares with.
@@ -48,6 +53,22 @@ pub struct Topology {
     /// How the force pass walks this topology: tile by tile (`Some`), or from a per-spring
     /// buffer (`None`); decided here, once.
     pub tiled: Option<TileLayout>,
+}
+
+/// `grid` as `(columns, rows)` when the cloth's `n` vertices are its and `triangles` are the ones [`crate::topology::GridSpec`] makes
+/// of it ([`Topology::grid_faces`]).
+fn grid_faces((w, h): (u32, u32), n: usize, triangles: &[[u32; 3]]) -> Option<(usize, usize)> {
+    let (w, h) = (w as usize, h as usize);
+    if w < 2 || h < 2 || w.checked_mul(h) != Some(n) || triangles.len() != 2 * (w - 1) * (h - 1) {
+        return None;
+    }
+    let cells = (0..h - 1).flat_map(|j| (0..w - 1).map(move |i| (i, j)));
+    let expected = cells.flat_map(|(i, j)| {
+        let at = |i: usize, j: usize| (j * w + i) as u32;
+        let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1));
+        [[a, c, b], [b, c, d]]
+    });
+    expected.eq(triangles.iter().copied()).then_some((w, h))
 }
 
 impl Topology {
@@ -112,6 +133,7 @@ impl Topology {
             rest_positions,
             masses,
             springs,
+            grid_faces: grid.and_then(|g| grid_faces(g, n, &triangles)),
             triangles,
             grid,
             spacing,

@@ -1,0 +1,469 @@
+//! The carried water's turning forces ([`super::inertia::turning_forces`]) on a grid's
+//! triangles: a row of cells at a time in component arrays, each vertex gathering its faces'
+//! terms, instead of each face scattering its terms to its corners.
+//!
+//! A grid built by [`crate::topology::GridSpec`] splits every cell `(i, j)` (corners
+//! `a = (i, j)`, `b = (i + 1, j)`, `c = (i, j + 1)`, `d = (i + 1, j + 1)`) into `[a, c, b]`
+//! and `[b, c, d]`, cell after cell, row after row ([`Topology::grid_faces`]). So a vertex
+//! knows its faces, and which corner of each it is, from its place in the grid, and in which
+//! order a scatter over the faces reaches it: cell `(i - 1, j - 1)`'s second face, both of
+//! `(i, j - 1)`'s, both of `(i - 1, j)`'s and `(i, j)`'s first. Each vertex adds its faces'
+//! terms in that order, computed with the same operations, so it gets the scatter's bits
+//! (a test compares them on every shape of grid). Cell row j's terms are computed a vector
+//! of cells at a time ([`BLOCK`]) and finish vertex row j's sums and begin row j + 1's; the
+//! rows of vertices, cells and sums are a few rows of component arrays, in cache.
+//!
+//! Measured (AMD EPYC, `docs/benchmarks.md`, stop 49): the underwater step at 61 x 41 from
+//! 63-65 to 58-61 ns a particle, 201 x 201 on one thread 68-69 to 60-64; the scatter's chain of
+//! stores and reloads (a vertex is a corner of six faces, three of them consecutive) was the
+//! cost.
+
+use super::inertia::{patch_range, PatchOut};
+use crate::math::Vec3;
+use crate::topology::Topology;
+
+/// The face terms of a row of cells, each `cw` long, three components each: the first pass's
+/// area vectors and rates of the first and second face of every cell.
+const F0: usize = 0;
+const R0: usize = 3;
+const F1: usize = 6;
+/// The second pass's gradients at the corners of the first face (`[a, c, b]`: its corners 1,
+/// 2 and 0 are c, b, a) and of the second (`[b, c, d]`: c, d, b).
+const G0B: usize = 0;
+const G0C: usize = 3;
+const G0A: usize = 6;
+const G1B: usize = 9;
+const G1C: usize = 12;
+const G1A: usize = 15;
+const SLOTS: usize = 18;
+
+/// Cells per block of the face passes: one AVX-512 vector of f64.
+const BLOCK: usize = 8;
+
+/// The buffers [`turning_grid`] fills: rows of vertices' vectors, a row of cells' terms and
+/// two rows of sums, in component arrays (a few rows, in cache); each vertex's sums of its
+/// faces' area vectors and rates, and its `w`.
+pub(super) struct GridBuffers<'a> {
+    pub rows: &'a mut Vec<f64>,
+    pub sums: &'a mut Vec<Vec3>,
+    pub rates: &'a mut Vec<Vec3>,
+    pub patches: &'a mut Vec<Vec3>,
+}
+
+/// `data` cut into `N` consecutive slices of `len`.
+fn cut<const N: usize>(data: &mut [f64], len: usize) -> [&mut [f64]; N] {
+    let mut parts = data.chunks_exact_mut(len.max(1));
+    std::array::from_fn(|_| parts.next().unwrap_or_default())
+}
+
+/// Writes the components of `from` into `to[0..3]`.
+#[inline(always)]
+fn transpose(from: &[Vec3], to: &mut [&mut [f64]]) {
+    for (k, p) in from.iter().enumerate() {
+        for c in 0..3 {
+            to[c][k] = p[c];
+        }
+    }
+}
+
+/// Writes the components `from[0..3]` into `to`.
+#[inline(always)]
+fn untranspose(from: &[&mut [f64]], to: &mut [Vec3]) {
+    for (k, p) in to.iter_mut().enumerate() {
+        *p = Vec3::new(from[0][k], from[1][k], from[2][k]);
+    }
+}
+
+/// `a x b` in components, as `Vec3::cross` computes it.
+#[inline(always)]
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[inline(always)]
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline(always)]
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// Adds to vertex row j the terms of its faces in cell row j (`acc` the row, `w` long; the
+/// cell row's terms `cw = w - 1` long): the first face of cell i - 1 (`a`), its second (`b`)
+/// and the first of cell i (`c`), in that order.
+#[inline(always)]
+fn below(acc: &mut [f64], a: &[f64], b: &[f64], c: &[f64]) {
+    let cw = a.len();
+    let (acc, b, c) = (&mut acc[..cw + 1], &b[..cw], &c[..cw]);
+    acc[0] += c[0];
+    for i in 1..cw {
+        acc[i] = ((acc[i] + a[i - 1]) + b[i - 1]) + c[i];
+    }
+    acc[cw] = (acc[cw] + a[cw - 1]) + b[cw - 1];
+}
+
+/// Adds to vertex row j + 1 the terms of its faces in cell row j: the second face of cell
+/// i - 1 (`a`), the first of cell i (`b`) and its second (`c`), in that order.
+#[inline(always)]
+fn above(acc: &mut [f64], a: &[f64], b: &[f64], c: &[f64]) {
+    let cw = a.len();
+    let (acc, b, c) = (&mut acc[..cw + 1], &b[..cw], &c[..cw]);
+    acc[0] = (acc[0] + b[0]) + c[0];
+    for i in 1..cw {
+        acc[i] = ((acc[i] + a[i - 1]) + b[i]) + c[i];
+    }
+    acc[cw] += a[cw - 1];
+}
+
+/// [`super::inertia::turning_forces`] for a grid of `w` x `h` vertices whose triangles are
+/// [`Topology::grid_faces`]'s: the same terms in the same order, so the same bits.
+#[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
+#[inline(always)]
+pub(super) fn turning_grid(
+    ma: f64,
+    t: &Topology,
+    (w, h): (usize, usize),
+    x: &[Vec3],
+    v: &[Vec3],
+    buffers: GridBuffers<'_>,
+    projected: &mut [f64],
+    normals: &mut [Vec3],
+    out: &mut [Vec3],
+) {
+    let GridBuffers {
+        rows,
+        sums,
+        rates,
+        patches,
+    } = buffers;
+    let n = w * h;
+    let (cw, ch) = (w - 1, h - 1);
+    // Four rows of vectors, a row of cells' terms, two rows of six sums.
+    let len = 12 * w + SLOTS * cw + 12 * w;
+    if rows.len() != len {
+        rows.clear();
+        rows.resize(len, 0.0);
+    }
+    let (x, v, out) = (&x[..n], &v[..n], &mut out[..n]);
+    sums.resize(n, Vec3::zeros());
+    rates.resize(n, Vec3::zeros());
+    // Each vertex's sums of its faces' area vectors and rates, in ascending face order from
+    // zero (as a scatter adds them), a row of cells at a time.
+    {
+        let (mut xt, mut xb, mut vt, mut vb, mut terms, mut cur, mut next) = carve(rows, w);
+        for a in cur.iter_mut() {
+            a.fill(0.0);
+        }
+        transpose(&x[..w], &mut xb);
+        transpose(&v[..w], &mut vb);
+        for j in 0..ch {
+            // The row below becomes the top one.
+            std::mem::swap(&mut xt, &mut xb);
+            std::mem::swap(&mut vt, &mut vb);
+            transpose(&x[(j + 1) * w..(j + 2) * w], &mut xb);
+            transpose(&v[(j + 1) * w..(j + 2) * w], &mut vb);
+            blocks(
+                cw,
+                [row(&xt), row(&xb)],
+                [row(&vt), row(&vb)],
+                area_terms,
+                &mut terms[..12],
+            );
+            for k in 0..6 {
+                let slot = if k < 3 { F0 + k } else { R0 + k - 3 };
+                let (t0, t1) = (&*terms[slot], &*terms[slot + F1 - F0]);
+                below(cur[k], t0, t1, t0);
+                next[k].fill(0.0);
+                above(next[k], t1, t0, t1);
+            }
+            untranspose(&cur[..3], &mut sums[j * w..(j + 1) * w]);
+            untranspose(&cur[3..], &mut rates[j * w..(j + 1) * w]);
+            std::mem::swap(&mut cur, &mut next);
+        }
+        untranspose(&cur[..3], &mut sums[ch * w..]);
+        untranspose(&cur[3..], &mut rates[ch * w..]);
+    }
+    patches.clear();
+    patches.resize(n, Vec3::zeros());
+    patch_range(
+        ma,
+        &t.areas[..],
+        &t.patch_scale[..],
+        sums,
+        rates,
+        v,
+        PatchOut {
+            o: &mut out[..],
+            projected,
+            normals,
+            w: patches,
+        },
+    );
+    // Each face's gradients at its corners, added to the corners' forces in ascending face
+    // order.
+    let (mut xt, mut xb, mut wt, mut wb, mut terms, mut cur, mut next) = carve(rows, w);
+    transpose(&out[..w], &mut cur[..3]);
+    transpose(&x[..w], &mut xb);
+    transpose(&patches[..w], &mut wb);
+    for j in 0..ch {
+        std::mem::swap(&mut xt, &mut xb);
+        std::mem::swap(&mut wt, &mut wb);
+        transpose(&x[(j + 1) * w..(j + 2) * w], &mut xb);
+        transpose(&patches[(j + 1) * w..(j + 2) * w], &mut wb);
+        blocks(
+            cw,
+            [row(&xt), row(&xb)],
+            [row(&wt), row(&wb)],
+            gradient_terms,
+            &mut terms[..],
+        );
+        transpose(&out[(j + 1) * w..(j + 2) * w], &mut next[..3]);
+        for q in 0..3 {
+            below(cur[q], terms[G0C + q], terms[G1A + q], terms[G0A + q]);
+            above(next[q], terms[G1C + q], terms[G0B + q], terms[G1B + q]);
+        }
+        untranspose(&cur[..3], &mut out[j * w..(j + 1) * w]);
+        std::mem::swap(&mut cur, &mut next);
+    }
+    untranspose(&cur[..3], &mut out[ch * w..]);
+}
+
+/// A cell's four corners' vectors: a, b, c, d.
+type Corners = [[f64; 3]; 4];
+
+/// A row of three component arrays.
+type Row<'a> = [&'a mut [f64]; 3];
+
+/// `rows` carved for a grid `w` wide: four rows of vectors, a row of cells' terms and two
+/// rows of six sums.
+#[allow(clippy::type_complexity)]
+fn carve(
+    rows: &mut [f64],
+    w: usize,
+) -> (
+    Row<'_>,
+    Row<'_>,
+    Row<'_>,
+    Row<'_>,
+    [&mut [f64]; SLOTS],
+    [&mut [f64]; 6],
+    [&mut [f64]; 6],
+) {
+    let cw = w - 1;
+    let (vectors, rest) = rows.split_at_mut(12 * w);
+    let (terms, sums) = rest.split_at_mut(SLOTS * cw);
+    let [a, b, c, d] = cut::<4>(vectors, 3 * w).map(|r| cut::<3>(r, w));
+    let [e, f] = cut::<2>(sums, 6 * w).map(|r| cut::<6>(r, w));
+    (a, b, c, d, cut(terms, cw), e, f)
+}
+
+/// The first `w` of each component of a row.
+fn row<'a>(r: &'a [&mut [f64]; 3]) -> [&'a [f64]; 3] {
+    [&r[0][..], &r[1][..], &r[2][..]]
+}
+
+/// A cell's two faces' area vectors and rates (`[f0, r0, f1, r1]`) from its corners'
+/// positions and velocities (`a, b, c, d`), as `inertia::face_and_rate` computes them.
+#[inline(always)]
+fn area_terms([a, b, c, d]: Corners, [va, vb, vc, vd]: Corners) -> [[f64; 3]; 4] {
+    // [a, c, b]: e1 = c - a, e2 = b - a; the rate (v_c - v_a) x e2 + e1 x (v_b - v_a).
+    let (e1, e2) = (sub(c, a), sub(b, a));
+    let f0 = cross(e1, e2);
+    let r0 = add(cross(sub(vc, va), e2), cross(e1, sub(vb, va)));
+    // [b, c, d]: e1 = c - b, e2 = d - b.
+    let (e1, e2) = (sub(c, b), sub(d, b));
+    let f1 = cross(e1, e2);
+    let r1 = add(cross(sub(vc, vb), e2), cross(e1, sub(vd, vb)));
+    [f0, r0, f1, r1]
+}
+
+/// A cell's two faces' gradients at their corners (`[gb, gc, ga, hb, hc, ha]`: the first
+/// face's at c, b, a, the second's at c, d, b) from its corners' positions and `w`, as
+/// `inertia::face_gradients` computes them (and `-(gb + gc)` at the first corner).
+#[inline(always)]
+fn gradient_terms([a, b, c, d]: Corners, [wa, wb, wc, wd]: Corners) -> [[f64; 3]; 6] {
+    let zero = [0.0; 3];
+    // [a, c, b]: W = w_a + w_c + w_b from zero; e1 = c - a, e2 = b - a.
+    let sum = add(add(add(zero, wa), wc), wb);
+    let (e1, e2) = (sub(c, a), sub(b, a));
+    let (gb, gc) = (cross(e2, sum), cross(sum, e1));
+    let ga = add(gb, gc).map(|g| -g);
+    // [b, c, d]: W = w_b + w_c + w_d; e1 = c - b, e2 = d - b.
+    let sum = add(add(add(zero, wb), wc), wd);
+    let (e1, e2) = (sub(c, b), sub(d, b));
+    let (hb, hc) = (cross(e2, sum), cross(sum, e1));
+    let ha = add(hb, hc).map(|g| -g);
+    [gb, gc, ga, hb, hc, ha]
+}
+
+/// Runs `kernel` for the cells `0..len` of a row, [`BLOCK`] at a time: the corners' two
+/// vectors (`first` at the row's top and bottom: a, b = top[i], top[i + 1]; c, d = bottom[i],
+/// bottom[i + 1]; `second` likewise) are loaded into arrays a block at a time, the kernel
+/// runs lane by lane over the block (the compiler runs it a vector at a time), and its `K`
+/// results go to `out[3 k + component][i]`.
+#[inline(always)]
+fn blocks<const K: usize>(
+    len: usize,
+    first: [[&[f64]; 3]; 2],
+    second: [[&[f64]; 3]; 2],
+    kernel: fn(Corners, Corners) -> [[f64; 3]; K],
+    out: &mut [&mut [f64]],
+) {
+    const B: usize = BLOCK;
+    let whole = len / B * B;
+    let mut i0 = 0;
+    while i0 < whole {
+        // [side][corner][component][lane]
+        let mut p = [[[[0.0; B]; 3]; 4]; 2];
+        for (side, rows) in [&first, &second].into_iter().enumerate() {
+            for q in 0..3 {
+                p[side][0][q].copy_from_slice(&rows[0][q][i0..i0 + B]);
+                p[side][1][q].copy_from_slice(&rows[0][q][i0 + 1..i0 + 1 + B]);
+                p[side][2][q].copy_from_slice(&rows[1][q][i0..i0 + B]);
+                p[side][3][q].copy_from_slice(&rows[1][q][i0 + 1..i0 + 1 + B]);
+            }
+        }
+        let mut res = [[[0.0; B]; 3]; K];
+        for l in 0..B {
+            let mut u = [[[0.0; 3]; 4]; 2];
+            for side in 0..2 {
+                for corner in 0..4 {
+                    for q in 0..3 {
+                        u[side][corner][q] = p[side][corner][q][l];
+                    }
+                }
+            }
+            let r = kernel(u[0], u[1]);
+            for k in 0..K {
+                for q in 0..3 {
+                    res[k][q][l] = r[k][q];
+                }
+            }
+        }
+        for k in 0..K {
+            for q in 0..3 {
+                out[3 * k + q][i0..i0 + B].copy_from_slice(&res[k][q]);
+            }
+        }
+        i0 += B;
+    }
+    for i in whole..len {
+        let lane = |rows: &[[&[f64]; 3]; 2]| -> [[f64; 3]; 4] {
+            let at = |r: &[&[f64]; 3], i: usize| [r[0][i], r[1][i], r[2][i]];
+            [
+                at(&rows[0], i),
+                at(&rows[0], i + 1),
+                at(&rows[1], i),
+                at(&rows[1], i + 1),
+            ]
+        };
+        let r = kernel(lane(&first), lane(&second));
+        for k in 0..K {
+            for q in 0..3 {
+                out[3 * k + q][i] = r[k][q];
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::forces::inertia::{turning_forces, turning_serial, TurningScratch, CARRIED_FULL};
+    use crate::Model;
+
+    /// The grid's gathered passes give the scatter's bits (forces added to what was there,
+    /// projected-area ratios, unit normals) on grids of every shape the rows allow (one cell,
+    /// one row or column of cells, rows shorter and longer than a block), crumpled, with
+    /// patches stretched past the carried water's bound.
+    #[test]
+    fn the_grid_passes_keep_the_scatters_bits() {
+        let mut m = Model::underwater();
+        m.water.added_mass = 8.0;
+        for (w, h, seed) in [
+            (2, 2, 1),
+            (3, 2, 2),
+            (2, 5, 3),
+            (9, 8, 4),
+            (10, 3, 5),
+            (23, 17, 6),
+            (61, 41, 7),
+        ] {
+            let (t, mut x, v) = crate::testing::crumpled_grid(w, h, seed);
+            assert_eq!(t.grid_faces, Some((w as usize, h as usize)));
+            let n = x.len();
+            assert!(!crate::parallel::worth_it(n));
+            // Some patches stretched well past the bound.
+            for k in (0..n).step_by(5) {
+                x[k] *= 1.6;
+            }
+            let prior: Vec<Vec3> = (0..n)
+                .map(|i| Vec3::new(i as f64, -0.5, 0.25 * i as f64))
+                .collect();
+            let run = |grid: bool| {
+                let mut s = TurningScratch::default();
+                let (mut p, mut nr, mut out) = (vec![0.0; n], vec![Vec3::zeros(); n], prior.clone());
+                // Twice: buffers sized by the first call are reused by the second.
+                for _ in 0..2 {
+                    out.clone_from(&prior);
+                    if grid {
+                        turning_forces(&m, &t, &x, &v, &mut s, &mut p, &mut nr, &mut out, None);
+                    } else {
+                        turning_serial(8.0, &t, &x, &v, &mut s, &mut p, &mut nr, &mut out, None);
+                    }
+                }
+                (out, p, nr)
+            };
+            let (want, got) = (run(false), run(true));
+            assert!(
+                want.1.iter().any(|&p| p * p > CARRIED_FULL),
+                "{w}x{h}: no patch past the bound"
+            );
+            let bits = |a: &[Vec3]| -> Vec<u64> {
+                a.iter()
+                    .flat_map(|p| p.iter().map(|c| c.to_bits()))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(bits(&got.0), bits(&want.0), "forces, {w}x{h}");
+            assert_eq!(bits(&got.2), bits(&want.2), "normals, {w}x{h}");
+            let ratios = |a: &[f64]| a.iter().map(|p| p.to_bits()).collect::<Vec<_>>();
+            assert_eq!(ratios(&got.1), ratios(&want.1), "ratios, {w}x{h}");
+            assert!(got.0.iter().zip(&prior).all(|(a, b)| a != b));
+        }
+    }
+
+    /// A grid's triangles are recognised only when they are exactly the ones a grid makes.
+    #[test]
+    fn only_a_grids_own_triangles_are_taken_for_a_grid() {
+        let (t, _, _) = crate::testing::crumpled_grid(4, 3, 1);
+        assert_eq!(t.grid_faces, Some((4, 3)));
+        let mut triangles = t.triangles.clone();
+        triangles.swap(2, 3);
+        let moved = Topology::new(
+            t.rest_positions.clone(),
+            t.masses.clone(),
+            t.springs.clone(),
+            triangles,
+            t.grid,
+        );
+        assert_eq!(moved.grid_faces, None);
+        let mut flipped = t.triangles.clone();
+        flipped[5] = [flipped[5][0], flipped[5][2], flipped[5][1]];
+        let flipped = Topology::new(
+            t.rest_positions.clone(),
+            t.masses.clone(),
+            t.springs.clone(),
+            flipped,
+            t.grid,
+        );
+        assert_eq!(flipped.grid_faces, None);
+        let jittered = crate::testing::jittered_mesh(5, 4);
+        assert_eq!(jittered.grid_faces, None);
+    }
+}
