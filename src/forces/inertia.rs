@@ -216,8 +216,9 @@ pub struct TurningScratch {
     sums: Vec<Vec3>,
     rates: Vec<Vec3>,
     patches: Vec<Vec3>,
-    /// A grid's rows of vertices and of cells, in component arrays ([`super::turning_grid`]).
-    rows: Vec<f64>,
+    /// A grid's bands' rows of vertices and of cells, in component arrays
+    /// ([`super::turning_grid`]).
+    bands: Vec<Vec<f64>>,
     /// How the pool's path splits the cloth.
     split: TurningSplit,
 }
@@ -280,54 +281,45 @@ pub fn turning_forces(
     if ma == 0.0 && coarse.is_none() {
         return;
     }
-    // Faces, vertices and faces again; both paths give every vertex the same terms in the same
-    // order, so a large cloth spreads them over the pool with the same bits. (One path would
+    // Faces, vertices and faces again; every path gives every vertex the same terms in the same
+    // order, so a large cloth spreads them over the pool with the same bits. A grid's cells
+    // say which faces a vertex has: it takes the rows path (`turning_grid.rs`) on one thread
+    // and on the pool. (One path would
     // do: the pool's with one chunk. Measured, its chunk lists, wavefront marks and border
     // tests cost more than they save on one thread: at 61 x 41 9.06 G instructions against
     // 8.12 G (the pool's path before the wavefront), at 201 x 201 the turning forces 1.69 G
     // against 1.47 G, and no faster at 1001 x 1001.)
     let n = x.len();
-    if parallel::worth_it(n) && coarse.is_none() {
-        // Four chunks a thread, so that the pool can even out uneven chunks.
-        let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
-        turning_chunked(ma, t, x, v, scratch, chunk, true, projected, normals, out);
-    } else if let (Some(size), None) = (t.grid_faces, coarse.as_ref()) {
+    let par = parallel::worth_it(n);
+    if let (Some(size), None) = (t.grid_faces, coarse.as_ref()) {
+        // A grid: in bands of rows, four a thread on the pool, so that it can even out uneven
+        // bands; one band on one thread.
+        let band = if par {
+            size.1.div_ceil(4 * rayon::current_num_threads())
+        } else {
+            size.1
+        };
         let TurningScratch {
             sums,
             rates,
             patches,
-            rows,
+            bands,
             ..
         } = scratch;
         let buffers = super::turning_grid::GridBuffers {
-            rows,
+            bands,
             sums,
             rates,
             patches,
         };
-        turning_grid_widest(ma, t, size, x, v, buffers, projected, normals, out);
+        super::turning_grid::turning_grid(ma, t, size, x, v, buffers, (band, par), projected, normals, out);
+    } else if par && coarse.is_none() {
+        // Four chunks a thread, so that the pool can even out uneven chunks.
+        let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
+        turning_chunked(ma, t, x, v, scratch, chunk, true, projected, normals, out);
     } else {
         turning_serial_widest(ma, t, x, v, scratch, projected, normals, out, coarse);
     }
-}
-
-crate::simd_dispatch! { fn turning_grid_widest(ma: f64, t: &Topology, size: (usize, usize), x: &[Vec3], v: &[Vec3], buffers: super::turning_grid::GridBuffers<'_>, projected: &mut [f64], normals: &mut [Vec3], out: &mut [Vec3]) => turning_grid_body }
-
-/// [`super::turning_grid::turning_grid`], for the dispatch.
-#[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
-#[inline(always)]
-fn turning_grid_body(
-    ma: f64,
-    t: &Topology,
-    size: (usize, usize),
-    x: &[Vec3],
-    v: &[Vec3],
-    buffers: super::turning_grid::GridBuffers<'_>,
-    projected: &mut [f64],
-    normals: &mut [Vec3],
-    out: &mut [Vec3],
-) {
-    super::turning_grid::turning_grid(ma, t, size, x, v, buffers, projected, normals, out);
 }
 
 crate::simd_dispatch! { fn turning_serial_widest(ma: f64, t: &Topology, x: &[Vec3], v: &[Vec3], scratch: &mut TurningScratch, projected: &mut [f64], normals: &mut [Vec3], out: &mut [Vec3], coarse: Option<&mut super::coarse_water::CoarseWater>) => turning_serial }

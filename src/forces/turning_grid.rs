@@ -13,13 +13,23 @@
 //! of cells at a time ([`BLOCK`]) and finish vertex row j's sums and begin row j + 1's; the
 //! rows of vertices, cells and sums are a few rows of component arrays, in cache.
 //!
-//! Measured (AMD EPYC, `docs/benchmarks.md`, stop 49): the underwater step at 61 x 41 from
-//! 63-65 to 58-61 ns a particle, 201 x 201 on one thread 68-69 to 60-64; the scatter's chain of
-//! stores and reloads (a vertex is a corner of six faces, three of them consecutive) was the
-//! cost.
+//! On the pool the rows are cut into bands, one task each: first every band's sums and patch
+//! terms, then every band's gradients (they read the `w` of the rows beside the band). A band
+//! computes the cell row above it too, as the band above does, with the same values: the bits
+//! do not depend on the bands or the thread count (the determinism hashes run the underwater
+//! preset on 1, 2 and 8 threads). This replaces, for grids, the chunks and wavefront that
+//! other meshes take (`inertia.rs`).
+//!
+//! Measured (AMD EPYC, `docs/benchmarks.md`, stop 49), ns a particle-step of the underwater
+//! preset, against the scatter: 61 x 41 59-63 against 64-66; 201 x 201 on one thread 61-62
+//! against 69, on two 33 against 41; 1001 x 1001 on two threads 48-49 against 53 (1.78-1.80
+//! times one thread's 85-87). The scatter's chain of stores and reloads (a vertex is a corner
+//! of six faces, three of them consecutive) was the cost on one thread; the chunks' borders
+//! and wavefront on two.
 
 use super::inertia::{patch_range, PatchOut};
 use crate::math::Vec3;
+use crate::parallel;
 use crate::topology::Topology;
 
 /// The face terms of a row of cells, each `cw` long, three components each: the first pass's
@@ -40,11 +50,11 @@ const SLOTS: usize = 18;
 /// Cells per block of the face passes: one AVX-512 vector of f64.
 const BLOCK: usize = 8;
 
-/// The buffers [`turning_grid`] fills: rows of vertices' vectors, a row of cells' terms and
-/// two rows of sums, in component arrays (a few rows, in cache); each vertex's sums of its
-/// faces' area vectors and rates, and its `w`.
+/// The buffers [`turning_grid`] fills: each band's rows of vertices' vectors, of a row of
+/// cells' terms and of sums, in component arrays (a few rows, in cache); each vertex's sums of
+/// its faces' area vectors and rates, and its `w`.
 pub(super) struct GridBuffers<'a> {
-    pub rows: &'a mut Vec<f64>,
+    pub bands: &'a mut Vec<Vec<f64>>,
     pub sums: &'a mut Vec<Vec3>,
     pub rates: &'a mut Vec<Vec3>,
     pub patches: &'a mut Vec<Vec3>,
@@ -122,9 +132,12 @@ fn above(acc: &mut [f64], a: &[f64], b: &[f64], c: &[f64]) {
 }
 
 /// [`super::inertia::turning_forces`] for a grid of `w` x `h` vertices whose triangles are
-/// [`Topology::grid_faces`]'s: the same terms in the same order, so the same bits.
+/// [`Topology::grid_faces`]'s: the same terms in the same order, so the same bits. In bands of
+/// `band` vertex rows, on the pool when `par`: first every band's sums and patch terms, then
+/// every band's gradients (which read the `w` of the rows beside it). A band computes the
+/// cell row above it too, as the band above does: the same values, so the bits do not depend
+/// on the bands.
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
-#[inline(always)]
 pub(super) fn turning_grid(
     ma: f64,
     t: &Topology,
@@ -132,110 +145,240 @@ pub(super) fn turning_grid(
     x: &[Vec3],
     v: &[Vec3],
     buffers: GridBuffers<'_>,
+    (band, par): (usize, bool),
     projected: &mut [f64],
     normals: &mut [Vec3],
     out: &mut [Vec3],
 ) {
     let GridBuffers {
-        rows,
+        bands,
         sums,
         rates,
         patches,
     } = buffers;
     let n = w * h;
-    let (cw, ch) = (w - 1, h - 1);
-    // Four rows of vectors, a row of cells' terms, two rows of six sums.
-    let len = 12 * w + SLOTS * cw + 12 * w;
-    if rows.len() != len {
-        rows.clear();
-        rows.resize(len, 0.0);
+    let band = band.clamp(1, h);
+    let count = h.div_ceil(band);
+    let len = 24 * w + SLOTS * (w - 1);
+    if bands.len() != count || bands.iter().any(|b| b.len() != len) {
+        bands.clear();
+        bands.resize(count, vec![0.0; len]);
     }
-    let (x, v, out) = (&x[..n], &v[..n], &mut out[..n]);
-    sums.resize(n, Vec3::zeros());
-    rates.resize(n, Vec3::zeros());
-    // Each vertex's sums of its faces' area vectors and rates, in ascending face order from
-    // zero (as a scatter adds them), a row of cells at a time.
+    for a in [&mut *sums, &mut *rates, &mut *patches] {
+        a.resize(n, Vec3::zeros());
+    }
+    let (x, v) = (&x[..n], &v[..n]);
+    let rows = parallel::Disjoint::new(&mut bands[..]);
     {
-        let (mut xt, mut xb, mut vt, mut vb, mut terms, mut cur, mut next) = carve(rows, w);
-        for a in cur.iter_mut() {
-            a.fill(0.0);
-        }
-        transpose(&x[..w], &mut xb);
-        transpose(&v[..w], &mut vb);
-        for j in 0..ch {
-            // The row below becomes the top one.
-            std::mem::swap(&mut xt, &mut xb);
-            std::mem::swap(&mut vt, &mut vb);
-            transpose(&x[(j + 1) * w..(j + 2) * w], &mut xb);
-            transpose(&v[(j + 1) * w..(j + 2) * w], &mut vb);
-            blocks(
-                cw,
-                [row(&xt), row(&xb)],
-                [row(&vt), row(&vb)],
-                area_terms,
-                &mut terms[..12],
-            );
-            for k in 0..6 {
-                let slot = if k < 3 { F0 + k } else { R0 + k - 3 };
-                let (t0, t1) = (&*terms[slot], &*terms[slot + F1 - F0]);
-                below(cur[k], t0, t1, t0);
-                next[k].fill(0.0);
-                above(next[k], t1, t0, t1);
-            }
-            untranspose(&cur[..3], &mut sums[j * w..(j + 1) * w]);
-            untranspose(&cur[3..], &mut rates[j * w..(j + 1) * w]);
-            std::mem::swap(&mut cur, &mut next);
-        }
-        untranspose(&cur[..3], &mut sums[ch * w..]);
-        untranspose(&cur[3..], &mut rates[ch * w..]);
+        let d = [
+            &mut sums[..],
+            &mut rates[..],
+            &mut patches[..],
+            &mut normals[..n],
+            &mut out[..n],
+        ]
+        .map(parallel::Disjoint::new);
+        let projected = parallel::Disjoint::new(&mut projected[..n]);
+        parallel::for_chunks(par, h, band, |first, len| {
+            let r = first * w..(first + len) * w;
+            // SAFETY: every task borrows only its own band's rows of each array, and its own
+            // row buffer.
+            let [sums, rates, patches, normals, out] = d.each_ref().map(|a| unsafe { a.range(r.clone()) });
+            // SAFETY: as above.
+            let (projected, rows) = unsafe {
+                (
+                    projected.range(r.clone()),
+                    rows.range(first / band..first / band + 1),
+                )
+            };
+            let mine = Band {
+                rows: first..first + len,
+                buffer: &mut rows[0],
+            };
+            let outputs = BandOut {
+                sums,
+                rates,
+                patches,
+                normals,
+                out,
+                projected,
+            };
+            areas_and_patches_widest(ma, t, w, h, x, v, mine, outputs);
+        });
     }
-    patches.clear();
-    patches.resize(n, Vec3::zeros());
-    patch_range(
-        ma,
-        &t.areas[..],
-        &t.patch_scale[..],
+    let (patches, d) = (&patches[..], parallel::Disjoint::new(&mut out[..n]));
+    parallel::for_chunks(par, h, band, |first, len| {
+        // SAFETY: as above.
+        let (out, rows) = unsafe {
+            (
+                d.range(first * w..(first + len) * w),
+                rows.range(first / band..first / band + 1),
+            )
+        };
+        let mine = Band {
+            rows: first..first + len,
+            buffer: &mut rows[0],
+        };
+        gradients_widest(w, h, x, patches, mine, out);
+    });
+}
+
+/// A band of vertex rows and its row buffer.
+struct Band<'a> {
+    rows: std::ops::Range<usize>,
+    buffer: &'a mut Vec<f64>,
+}
+
+/// What the first pass writes for a band's vertices.
+struct BandOut<'a> {
+    sums: &'a mut [Vec3],
+    rates: &'a mut [Vec3],
+    patches: &'a mut [Vec3],
+    normals: &'a mut [Vec3],
+    out: &'a mut [Vec3],
+    projected: &'a mut [f64],
+}
+
+crate::simd_dispatch! { fn areas_and_patches_widest(ma: f64, t: &Topology, w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: BandOut<'_>) => areas_and_patches }
+
+/// A band's sums ([`areas`]) and then its patch terms ([`patch_range`]).
+#[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
+#[inline(always)]
+fn areas_and_patches(
+    ma: f64,
+    t: &Topology,
+    w: usize,
+    h: usize,
+    x: &[Vec3],
+    v: &[Vec3],
+    band: Band<'_>,
+    into: BandOut<'_>,
+) {
+    let r = band.rows.start * w..band.rows.end * w;
+    let BandOut {
         sums,
         rates,
-        v,
+        patches,
+        normals,
+        out,
+        projected,
+    } = into;
+    areas(w, h, x, v, band, [&mut *sums, &mut *rates]);
+    patch_range(
+        ma,
+        &t.areas[r.clone()],
+        &t.patch_scale[r.clone()],
+        sums,
+        rates,
+        &v[r],
         PatchOut {
-            o: &mut out[..],
+            o: out,
             projected,
             normals,
             w: patches,
         },
     );
-    // Each face's gradients at its corners, added to the corners' forces in ascending face
-    // order.
-    let (mut xt, mut xb, mut wt, mut wb, mut terms, mut cur, mut next) = carve(rows, w);
-    transpose(&out[..w], &mut cur[..3]);
-    transpose(&x[..w], &mut xb);
-    transpose(&patches[..w], &mut wb);
-    for j in 0..ch {
+}
+
+crate::simd_dispatch! { fn gradients_widest(w: usize, h: usize, x: &[Vec3], patches: &[Vec3], band: Band<'_>, out: &mut [Vec3]) => gradients }
+
+/// The cell rows whose terms a band of vertex rows `rows` needs (the one above it too), of a
+/// grid `h` rows high.
+fn cell_rows(rows: &std::ops::Range<usize>, h: usize) -> std::ops::Range<usize> {
+    rows.start.saturating_sub(1)..rows.end.min(h - 1)
+}
+
+/// Each vertex of the band's sums of its faces' area vectors and rates (`into`: the band's
+/// rows), in ascending face order from zero, as a scatter adds them.
+#[inline(always)]
+fn areas(w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: [&mut [Vec3]; 2]) {
+    let [sums, rates] = into;
+    let Band { rows, buffer } = band;
+    let (mut xt, mut xb, mut vt, mut vb, mut terms, mut cur, mut next) = carve(buffer, w);
+    let cells = cell_rows(&rows, h);
+    for a in cur.iter_mut() {
+        a.fill(0.0);
+    }
+    transpose(&x[cells.start * w..(cells.start + 1) * w], &mut xb);
+    transpose(&v[cells.start * w..(cells.start + 1) * w], &mut vb);
+    let at = |row: usize| (row - rows.start) * w..(row - rows.start + 1) * w;
+    for c in cells {
+        // The row below becomes the top one.
+        std::mem::swap(&mut xt, &mut xb);
+        std::mem::swap(&mut vt, &mut vb);
+        transpose(&x[(c + 1) * w..(c + 2) * w], &mut xb);
+        transpose(&v[(c + 1) * w..(c + 2) * w], &mut vb);
+        blocks(
+            w - 1,
+            [row(&xt), row(&xb)],
+            [row(&vt), row(&vb)],
+            area_terms,
+            &mut terms[..12],
+        );
+        // Cell row c completes vertex row c's sums and begins row c + 1's.
+        for k in 0..6 {
+            let slot = if k < 3 { F0 + k } else { R0 + k - 3 };
+            let (t0, t1) = (&*terms[slot], &*terms[slot + F1 - F0]);
+            below(cur[k], t0, t1, t0);
+            next[k].fill(0.0);
+            above(next[k], t1, t0, t1);
+        }
+        if c >= rows.start {
+            untranspose(&cur[..3], &mut sums[at(c)]);
+            untranspose(&cur[3..], &mut rates[at(c)]);
+        }
+        std::mem::swap(&mut cur, &mut next);
+    }
+    if rows.end == h {
+        untranspose(&cur[..3], &mut sums[at(h - 1)]);
+        untranspose(&cur[3..], &mut rates[at(h - 1)]);
+    }
+}
+
+/// Each face's gradients at its corners (`patches` every vertex's `w`), added to the band's
+/// vertices' forces (`out`: the band's rows) in ascending face order.
+#[inline(always)]
+fn gradients(w: usize, h: usize, x: &[Vec3], patches: &[Vec3], band: Band<'_>, out: &mut [Vec3]) {
+    let Band { rows, buffer } = band;
+    let (mut xt, mut xb, mut wt, mut wb, mut terms, mut cur, mut next) = carve(buffer, w);
+    let cells = cell_rows(&rows, h);
+    let at = |row: usize| (row - rows.start) * w..(row - rows.start + 1) * w;
+    if rows.start == 0 {
+        transpose(&out[at(0)], &mut cur[..3]);
+    }
+    transpose(&x[cells.start * w..(cells.start + 1) * w], &mut xb);
+    transpose(&patches[cells.start * w..(cells.start + 1) * w], &mut wb);
+    for c in cells {
         std::mem::swap(&mut xt, &mut xb);
         std::mem::swap(&mut wt, &mut wb);
-        transpose(&x[(j + 1) * w..(j + 2) * w], &mut xb);
-        transpose(&patches[(j + 1) * w..(j + 2) * w], &mut wb);
+        transpose(&x[(c + 1) * w..(c + 2) * w], &mut xb);
+        transpose(&patches[(c + 1) * w..(c + 2) * w], &mut wb);
         blocks(
-            cw,
+            w - 1,
             [row(&xt), row(&xb)],
             [row(&wt), row(&wb)],
             gradient_terms,
             &mut terms[..],
         );
-        transpose(&out[(j + 1) * w..(j + 2) * w], &mut next[..3]);
-        for q in 0..3 {
-            below(cur[q], terms[G0C + q], terms[G1A + q], terms[G0A + q]);
-            above(next[q], terms[G1C + q], terms[G0B + q], terms[G1B + q]);
+        // Cell row c completes vertex row c's forces and begins row c + 1's.
+        if c >= rows.start {
+            for q in 0..3 {
+                below(cur[q], terms[G0C + q], terms[G1A + q], terms[G0A + q]);
+            }
+            untranspose(&cur[..3], &mut out[at(c)]);
         }
-        untranspose(&cur[..3], &mut out[j * w..(j + 1) * w]);
+        if c + 1 < rows.end {
+            transpose(&out[at(c + 1)], &mut next[..3]);
+            for q in 0..3 {
+                above(next[q], terms[G1C + q], terms[G0B + q], terms[G1B + q]);
+            }
+        }
         std::mem::swap(&mut cur, &mut next);
     }
-    untranspose(&cur[..3], &mut out[ch * w..]);
+    if rows.end == h {
+        untranspose(&cur[..3], &mut out[at(h - 1)]);
+    }
 }
-
-/// A cell's four corners' vectors: a, b, c, d.
-type Corners = [[f64; 3]; 4];
 
 /// A row of three component arrays.
 type Row<'a> = [&'a mut [f64]; 3];
@@ -267,6 +410,9 @@ fn carve(
 fn row<'a>(r: &'a [&mut [f64]; 3]) -> [&'a [f64]; 3] {
     [&r[0][..], &r[1][..], &r[2][..]]
 }
+
+/// A cell's four corners' vectors: a, b, c, d.
+type Corners = [[f64; 3]; 4];
 
 /// A cell's two faces' area vectors and rates (`[f0, r0, f1, r1]`) from its corners'
 /// positions and velocities (`a, b, c, d`), as `inertia::face_and_rate` computes them.
@@ -381,7 +527,8 @@ mod tests {
     /// The grid's gathered passes give the scatter's bits (forces added to what was there,
     /// projected-area ratios, unit normals) on grids of every shape the rows allow (one cell,
     /// one row or column of cells, rows shorter and longer than a block), crumpled, with
-    /// patches stretched past the carried water's bound.
+    /// patches stretched past the carried water's bound; in one band and in bands of one, two,
+    /// three and seven rows, on one thread and on the pool.
     #[test]
     fn the_grid_passes_keep_the_scatters_bits() {
         let mut m = Model::underwater();
@@ -396,9 +543,9 @@ mod tests {
             (61, 41, 7),
         ] {
             let (t, mut x, v) = crate::testing::crumpled_grid(w, h, seed);
-            assert_eq!(t.grid_faces, Some((w as usize, h as usize)));
+            let size = (w as usize, h as usize);
+            assert_eq!(t.grid_faces, Some(size));
             let n = x.len();
-            assert!(!crate::parallel::worth_it(n));
             // Some patches stretched well past the bound.
             for k in (0..n).step_by(5) {
                 x[k] *= 1.6;
@@ -406,35 +553,62 @@ mod tests {
             let prior: Vec<Vec3> = (0..n)
                 .map(|i| Vec3::new(i as f64, -0.5, 0.25 * i as f64))
                 .collect();
-            let run = |grid: bool| {
+            let run = |how: Option<(usize, bool)>| {
                 let mut s = TurningScratch::default();
                 let (mut p, mut nr, mut out) = (vec![0.0; n], vec![Vec3::zeros(); n], prior.clone());
                 // Twice: buffers sized by the first call are reused by the second.
                 for _ in 0..2 {
                     out.clone_from(&prior);
-                    if grid {
-                        turning_forces(&m, &t, &x, &v, &mut s, &mut p, &mut nr, &mut out, None);
-                    } else {
-                        turning_serial(8.0, &t, &x, &v, &mut s, &mut p, &mut nr, &mut out, None);
+                    match how {
+                        None => turning_serial(8.0, &t, &x, &v, &mut s, &mut p, &mut nr, &mut out, None),
+                        Some(bands) => {
+                            let mut b = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+                            let buffers = GridBuffers {
+                                bands: &mut b.0,
+                                sums: &mut b.1,
+                                rates: &mut b.2,
+                                patches: &mut b.3,
+                            };
+                            turning_grid(8.0, &t, size, &x, &v, buffers, bands, &mut p, &mut nr, &mut out);
+                        }
                     }
                 }
                 (out, p, nr)
             };
-            let (want, got) = (run(false), run(true));
+            let want = run(None);
             assert!(
                 want.1.iter().any(|&p| p * p > CARRIED_FULL),
                 "{w}x{h}: no patch past the bound"
             );
+            assert!(want.0.iter().zip(&prior).all(|(a, b)| a != b));
             let bits = |a: &[Vec3]| -> Vec<u64> {
                 a.iter()
                     .flat_map(|p| p.iter().map(|c| c.to_bits()))
                     .collect::<Vec<_>>()
             };
-            assert_eq!(bits(&got.0), bits(&want.0), "forces, {w}x{h}");
-            assert_eq!(bits(&got.2), bits(&want.2), "normals, {w}x{h}");
             let ratios = |a: &[f64]| a.iter().map(|p| p.to_bits()).collect::<Vec<_>>();
-            assert_eq!(ratios(&got.1), ratios(&want.1), "ratios, {w}x{h}");
-            assert!(got.0.iter().zip(&prior).all(|(a, b)| a != b));
+            for bands in [
+                (h as usize, false),
+                (1, false),
+                (2, true),
+                (3, true),
+                (7, false),
+                (1, true),
+            ] {
+                let got = run(Some(bands));
+                assert_eq!(bits(&got.0), bits(&want.0), "forces, {w}x{h}, bands {bands:?}");
+                assert_eq!(bits(&got.2), bits(&want.2), "normals, {w}x{h}, bands {bands:?}");
+                assert_eq!(
+                    ratios(&got.1),
+                    ratios(&want.1),
+                    "ratios, {w}x{h}, bands {bands:?}"
+                );
+            }
+            // And the step's own choice.
+            let mut s = TurningScratch::default();
+            let (mut p, mut nr, mut out) = (vec![0.0; n], vec![Vec3::zeros(); n], prior.clone());
+            turning_forces(&m, &t, &x, &v, &mut s, &mut p, &mut nr, &mut out, None);
+            assert_eq!(bits(&out), bits(&want.0), "forces, {w}x{h}, the step's choice");
         }
     }
 
