@@ -465,55 +465,76 @@ fn blocks<const K: usize>(
     let whole = len / B * B;
     let mut i0 = 0;
     while i0 < whole {
-        // [side][corner][component][lane]
-        let mut p = [[[[0.0; B]; 3]; 4]; 2];
-        for (side, rows) in [&first, &second].into_iter().enumerate() {
-            for q in 0..3 {
-                p[side][0][q].copy_from_slice(&rows[0][q][i0..i0 + B]);
-                p[side][1][q].copy_from_slice(&rows[0][q][i0 + 1..i0 + 1 + B]);
-                p[side][2][q].copy_from_slice(&rows[1][q][i0..i0 + B]);
-                p[side][3][q].copy_from_slice(&rows[1][q][i0 + 1..i0 + 1 + B]);
-            }
-        }
-        let mut res = [[[0.0; B]; 3]; K];
-        for l in 0..B {
-            let mut u = [[[0.0; 3]; 4]; 2];
-            for side in 0..2 {
-                for corner in 0..4 {
+        block(i0, &first, &second, kernel, out);
+        i0 += B;
+    }
+    if whole < len {
+        if len >= B {
+            // The last block again, ending at the row's end: a cell's terms depend on its
+            // corners only, so the cells done twice get the same values twice.
+            block(len - B, &first, &second, kernel, out);
+        } else {
+            for i in 0..len {
+                let at = |r: &[&[f64]; 3], i: usize| [r[0][i], r[1][i], r[2][i]];
+                let lane = |rows: &[[&[f64]; 3]; 2]| {
+                    [
+                        at(&rows[0], i),
+                        at(&rows[0], i + 1),
+                        at(&rows[1], i),
+                        at(&rows[1], i + 1),
+                    ]
+                };
+                let r = kernel(lane(&first), lane(&second));
+                for k in 0..K {
                     for q in 0..3 {
-                        u[side][corner][q] = p[side][corner][q][l];
+                        out[3 * k + q][i] = r[k][q];
                     }
                 }
             }
-            let r = kernel(u[0], u[1]);
-            for k in 0..K {
+        }
+    }
+}
+
+/// One block of [`blocks`]: the cells `i0 .. i0 + BLOCK`.
+#[inline(always)]
+fn block<const K: usize>(
+    i0: usize,
+    first: &[[&[f64]; 3]; 2],
+    second: &[[&[f64]; 3]; 2],
+    kernel: fn(Corners, Corners) -> [[f64; 3]; K],
+    out: &mut [&mut [f64]],
+) {
+    const B: usize = BLOCK;
+    // [side][corner][component][lane]
+    let mut p = [[[[0.0; B]; 3]; 4]; 2];
+    for (side, rows) in [first, second].into_iter().enumerate() {
+        for q in 0..3 {
+            p[side][0][q].copy_from_slice(&rows[0][q][i0..i0 + B]);
+            p[side][1][q].copy_from_slice(&rows[0][q][i0 + 1..i0 + 1 + B]);
+            p[side][2][q].copy_from_slice(&rows[1][q][i0..i0 + B]);
+            p[side][3][q].copy_from_slice(&rows[1][q][i0 + 1..i0 + 1 + B]);
+        }
+    }
+    let mut res = [[[0.0; B]; 3]; K];
+    for l in 0..B {
+        let mut u = [[[0.0; 3]; 4]; 2];
+        for side in 0..2 {
+            for corner in 0..4 {
                 for q in 0..3 {
-                    res[k][q][l] = r[k][q];
+                    u[side][corner][q] = p[side][corner][q][l];
                 }
             }
         }
+        let r = kernel(u[0], u[1]);
         for k in 0..K {
             for q in 0..3 {
-                out[3 * k + q][i0..i0 + B].copy_from_slice(&res[k][q]);
+                res[k][q][l] = r[k][q];
             }
         }
-        i0 += B;
     }
-    for i in whole..len {
-        let lane = |rows: &[[&[f64]; 3]; 2]| -> [[f64; 3]; 4] {
-            let at = |r: &[&[f64]; 3], i: usize| [r[0][i], r[1][i], r[2][i]];
-            [
-                at(&rows[0], i),
-                at(&rows[0], i + 1),
-                at(&rows[1], i),
-                at(&rows[1], i + 1),
-            ]
-        };
-        let r = kernel(lane(&first), lane(&second));
-        for k in 0..K {
-            for q in 0..3 {
-                out[3 * k + q][i] = r[k][q];
-            }
+    for k in 0..K {
+        for q in 0..3 {
+            out[3 * k + q][i0..i0 + B].copy_from_slice(&res[k][q]);
         }
     }
 }
