@@ -37,7 +37,7 @@ pub struct Topology {
     /// such a grid (every cell `(i, j)` split into `[a, c, b]` and `[b, c, d]`, `a = (i, j)`,
     /// `b = (i + 1, j)`, `c = (i, j + 1)`, `d = (i + 1, j + 1)`, cell after cell, row after
     /// row): then a pass may find a vertex's faces from its place in the grid.
-    pub grid_faces: Option<(usize, usize)>,
+    pub(crate) grid_faces: Option<(usize, usize)>,
     /// The cloth's spacing, m: a grid's own; for a mesh the side of a square of two of its
     /// triangles' mean rest area (a grid's spacing for a triangulated grid, jittered or not;
     /// 0 without triangles). What `Model::bend_reference_spacing` compares with.
@@ -55,8 +55,8 @@ pub struct Topology {
     pub tiled: Option<TileLayout>,
 }
 
-/// `grid` as `(columns, rows)` when the cloth's `n` vertices are its and `triangles` are the ones [`crate::topology::GridSpec`] makes
-/// of it ([`Topology::grid_faces`]).
+/// `grid` as `(columns, rows)` when the cloth's `n` vertices are its and `triangles` are the
+/// ones [`crate::topology::GridSpec`] makes of it ([`Topology::grid_faces`]).
 fn grid_faces((w, h): (u32, u32), n: usize, triangles: &[[u32; 3]]) -> Option<(usize, usize)> {
     let (w, h) = (w as usize, h as usize);
     if w < 2 || h < 2 || w.checked_mul(h) != Some(n) || triangles.len() != 2 * (w - 1) * (h - 1) {
