@@ -81,36 +81,17 @@ fn cases() -> Vec<(String, Box<dyn Fn() -> Cloth + Sync>)> {
     v
 }
 
-fn large_underwater() -> Cloth {
-    let (w, h) = (131u32, 129u32);
-    let t = GridSpec {
-        width: w,
-        height: h,
-        spacing: 0.01,
-        total_mass: 0.24 / 2501.0 * f64::from(w * h),
-    }
-    .build()
-    .unwrap();
-    let mut model = Model::underwater();
-    model.current = Vec3::new(0.05, 0.0, 0.2);
-    let mut c = Cloth::new(
-        t,
-        ClothConfig {
-            model,
-            integrator: Integrator::SymplecticEuler,
-            ..ClothConfig::default()
-        },
-    )
-    .unwrap();
-    let top: Vec<u32> = (0..w).map(|i| grid_index(w, i, 0)).collect();
-    c.set_pinned(&top).unwrap();
-    for _ in 0..30 {
-        c.step(5e-4).unwrap();
-    }
-    c
+fn large() -> Cloth {
+    large_with(Variant::Fractional.model(0.01))
 }
 
-fn large() -> Cloth {
+fn large_underwater() -> Cloth {
+    large_with(Model::underwater())
+}
+
+/// A 131 x 129 cloth of `model` hanging from its top row in a current, 30 steps of
+/// symplectic Euler.
+fn large_with(mut model: Model) -> Cloth {
     let (w, h) = (131u32, 129u32);
     let t = GridSpec {
         width: w,
@@ -120,7 +101,6 @@ fn large() -> Cloth {
     }
     .build()
     .unwrap();
-    let mut model = Variant::Fractional.model(0.01);
     model.current = Vec3::new(0.05, 0.0, 0.2);
     let mut c = Cloth::new(
         t,

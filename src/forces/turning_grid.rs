@@ -294,27 +294,15 @@ fn cell_rows(rows: &std::ops::Range<usize>, h: usize) -> std::ops::Range<usize> 
 fn areas(w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: [&mut [Vec3]; 2]) {
     let [sums, rates] = into;
     let Band { rows, buffer } = band;
-    let (mut xt, mut xb, mut vt, mut vb, mut terms, mut cur, mut next) = carve(buffer, w);
+    let (mut vectors, mut terms, mut cur, mut next) = carve(buffer, w);
     let cells = cell_rows(&rows, h);
     for a in cur.iter_mut() {
         a.fill(0.0);
     }
-    transpose(&x[cells.start * w..(cells.start + 1) * w], &mut xb);
-    transpose(&v[cells.start * w..(cells.start + 1) * w], &mut vb);
+    vectors.start(cells.start, [x, v], w);
     let at = |row: usize| (row - rows.start) * w..(row - rows.start + 1) * w;
     for c in cells {
-        // The row below becomes the top one.
-        std::mem::swap(&mut xt, &mut xb);
-        std::mem::swap(&mut vt, &mut vb);
-        transpose(&x[(c + 1) * w..(c + 2) * w], &mut xb);
-        transpose(&v[(c + 1) * w..(c + 2) * w], &mut vb);
-        blocks(
-            w - 1,
-            [row(&xt), row(&xb)],
-            [row(&vt), row(&vb)],
-            area_terms,
-            &mut terms[..12],
-        );
+        vectors.cell_row(c, [x, v], w, area_terms, &mut terms[..12]);
         // Cell row c completes vertex row c's sums and begins row c + 1's.
         for k in 0..6 {
             let slot = if k < 3 { F0 + k } else { R0 + k - 3 };
@@ -340,26 +328,15 @@ fn areas(w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: [&mut
 #[inline(always)]
 fn gradients(w: usize, h: usize, x: &[Vec3], patches: &[Vec3], band: Band<'_>, out: &mut [Vec3]) {
     let Band { rows, buffer } = band;
-    let (mut xt, mut xb, mut wt, mut wb, mut terms, mut cur, mut next) = carve(buffer, w);
+    let (mut vectors, mut terms, mut cur, mut next) = carve(buffer, w);
     let cells = cell_rows(&rows, h);
     let at = |row: usize| (row - rows.start) * w..(row - rows.start + 1) * w;
     if rows.start == 0 {
         transpose(&out[at(0)], &mut cur[..3]);
     }
-    transpose(&x[cells.start * w..(cells.start + 1) * w], &mut xb);
-    transpose(&patches[cells.start * w..(cells.start + 1) * w], &mut wb);
+    vectors.start(cells.start, [x, patches], w);
     for c in cells {
-        std::mem::swap(&mut xt, &mut xb);
-        std::mem::swap(&mut wt, &mut wb);
-        transpose(&x[(c + 1) * w..(c + 2) * w], &mut xb);
-        transpose(&patches[(c + 1) * w..(c + 2) * w], &mut wb);
-        blocks(
-            w - 1,
-            [row(&xt), row(&xb)],
-            [row(&wt), row(&wb)],
-            gradient_terms,
-            &mut terms[..],
-        );
+        vectors.cell_row(c, [x, patches], w, gradient_terms, &mut terms[..]);
         // Cell row c completes vertex row c's forces and begins row c + 1's.
         if c >= rows.start {
             for q in 0..3 {
@@ -383,17 +360,49 @@ fn gradients(w: usize, h: usize, x: &[Vec3], patches: &[Vec3], band: Band<'_>, o
 /// A row of three component arrays.
 type Row<'a> = [&'a mut [f64]; 3];
 
-/// `rows` carved for a grid `w` wide: four rows of vectors, a row of cells' terms and two
-/// rows of six sums.
+/// Two vertex rows (the top and the one below it) of two per-vertex vectors (positions and
+/// velocities, or positions and `w`), in component arrays.
+struct VertexRows<'a> {
+    top: [Row<'a>; 2],
+    bottom: [Row<'a>; 2],
+}
+
+impl VertexRows<'_> {
+    /// Reads vertex row `r` of `from` into the bottom rows.
+    #[inline(always)]
+    fn start(&mut self, r: usize, from: [&[Vec3]; 2], w: usize) {
+        for (to, from) in self.bottom.iter_mut().zip(from) {
+            transpose(&from[r * w..(r + 1) * w], to);
+        }
+    }
+
+    /// Cell row `c`'s terms by `kernel` into `terms`: the bottom rows move up and vertex row
+    /// `c + 1` of `from` is read into the bottom ones.
+    #[inline(always)]
+    fn cell_row<const K: usize>(
+        &mut self,
+        c: usize,
+        from: [&[Vec3]; 2],
+        w: usize,
+        kernel: fn(Corners, Corners) -> [[f64; 3]; K],
+        terms: &mut [&mut [f64]],
+    ) {
+        std::mem::swap(&mut self.top, &mut self.bottom);
+        self.start(c + 1, from, w);
+        let [t0, t1] = &self.top;
+        let [b0, b1] = &self.bottom;
+        blocks(w - 1, [row(t0), row(b0)], [row(t1), row(b1)], kernel, terms);
+    }
+}
+
+/// `rows` carved for a grid `w` wide: two vertex rows of two vectors, a row of cells' terms
+/// and two rows of six sums.
 #[allow(clippy::type_complexity)]
 fn carve(
     rows: &mut [f64],
     w: usize,
 ) -> (
-    Row<'_>,
-    Row<'_>,
-    Row<'_>,
-    Row<'_>,
+    VertexRows<'_>,
     [&mut [f64]; SLOTS],
     [&mut [f64]; 6],
     [&mut [f64]; 6],
@@ -403,7 +412,11 @@ fn carve(
     let (terms, sums) = rest.split_at_mut(SLOTS * cw);
     let [a, b, c, d] = cut::<4>(vectors, 3 * w).map(|r| cut::<3>(r, w));
     let [e, f] = cut::<2>(sums, 6 * w).map(|r| cut::<6>(r, w));
-    (a, b, c, d, cut(terms, cw), e, f)
+    let vectors = VertexRows {
+        top: [a, c],
+        bottom: [b, d],
+    };
+    (vectors, cut(terms, cw), e, f)
 }
 
 /// The first `w` of each component of a row.
@@ -638,26 +651,23 @@ mod tests {
     fn only_a_grids_own_triangles_are_taken_for_a_grid() {
         let (t, _, _) = crate::testing::crumpled_grid(4, 3, 1);
         assert_eq!(t.grid_faces, Some((4, 3)));
-        let mut triangles = t.triangles.clone();
-        triangles.swap(2, 3);
-        let moved = Topology::new(
-            t.rest_positions.clone(),
-            t.masses.clone(),
-            t.springs.clone(),
-            triangles,
-            t.grid,
-        );
-        assert_eq!(moved.grid_faces, None);
+        let with = |triangles: Vec<[u32; 3]>| {
+            Topology::new(
+                t.rest_positions.clone(),
+                t.masses.clone(),
+                t.springs.clone(),
+                triangles,
+                t.grid,
+            )
+        };
+        assert_eq!(with(t.triangles.clone()).grid_faces, Some((4, 3)));
+        // Two faces in another order; a face's corners turned the other way.
+        let mut moved = t.triangles.clone();
+        moved.swap(2, 3);
+        assert_eq!(with(moved).grid_faces, None);
         let mut flipped = t.triangles.clone();
         flipped[5] = [flipped[5][0], flipped[5][2], flipped[5][1]];
-        let flipped = Topology::new(
-            t.rest_positions.clone(),
-            t.masses.clone(),
-            t.springs.clone(),
-            flipped,
-            t.grid,
-        );
-        assert_eq!(flipped.grid_faces, None);
+        assert_eq!(with(flipped).grid_faces, None);
         let jittered = crate::testing::jittered_mesh(5, 4);
         assert_eq!(jittered.grid_faces, None);
     }
