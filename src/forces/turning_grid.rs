@@ -20,12 +20,12 @@
 //! preset on 1, 2 and 8 threads). This replaces, for grids, the chunks and wavefront that
 //! other meshes take (`inertia.rs`).
 //!
-//! Measured (AMD EPYC, `docs/benchmarks.md`, stop 49), ns a particle-step of the underwater
-//! preset, against the scatter: 61 x 41 59-63 against 64-66; 201 x 201 on one thread 61-62
-//! against 69, on two 33 against 41; 1001 x 1001 on two threads 48-49 against 53 (1.78-1.80
-//! times one thread's 85-87). The scatter's chain of stores and reloads (a vertex is a corner
-//! of six faces, three of them consecutive) was the cost on one thread; the chunks' borders
-//! and wavefront on two.
+//! Measured (AMD EPYC, `docs/benchmarks.md`, stop 49, alternated with the scatter's build), ns
+//! a particle-step of the underwater preset: 61 x 41 58-60 against 64-66; 201 x 201 on one
+//! thread 63-64 against 71-74, on two 33-35 against 41; 1001 x 1001 on two threads 48-49
+//! against 54-55 (1.77-1.84 times one thread's 87-88). The scatter's chain of stores and
+//! reloads (a vertex is a corner of six faces, three of them consecutive) was the cost on one
+//! thread; the chunks' borders and wavefront on two.
 
 use super::inertia::{patch_range, PatchOut};
 use crate::math::Vec3;
@@ -195,15 +195,13 @@ pub(super) fn turning_grid(
                 rows: first..first + len,
                 buffer: &mut rows[0],
             };
-            let outputs = BandOut {
-                sums,
-                rates,
-                patches,
-                normals,
-                out,
+            let patch_out = PatchOut {
+                o: out,
                 projected,
+                normals,
+                w: patches,
             };
-            areas_and_patches_widest(ma, t, w, h, x, v, mine, outputs);
+            areas_and_patches_widest(ma, t, w, h, x, v, mine, [sums, rates], patch_out);
         });
     }
     let (patches, d) = (&patches[..], parallel::Disjoint::new(&mut out[..n]));
@@ -229,19 +227,10 @@ struct Band<'a> {
     buffer: &'a mut Vec<f64>,
 }
 
-/// What the first pass writes for a band's vertices.
-struct BandOut<'a> {
-    sums: &'a mut [Vec3],
-    rates: &'a mut [Vec3],
-    patches: &'a mut [Vec3],
-    normals: &'a mut [Vec3],
-    out: &'a mut [Vec3],
-    projected: &'a mut [f64],
-}
+crate::simd_dispatch! { fn areas_and_patches_widest(ma: f64, t: &Topology, w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: [&mut [Vec3]; 2], patch_out: PatchOut<'_>) => areas_and_patches }
 
-crate::simd_dispatch! { fn areas_and_patches_widest(ma: f64, t: &Topology, w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: BandOut<'_>) => areas_and_patches }
-
-/// A band's sums ([`areas`]) and then its patch terms ([`patch_range`]).
+/// A band's sums and rates ([`areas`], into `into`) and then its patch terms ([`patch_range`],
+/// into `patch_out`: the band's rows).
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 #[inline(always)]
 fn areas_and_patches(
@@ -252,17 +241,11 @@ fn areas_and_patches(
     x: &[Vec3],
     v: &[Vec3],
     band: Band<'_>,
-    into: BandOut<'_>,
+    into: [&mut [Vec3]; 2],
+    patch_out: PatchOut<'_>,
 ) {
     let r = band.rows.start * w..band.rows.end * w;
-    let BandOut {
-        sums,
-        rates,
-        patches,
-        normals,
-        out,
-        projected,
-    } = into;
+    let [sums, rates] = into;
     areas(w, h, x, v, band, [&mut *sums, &mut *rates]);
     patch_range(
         ma,
@@ -271,12 +254,7 @@ fn areas_and_patches(
         sums,
         rates,
         &v[r],
-        PatchOut {
-            o: out,
-            projected,
-            normals,
-            w: patches,
-        },
+        patch_out,
     );
 }
 
