@@ -964,6 +964,82 @@ mod tests {
         );
     }
 
+    /// When the watch measures again by bounds, each pair's bound is at most its distance where
+    /// it measured, and the pairs it checks are exactly those an exact measure of every pair
+    /// there puts within the skin. The sheet waves and is squeezed, and now and then its
+    /// vertices jump each its own way. Fails with a bound that leaves out one pair of edge
+    /// ends or a triangle's first corner (each checked), and when every pair is measured
+    /// exactly (no bound below a distance: nothing decided by the bound).
+    #[test]
+    fn the_guard_measures_again_by_bounds_what_it_would_measure_exactly() {
+        let (_, rest, triangles) = folded_sheet(12, 9);
+        let (thickness, tolerance) = (0.004, 1e-6);
+        let mut sc = SelfCollision::new(&triangles);
+        sc.prepare(&rest, &triangles, thickness).expect("prepared");
+        let (edge_pairs, vertex_pairs) = (sc.guard.pairs().0.to_vec(), sc.guard.pairs().1.to_vec());
+        let skin = sc.guard.skin();
+        let mut r = crate::testing::numbers(5);
+        let mut x0 = rest.clone();
+        let (mut measures, mut by_bound, mut within) = (0usize, 0usize, 0usize);
+        for step in 0..400 {
+            let t = f64::from(step) * 0.01;
+            // Now and then the vertices jump each its own way (a corner towards a vertex).
+            let noise = if step % 25 == 24 { 0.0008 } else { 0.00005 };
+            let x1: Vec<Vec3> = x0
+                .iter()
+                .zip(&rest)
+                .map(|(p, q)| {
+                    let wave = 0.02 * (40.0 * q.x + 3.0 * t).sin() * (1.0 - (-t).exp());
+                    let squeeze = 1.0 - 0.3 * (1.0 - (-0.5 * t).exp());
+                    let target = Vec3::new(q.x, q.y * squeeze, wave);
+                    p + 0.2 * (target - p) + noise * Vec3::new(r(), r(), r())
+                })
+                .collect();
+            sc.watch_guard(&x0, &x1, &triangles, tolerance);
+            let (close_e, close_v) = (sc.guarded().0.to_vec(), sc.guarded().1.to_vec());
+            if let Some((base, apart)) = sc.guard.measure() {
+                if base != x0.as_slice() {
+                    x0 = x1;
+                    continue;
+                }
+                measures += 1;
+                let exact_e = edge_pairs
+                    .iter()
+                    .map(|&(e, f)| edge_edge(base, &sc.edges[e as usize], &sc.edges[f as usize]).0);
+                let exact_v = vertex_pairs
+                    .iter()
+                    .map(|&(p, t)| vertex_triangle(base, p, &triangles[t as usize]).0);
+                let pairs = edge_pairs
+                    .iter()
+                    .map(|&q| (q, true))
+                    .chain(vertex_pairs.iter().map(|&q| (q, false)));
+                for (((q, is_edge), exact), &bound) in pairs.zip(exact_e.chain(exact_v)).zip(apart) {
+                    assert!(
+                        bound <= exact,
+                        "step {step}: pair {q:?} bound {bound} past its distance {exact}"
+                    );
+                    by_bound += usize::from(bound < exact);
+                    within += usize::from(exact < skin);
+                    let checked = if is_edge {
+                        close_e.contains(&q)
+                    } else {
+                        close_v.contains(&q)
+                    };
+                    assert_eq!(
+                        checked,
+                        exact < skin,
+                        "step {step}: pair {q:?} at {exact} (skin {skin})"
+                    );
+                }
+            }
+            x0 = x1;
+        }
+        assert!(
+            measures > 5 && by_bound > 0 && within > 0,
+            "measures {measures}, decided by bound {by_bound}, within the skin {within}"
+        );
+    }
+
     /// On a sheet large enough for the pool (its walk split into tasks and the near pairs into
     /// chunks), the look finds the same pairs on two threads as on one.
     #[test]
