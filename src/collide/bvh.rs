@@ -44,24 +44,41 @@ impl Aabb {
     }
 
     /// This box grown by every difference `a[i] - base[i]`. Plain comparisons (a NaN is
-    /// passed over, as by [`Aabb::grow`]), which the compiler keeps in registers: about twice
-    /// as fast as growing the box point by point (the self-collision's watches run it every
-    /// step over the cloth).
+    /// passed over, as by [`Aabb::grow`]) over the coordinates as one array, eight points at a
+    /// time in 24 lanes (lane `k` holds coordinate `k % 3`) at the CPU's widest vectors, then
+    /// the lanes folded: the self-collision's watches run it every step over the cloth.
     pub fn grown_by_differences(self, a: &[Vec3], base: &[Vec3]) -> Aabb {
-        let (mut lo, mut hi) = (
-            [self.min.x, self.min.y, self.min.z],
-            [self.max.x, self.max.y, self.max.z],
+        let n = a.len().min(base.len());
+        let (a, base) = (&a[..n], &base[..n]);
+        let whole = n / 8 * 8;
+        let mut lo = [0.0; LANES];
+        let mut hi = [0.0; LANES];
+        for k in 0..LANES {
+            (lo[k], hi[k]) = (self.min[k % 3], self.max[k % 3]);
+        }
+        differences_widest(
+            bytemuck::cast_slice(&a[..whole]),
+            bytemuck::cast_slice(&base[..whole]),
+            &mut lo,
+            &mut hi,
         );
-        for (p, o) in a.iter().zip(base) {
-            for k in 0..3 {
-                let d = p[k] - o[k];
-                lo[k] = if d < lo[k] { d } else { lo[k] };
-                hi[k] = if d > hi[k] { d } else { hi[k] };
+        let mut min = [lo[0], lo[1], lo[2]];
+        let mut max = [hi[0], hi[1], hi[2]];
+        for k in 3..LANES {
+            let c = k % 3;
+            min[c] = if lo[k] < min[c] { lo[k] } else { min[c] };
+            max[c] = if hi[k] > max[c] { hi[k] } else { max[c] };
+        }
+        for (p, o) in a[whole..].iter().zip(&base[whole..]) {
+            for c in 0..3 {
+                let d = p[c] - o[c];
+                min[c] = if d < min[c] { d } else { min[c] };
+                max[c] = if d > max[c] { d } else { max[c] };
             }
         }
         Aabb {
-            min: Vec3::from(lo),
-            max: Vec3::from(hi),
+            min: Vec3::from(min),
+            max: Vec3::from(max),
         }
     }
 
@@ -109,6 +126,24 @@ impl Aabb {
 
     fn centre(&self) -> Vec3 {
         0.5 * (self.min + self.max)
+    }
+}
+
+/// Lanes of [`Aabb::grown_by_differences`]: eight points' coordinates.
+const LANES: usize = 24;
+
+crate::simd_dispatch! { fn differences_widest(a: &[f64], base: &[f64], lo: &mut [f64; LANES], hi: &mut [f64; LANES]) => differences }
+
+/// `lo` and `hi` grown lane by lane by the differences `a - base`, taken `LANES` at a time
+/// (both as long, a multiple of `LANES`).
+#[inline(always)]
+fn differences(a: &[f64], base: &[f64], lo: &mut [f64; LANES], hi: &mut [f64; LANES]) {
+    for (p, o) in a.chunks_exact(LANES).zip(base.chunks_exact(LANES)) {
+        for k in 0..LANES {
+            let d = p[k] - o[k];
+            lo[k] = if d < lo[k] { d } else { lo[k] };
+            hi[k] = if d > hi[k] { d } else { hi[k] };
+        }
     }
 }
 
@@ -272,7 +307,34 @@ impl Bvh {
     /// [`Bvh::self_tasks`]) whose boxes overlap, `i` and `j` in no set order. The tree walked
     /// against itself visits each pair of overlapping nodes once, where a query per item walks
     /// from the root for each and meets each pair twice.
-    pub fn self_overlapping(&self, task: (u32, u32), mut f: impl FnMut(u32, u32)) {
+    pub fn self_overlapping(&self, task: (u32, u32), f: impl FnMut(u32, u32)) {
+        self.walk_self(task, |k, l| self.boxes[k].overlaps(&self.boxes[l]), f);
+    }
+
+    /// The items' `boxes` (item k's is `boxes[k]`) in the tree's order, for
+    /// [`Bvh::self_overlapping_apart`].
+    pub fn in_order(&self, boxes: &[Aabb]) -> Vec<Aabb> {
+        self.order.iter().map(|&i| boxes[i as usize]).collect()
+    }
+
+    /// As [`Bvh::self_overlapping`], but only the pairs whose `other` boxes (one an item, in
+    /// the tree's order: [`Bvh::in_order`]) are apart: the self-collision's walk, which leaves
+    /// out the triangles near each other at rest. Both tests are made for every pair of a
+    /// leaf pair, and the one branch (mostly not taken: neighbours) is easy to predict.
+    pub fn self_overlapping_apart(&self, task: (u32, u32), other: &[Aabb], f: impl FnMut(u32, u32)) {
+        debug_assert_eq!(other.len(), self.boxes.len());
+        self.walk_self(
+            task,
+            |k, l| self.boxes[k].overlaps(&self.boxes[l]) & !other[k].overlaps(&other[l]),
+            f,
+        );
+    }
+
+    /// The tree against itself from the node pair `task`: `f(i, j)` for the items of the
+    /// slots `k`, `l` (places in `order`) of every leaf pair whose bounds overlap where
+    /// `pair(k, l)`.
+    #[inline(always)]
+    fn walk_self(&self, task: (u32, u32), pair: impl Fn(usize, usize) -> bool, mut f: impl FnMut(u32, u32)) {
         let mut stack = vec![task];
         while let Some((a, b)) = stack.pop() {
             let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
@@ -282,26 +344,24 @@ impl Bvh {
                 self.expand(a, b, &mut stack);
                 continue;
             }
-            // A leaf's items and their boxes, side by side.
             let range = |n: &Node| n.first as usize..(n.first + n.count) as usize;
-            let (ia, ib) = (&self.order[range(na)], &self.order[range(nb)]);
-            let (ba, bb) = (&self.boxes[range(na)], &self.boxes[range(nb)]);
+            let (ra, rb) = (range(na), range(nb));
             if a == b {
-                for (k, (&i, bi)) in ia.iter().zip(ba).enumerate() {
-                    for (&j, bj) in ia[k + 1..].iter().zip(&ba[k + 1..]) {
-                        if bi.overlaps(bj) {
-                            f(i, j);
+                for k in ra.clone() {
+                    for l in k + 1..ra.end {
+                        if pair(k, l) {
+                            f(self.order[k], self.order[l]);
                         }
                     }
                 }
             } else if na.bounds.overlaps(&nb.bounds) {
-                for (&i, bi) in ia.iter().zip(ba) {
-                    if !bi.overlaps(&nb.bounds) {
+                for k in ra {
+                    if !self.boxes[k].overlaps(&nb.bounds) {
                         continue;
                     }
-                    for (&j, bj) in ib.iter().zip(bb) {
-                        if bi.overlaps(bj) {
-                            f(i, j);
+                    for l in rb.clone() {
+                        if pair(k, l) {
+                            f(self.order[k], self.order[l]);
                         }
                     }
                 }
@@ -406,28 +466,37 @@ mod tests {
     #[test]
     fn growing_by_differences_is_growing_point_by_point() {
         let mut r = crate::testing::numbers(11);
-        let a: Vec<Vec3> = (0..37).map(|_| Vec3::new(r(), r(), r())).collect();
-        let base: Vec<Vec3> = (0..37).map(|_| Vec3::new(r(), r(), r())).collect();
-        let mut start = Aabb::empty();
-        start.grow(&Vec3::new(0.1, -0.2, 0.3));
-        let mut each = start;
-        for (p, o) in a.iter().zip(&base) {
-            each.grow(&(p - o));
+        // Fewer points than a block of eight, whole blocks, and blocks with a tail; the
+        // extremes in the blocks' lanes and in the tail.
+        for n in [1usize, 7, 8, 37, 200] {
+            let a: Vec<Vec3> = (0..n).map(|_| Vec3::new(r(), r(), r())).collect();
+            let base: Vec<Vec3> = (0..n).map(|_| Vec3::new(r(), r(), r())).collect();
+            let mut start = Aabb::empty();
+            start.grow(&Vec3::new(0.1, -0.2, 0.3));
+            let each = |a: &[Vec3]| {
+                let mut each = start;
+                for (p, o) in a.iter().zip(&base) {
+                    each.grow(&(p - o));
+                }
+                each
+            };
+            assert_eq!(start.grown_by_differences(&a, &base), each(&a), "{n} points");
+            // A NaN is passed over by both, in a block and in the tail.
+            let mut with_nan = a.clone();
+            with_nan[n / 3].y = f64::NAN;
+            with_nan[n - 1].x = f64::NAN;
+            assert_eq!(
+                start.grown_by_differences(&with_nan, &base),
+                each(&with_nan),
+                "{n} points"
+            );
         }
-        assert_eq!(start.grown_by_differences(&a, &base), each);
-        // A NaN is passed over by both.
-        let mut with_nan = a.clone();
-        with_nan[5].y = f64::NAN;
-        let mut each = start;
-        for (p, o) in with_nan.iter().zip(&base) {
-            each.grow(&(p - o));
-        }
-        assert_eq!(start.grown_by_differences(&with_nan, &base), each);
         assert_eq!(Aabb::empty().grown_by_differences(&[], &[]), Aabb::empty());
     }
 
     /// The tree walked against itself finds every overlapping pair exactly once, whatever
-    /// the number of tasks it is split into, before and after a refit.
+    /// the number of tasks it is split into, before and after a refit; and, with other boxes,
+    /// every overlapping pair whose other boxes are apart.
     #[test]
     fn self_overlaps_match_brute_force() {
         for n in [0usize, 1, 3, 5, 700] {
@@ -447,13 +516,38 @@ mod tests {
                     "the test meets overlaps: {}",
                     brute.len()
                 );
+                // Other boxes: the first ones shifted, so some overlapping pairs' are apart
+                // and some apart pairs' overlap.
+                let other: Vec<Aabb> = b
+                    .iter()
+                    .enumerate()
+                    .map(|(k, x)| {
+                        let shift = Vec3::new(0.0, (k % 3) as f64 * 0.4, 0.0);
+                        Aabb {
+                            min: x.min + shift,
+                            max: x.max + shift,
+                        }
+                    })
+                    .collect();
+                let apart: Vec<(u32, u32)> = brute
+                    .iter()
+                    .copied()
+                    .filter(|&(i, j)| !other[i as usize].overlaps(&other[j as usize]))
+                    .collect();
+                assert!(n < 700 || (apart.len() > 20 && apart.len() < brute.len()));
+                let in_order = bvh.in_order(&other);
                 for tasks in [1, 7, 64] {
-                    let mut found = Vec::new();
+                    let (mut found, mut found_apart) = (Vec::new(), Vec::new());
                     for task in bvh.self_tasks(tasks) {
                         bvh.self_overlapping(task, |i, j| found.push((i.min(j), i.max(j))));
+                        bvh.self_overlapping_apart(task, &in_order, |i, j| {
+                            found_apart.push((i.min(j), i.max(j)))
+                        });
                     }
                     found.sort_unstable();
+                    found_apart.sort_unstable();
                     assert_eq!(found, brute, "{n} boxes, round {round}, {tasks} tasks");
+                    assert_eq!(found_apart, apart, "{n} boxes, round {round}, {tasks} tasks");
                 }
                 for x in &mut b {
                     *x = Aabb {

@@ -195,11 +195,11 @@ impl NearPairs {
         })
     }
 
-    /// Whether triangles `i` and `j` are rest-near (their pairs are listed here). Those that
-    /// are not are more than the radius apart at rest in some axis, so none of their vertex
-    /// and triangle, or edge and edge, is excluded or shares a vertex.
-    #[inline]
-    pub(super) fn rest_near(&self, i: u32, j: u32) -> bool {
-        self.rest_boxes[i as usize].overlaps(&self.rest_boxes[j as usize])
+    /// The triangles' rest boxes (grown by half the radius): triangles are rest-near (their
+    /// pairs are listed here) when theirs overlap. Those that are not are more than the
+    /// radius apart at rest in some axis, so none of their vertex and triangle, or edge and
+    /// edge, is excluded or shares a vertex.
+    pub(super) fn rest_boxes(&self) -> &[Aabb] {
+        &self.rest_boxes
     }
 }
