@@ -317,7 +317,7 @@ impl Bvh {
         self.order.iter().map(|&i| boxes[i as usize]).collect()
     }
 
-    /// As [`Bvh::self_overlapping`], but only the pairs whose `other` boxes (one an item, in
+    /// As [`Bvh::self_overlapping`], but only the pairs whose `other` boxes (one per item, in
     /// the tree's order: [`Bvh::in_order`]) are apart: the self-collision's walk, which leaves
     /// out the triangles near each other at rest. Both tests are made for every pair of a
     /// leaf pair, and the one branch (mostly not taken: neighbours) is easy to predict.
