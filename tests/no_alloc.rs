@@ -184,6 +184,71 @@ fn steps_do_not_allocate() {
             "fresh buffers allocate"
         );
     }
+    // Self-collision's looks reuse their lists: a sheet folded onto itself, looked at in two
+    // shapes by turns (the upper layer 3 mm above the lower, then 2.5 mm and slid 6 mm, far
+    // enough for a look each time), allocates nothing once both shapes' pairs have been found,
+    // where a fresh search allocates.
+    {
+        use fraccloth::collide::SelfCollision;
+        use fraccloth::Vec3;
+        let (cols, rows, s) = (10u32, 21u32, 0.01);
+        let at = |i: u32, j: u32| j * cols + i;
+        let mut triangles = Vec::new();
+        for j in 0..rows - 1 {
+            for i in 0..cols - 1 {
+                triangles.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
+                triangles.push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        let grid = |gap: f64, slide: f64, fold: bool| -> Vec<Vec3> {
+            (0..rows)
+                .flat_map(|j| (0..cols).map(move |i| (i, j)))
+                .map(|(i, j)| {
+                    let (x, z) = (f64::from(i) * s, f64::from(j) * s);
+                    if fold && j > rows / 2 {
+                        Vec3::new(x + slide, gap, f64::from(rows - 1 - j) * s)
+                    } else {
+                        Vec3::new(x, 0.0, z)
+                    }
+                })
+                .collect()
+        };
+        let rest = grid(0.0, 0.0, false);
+        let shapes = [grid(0.003, 0.0, true), grid(0.0025, 0.006, true)];
+        let (thickness, friction) = (0.004, 0.0);
+        let mut search = SelfCollision::new(&triangles);
+        search.prepare(&rest, &triangles, thickness).unwrap();
+        let mut contacts = Vec::new();
+        let mut found = Vec::new();
+        for x in shapes.iter().chain(&shapes) {
+            contacts.clear();
+            search
+                .contacts(x, &rest, &triangles, thickness, friction, &mut contacts)
+                .unwrap();
+            found.push(contacts.len());
+        }
+        assert!(found.iter().all(|&n| n > 0), "the layers touch: {found:?}");
+        let (looks, before) = (search.looks, ALLOCATIONS.load(Ordering::Relaxed));
+        for x in shapes.iter().cycle().take(10) {
+            contacts.clear();
+            search
+                .contacts(x, &rest, &triangles, thickness, friction, &mut contacts)
+                .unwrap();
+        }
+        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert_eq!(search.looks - looks, 10, "a look each time");
+        assert_eq!(during, 0, "self-collision: {during} allocations in 10 looks");
+        let mut fresh = SelfCollision::new(&triangles);
+        fresh.prepare(&rest, &triangles, thickness).unwrap();
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        fresh
+            .contacts(&shapes[0], &rest, &triangles, thickness, friction, &mut contacts)
+            .unwrap();
+        assert!(
+            ALLOCATIONS.load(Ordering::Relaxed) > before,
+            "a fresh search allocates"
+        );
+    }
     // The counter does count: building a cloth allocates.
     let before = ALLOCATIONS.load(Ordering::Relaxed);
     let _ = SceneSpec::paper(SceneKind::Swing, Variant::Fractional)

@@ -210,7 +210,7 @@ impl Cloth {
                 m.self_collision_thickness,
                 m.self_collision_friction,
                 &mut s.contacts,
-            );
+            )?;
         }
         if s.contacts.is_empty() {
             return Ok(());

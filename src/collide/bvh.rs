@@ -170,15 +170,35 @@ pub struct Bvh {
 impl Bvh {
     /// Builds the hierarchy over `boxes` (item k has box k).
     pub fn build(boxes: &[Aabb]) -> Bvh {
+        match Self::try_build(boxes) {
+            Ok(bvh) => bvh,
+            // As a `Vec` that cannot grow.
+            Err(_) => std::alloc::handle_alloc_error(std::alloc::Layout::new::<Node>()),
+        }
+    }
+
+    /// [`Bvh::build`], asking the allocator fallibly for everything whose size the item
+    /// count sets (the walk's own list of nodes to split is as deep as the tree).
+    pub fn try_build(boxes: &[Aabb]) -> Result<Bvh, std::collections::TryReserveError> {
+        let n = boxes.len();
+        // Leaves hold at least LEAF / 2 items (a node of more than LEAF is halved): at most
+        // 2n / LEAF leaves, and fewer than twice that in nodes (`the_nodes_fit_their_room`).
+        let (mut nodes, mut order, mut sorted, mut centres) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        nodes.try_reserve_exact(4 * n / LEAF + 1)?;
+        order.try_reserve_exact(n)?;
+        sorted.try_reserve_exact(n)?;
+        centres.try_reserve_exact(n)?;
+        order.extend(0..n as u32);
         let mut bvh = Bvh {
-            nodes: Vec::with_capacity(2 * boxes.len() / LEAF + 1),
-            order: (0..boxes.len() as u32).collect(),
+            nodes,
+            order,
             boxes: Vec::new(),
         };
         if boxes.is_empty() {
-            return bvh;
+            return Ok(bvh);
         }
-        let centres: Vec<Vec3> = boxes.iter().map(Aabb::centre).collect();
+        centres.extend(boxes.iter().map(Aabb::centre));
         bvh.nodes.push(Node {
             bounds: Aabb::empty(),
             first: 0,
@@ -215,8 +235,9 @@ impl Bvh {
             todo.push((child, lo, half));
             todo.push((child + 1, lo + half, n - half));
         }
-        bvh.boxes = bvh.order.iter().map(|&i| boxes[i as usize]).collect();
-        bvh
+        sorted.extend(bvh.order.iter().map(|&i| boxes[i as usize]));
+        bvh.boxes = sorted;
+        Ok(bvh)
     }
 
     /// Items in the hierarchy.
@@ -256,24 +277,33 @@ impl Bvh {
     /// node pairs whose item pairs together are every pair once, expanded level by level
     /// until there are at least `tasks` of them (fewer when the tree is small), for a pool.
     pub fn self_tasks(&self, tasks: usize) -> Vec<(u32, u32)> {
+        let mut out = Vec::new();
+        self.self_tasks_into(tasks, &mut out, &mut Vec::new());
+        out
+    }
+
+    /// [`Bvh::self_tasks`] into `out`, with `spare` for the level being expanded: both keep
+    /// their room from one call to the next (a self-collision look allocates nothing once its
+    /// lists have grown; the lists are a few times `tasks` long, whatever the tree's size).
+    pub fn self_tasks_into(&self, tasks: usize, out: &mut Vec<(u32, u32)>, spare: &mut Vec<(u32, u32)>) {
+        out.clear();
         if self.nodes.is_empty() {
-            return Vec::new();
+            return;
         }
-        let mut out = vec![(0u32, 0u32)];
+        out.push((0, 0));
         while out.len() < tasks {
-            let mut next = Vec::with_capacity(3 * out.len());
+            spare.clear();
             let mut grew = false;
-            for &(a, b) in &out {
-                let before = next.len();
-                self.expand(a, b, &mut next);
-                grew |= !(next.len() == before + 1 && next[before] == (a, b));
+            for &(a, b) in out.iter() {
+                let before = spare.len();
+                self.expand(a, b, spare);
+                grew |= !(spare.len() == before + 1 && spare[before] == (a, b));
             }
-            out = next;
+            std::mem::swap(out, spare);
             if !grew {
                 break;
             }
         }
-        out
     }
 
     /// One level of the walk of node pair `(a, b)`: pushes its children's pairs onto `out`, or
@@ -308,23 +338,44 @@ impl Bvh {
     /// against itself visits each pair of overlapping nodes once, where a query per item walks
     /// from the root for each and meets each pair twice.
     pub fn self_overlapping(&self, task: (u32, u32), f: impl FnMut(u32, u32)) {
-        self.walk_self(task, |k, l| self.boxes[k].overlaps(&self.boxes[l]), f);
+        self.walk_self(
+            task,
+            &mut Vec::new(),
+            |k, l| self.boxes[k].overlaps(&self.boxes[l]),
+            f,
+        );
     }
 
     /// The items' `boxes` (item k's is `boxes[k]`) in the tree's order, for
     /// [`Bvh::self_overlapping_apart`].
     pub fn in_order(&self, boxes: &[Aabb]) -> Vec<Aabb> {
-        self.order.iter().map(|&i| boxes[i as usize]).collect()
+        let mut out = Vec::new();
+        self.in_order_into(boxes, &mut out);
+        out
+    }
+
+    /// [`Bvh::in_order`] appended to `out` (which the caller may have reserved fallibly).
+    pub fn in_order_into(&self, boxes: &[Aabb], out: &mut Vec<Aabb>) {
+        out.extend(self.order.iter().map(|&i| boxes[i as usize]));
     }
 
     /// As [`Bvh::self_overlapping`], but only the pairs whose `other` boxes (one per item, in
     /// the tree's order: [`Bvh::in_order`]) are apart: the self-collision's walk, which leaves
     /// out the triangles near each other at rest. Both tests are made for every pair of a
     /// leaf pair, and the one branch (mostly not taken: neighbours) is easy to predict.
-    pub fn self_overlapping_apart(&self, task: (u32, u32), other: &[Aabb], f: impl FnMut(u32, u32)) {
+    /// `stack` is the walk's (its room is kept for the next walk: no allocation once it has
+    /// grown to a few times the tree's depth).
+    pub fn self_overlapping_apart(
+        &self,
+        task: (u32, u32),
+        other: &[Aabb],
+        stack: &mut Vec<(u32, u32)>,
+        f: impl FnMut(u32, u32),
+    ) {
         debug_assert_eq!(other.len(), self.boxes.len());
         self.walk_self(
             task,
+            stack,
             |k, l| self.boxes[k].overlaps(&self.boxes[l]) & !other[k].overlaps(&other[l]),
             f,
         );
@@ -334,14 +385,21 @@ impl Bvh {
     /// slots `k`, `l` (places in `order`) of every leaf pair whose bounds overlap where
     /// `pair(k, l)`.
     #[inline(always)]
-    fn walk_self(&self, task: (u32, u32), pair: impl Fn(usize, usize) -> bool, mut f: impl FnMut(u32, u32)) {
-        let mut stack = vec![task];
+    fn walk_self(
+        &self,
+        task: (u32, u32),
+        stack: &mut Vec<(u32, u32)>,
+        pair: impl Fn(usize, usize) -> bool,
+        mut f: impl FnMut(u32, u32),
+    ) {
+        stack.clear();
+        stack.push(task);
         while let Some((a, b)) = stack.pop() {
             let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
             let leaves = na.count > 0 && nb.count > 0;
             if !leaves {
                 // Never a leaf with itself: `expand` only pushes children.
-                self.expand(a, b, &mut stack);
+                self.expand(a, b, stack);
                 continue;
             }
             let range = |n: &Node| n.first as usize..(n.first + n.count) as usize;
@@ -440,6 +498,34 @@ impl Bvh {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_nodes_fit_their_room() {
+        // `try_build` reserves 4n / LEAF + 1 nodes: the tree never needs more (a push past it
+        // would reallocate, infallibly). Boxes on a line and in a cloud, 0 to 3000 of them.
+        for n in (0..200).chain([257, 1000, 1023, 1024, 1025, 3000]) {
+            for cloud in [false, true] {
+                let boxes: Vec<Aabb> = (0..n)
+                    .map(|k| {
+                        let t = k as f64;
+                        let c = if cloud {
+                            Vec3::new((t * 0.618).fract(), (t * 0.414).fract(), (t * 0.732).fract())
+                        } else {
+                            Vec3::new(t, 0.0, 0.0)
+                        };
+                        Aabb { min: c, max: c }
+                    })
+                    .collect();
+                let bvh = Bvh::try_build(&boxes).expect("room");
+                assert!(
+                    bvh.nodes.len() <= 4 * n / LEAF + 1,
+                    "{n} boxes: {} nodes",
+                    bvh.nodes.len()
+                );
+                assert_eq!(bvh.nodes.capacity(), 4 * n / LEAF + 1, "{n} boxes: no growth");
+                assert_eq!(bvh.len(), n);
+            }
+        }
+    }
     use super::*;
 
     fn boxes(n: usize) -> Vec<Aabb> {
@@ -538,9 +624,12 @@ mod tests {
                 let in_order = bvh.in_order(&other);
                 for tasks in [1, 7, 64] {
                     let (mut found, mut found_apart) = (Vec::new(), Vec::new());
-                    for task in bvh.self_tasks(tasks) {
+                    let (mut list, mut spare, mut stack) = (Vec::new(), Vec::new(), Vec::new());
+                    bvh.self_tasks_into(tasks, &mut list, &mut spare);
+                    assert_eq!(list, bvh.self_tasks(tasks));
+                    for &task in &list {
                         bvh.self_overlapping(task, |i, j| found.push((i.min(j), i.max(j))));
-                        bvh.self_overlapping_apart(task, &in_order, |i, j| {
+                        bvh.self_overlapping_apart(task, &in_order, &mut stack, |i, j| {
                             found_apart.push((i.min(j), i.max(j)))
                         });
                     }

@@ -105,6 +105,13 @@ pub struct SelfCollision {
     /// The neighbour pairs the proximity search leaves out, whose passage through each other
     /// the impact zones' continuous check watches ([`Guard`]).
     guard: Guard,
+    /// A look's working lists, kept for the next look: the parts' finds, the walk's tasks,
+    /// and a copy of the remembered pairs (their sides, read while the new lists are made).
+    found: Vec<Found>,
+    tasks: Vec<(u32, u32)>,
+    tasks_spare: Vec<(u32, u32)>,
+    old_vt: Vec<Pair>,
+    old_ee: Vec<Pair>,
 }
 
 pub use super::guard::{GUARD_QUANTILE, GUARD_SKIN};
@@ -191,11 +198,28 @@ fn side(v: f64) -> i8 {
 /// How many listed near pairs a task tests.
 const NEAR_CHUNK: usize = 4096;
 
-/// Pairs found by part of a look.
-#[derive(Default)]
+/// Pairs found by part of a look, with the walk's stack. Kept from look to look, so a look
+/// allocates nothing once its lists have grown; they grow fallibly (`failed` when the
+/// allocator refused: the look is an out-of-memory error, not an abort).
+#[derive(Clone, Debug, Default)]
 struct Found {
     vt: Vec<Pair>,
     ee: Vec<Pair>,
+    stack: Vec<(u32, u32)>,
+    failed: bool,
+}
+
+impl Found {
+    fn clear(&mut self) {
+        self.vt.clear();
+        self.ee.clear();
+        self.failed = false;
+    }
+}
+
+/// Room in `list` for `k` more pairs, asked of the allocator fallibly; false when refused.
+fn room_for(list: &mut Vec<Pair>, k: usize) -> bool {
+    list.capacity() - list.len() >= k || list.try_reserve(list.len().max(64).max(k)).is_ok()
 }
 
 /// What a look's tests read: the positions, the boxes, the neighbours and the old list.
@@ -292,6 +316,12 @@ impl Search<'_> {
     #[inline(never)]
     fn far_triangles(&self, i: u32, j: u32, found: &mut Found) {
         let (vt, ee) = (&mut found.vt, &mut found.ee);
+        // A triangle pair yields at most 6 vertex-triangle and 9 edge-edge pairs (each vertex
+        // and edge has one owner): room for them first, so the pushes below never allocate.
+        if !room_for(vt, 6) || !room_for(ee, 9) {
+            found.failed = true;
+            return;
+        }
         self.owners.pairs_of(
             i,
             j,
@@ -300,17 +330,24 @@ impl Search<'_> {
         );
     }
 
-    /// Chunk `k` of the near pairs' lists.
-    fn near_chunk(&self, near: &NearPairs, k: usize) -> Found {
-        let mut found = Found::default();
+    /// Chunk `k` of the near pairs' lists, into `found` (at most one pair each: room for all
+    /// first).
+    fn near_chunk(&self, near: &NearPairs, k: usize, found: &mut Found) {
         let part = |len: usize| (k * NEAR_CHUNK).min(len)..((k + 1) * NEAR_CHUNK).min(len);
-        for &(p, t) in &near.vertex_triangle[part(near.vertex_triangle.len())] {
+        let (vt, ee) = (
+            &near.vertex_triangle[part(near.vertex_triangle.len())],
+            &near.edge_edge[part(near.edge_edge.len())],
+        );
+        if !room_for(&mut found.vt, vt.len()) || !room_for(&mut found.ee, ee.len()) {
+            found.failed = true;
+            return;
+        }
+        for &(p, t) in vt {
             self.vertex_near(p, t, false, &mut found.vt);
         }
-        for &(e, f) in &near.edge_edge[part(near.edge_edge.len())] {
+        for &(e, f) in ee {
             self.edge_near(e, f, false, &mut found.ee);
         }
-        found
     }
 }
 
@@ -338,12 +375,7 @@ impl SelfCollision {
     /// done already. Fails, with nothing changed, when the lists would hold more than
     /// [`PAIRS_PER_VERTEX`] entries a vertex (a thickness large against the mesh's spacing:
     /// the message says how large a one the mesh takes) or memory runs out.
-    pub(crate) fn prepare(
-        &mut self,
-        rest: &[Vec3],
-        triangles: &[[u32; 3]],
-        thickness: f64,
-    ) -> Result<(), Error> {
+    pub fn prepare(&mut self, rest: &[Vec3], triangles: &[[u32; 3]], thickness: f64) -> Result<(), Error> {
         if thickness <= 0.0 || self.prepared(rest.len(), triangles.len(), EXCLUDED * thickness) {
             return Ok(());
         }
@@ -418,8 +450,12 @@ impl SelfCollision {
     }
 
     /// The contacts of the cloth (positions `x`, velocities unused here, rest positions `rest`)
-    /// with itself at thickness `thickness`, appended to `out`.
-    pub(crate) fn contacts(
+    /// with itself at thickness `thickness`, appended to `out`, after [`SelfCollision::prepare`]
+    /// at that thickness. Looks the pairs up again when the cloth has deformed enough. Every
+    /// list it grows (the pairs, the look's working lists, `out`) is asked of the allocator
+    /// fallibly and kept for the next call: an out-of-memory error, not an abort, when memory
+    /// runs out, and no allocation once the lists have grown to what the shapes need.
+    pub fn contacts(
         &mut self,
         x: &[Vec3],
         rest: &[Vec3],
@@ -427,12 +463,17 @@ impl SelfCollision {
         thickness: f64,
         friction: f64,
         out: &mut Vec<Contact>,
-    ) {
+    ) -> Result<(), Error> {
         let skin = SKIN * thickness;
         let reach = thickness + skin;
         if self.deformed(x, skin) {
-            self.look(x, rest, triangles, reach, EXCLUDED * thickness);
+            self.look(x, rest, triangles, reach, EXCLUDED * thickness)?;
         }
+        // At most one contact a pair: room for all of them, so the pushes never allocate.
+        let pairs = self.vertex_triangle.len() + self.edge_edge.len();
+        out.try_reserve(pairs).map_err(|_| {
+            Error::out_of_memory(format!("self-collision: {pairs} contacts cannot be allocated"))
+        })?;
         let cap = 2.0 * thickness;
         // A contact between four vertices at signed distance `dist` along `dir`, if within the
         // thickness.
@@ -551,6 +592,7 @@ impl SelfCollision {
                 dir,
             );
         }
+        Ok(())
     }
 
     /// Whether the cloth at `x` may have brought a pair from beyond `thickness + skin` to
@@ -578,10 +620,18 @@ impl SelfCollision {
     /// Looks the pairs up again at positions `x`: every pair within `reach`, not neighbours
     /// ([`Exclusions`]: nearer than `excluded_within` at rest), with its side from the old list
     /// or, when new, from where it is now.
-    fn look(&mut self, x: &[Vec3], rest: &[Vec3], triangles: &[[u32; 3]], reach: f64, excluded_within: f64) {
+    fn look(
+        &mut self,
+        x: &[Vec3],
+        rest: &[Vec3],
+        triangles: &[[u32; 3]],
+        reach: f64,
+        excluded_within: f64,
+    ) -> Result<(), Error> {
+        let oom = |what: &str| Error::out_of_memory(format!("self-collision: {what} cannot be allocated"));
         self.looks += 1;
+        // Looked at afresh by the next step unless this look completes.
         self.looked_at.clear();
-        self.looked_at.extend_from_slice(x);
         // A vertex is a candidate for a triangle within `reach` of the triangle's box, two
         // edges for each other when their boxes grown by half the reach overlap. The
         // triangles' tree holds their boxes grown by half the reach: a vertex (an edge) of one
@@ -589,12 +639,18 @@ impl SelfCollision {
         // over each other.
         self.tri_boxes.clear();
         self.tree_boxes.clear();
+        self.edge_boxes.clear();
+        self.tri_boxes
+            .try_reserve(triangles.len())
+            .and_then(|()| self.tree_boxes.try_reserve(triangles.len()))
+            .and_then(|()| self.edge_boxes.try_reserve(self.edges.len()))
+            .and_then(|()| self.looked_at.try_reserve(x.len()))
+            .map_err(|_| oom("the boxes of a look"))?;
         for t in triangles {
             let b = Aabb::of(t.iter().map(|&i| &x[i as usize]));
             self.tri_boxes.push(b.inflated(reach));
             self.tree_boxes.push(b.inflated(0.5 * reach));
         }
-        self.edge_boxes.clear();
         self.edge_boxes.extend(
             self.edges
                 .iter()
@@ -603,7 +659,7 @@ impl SelfCollision {
         if self.tri_bvh.len() == triangles.len() {
             self.tri_bvh.refit(&self.tree_boxes);
         } else {
-            self.tri_bvh = Bvh::build(&self.tree_boxes);
+            self.tri_bvh = Bvh::try_build(&self.tree_boxes).map_err(|_| oom("the triangles' tree"))?;
             self.rest_in_order.clear();
         }
         if !self.prepared(x.len(), triangles.len(), excluded_within) {
@@ -612,14 +668,28 @@ impl SelfCollision {
             if self.prepare_within(rest, triangles, excluded_within).is_err() {
                 self.vertex_triangle.clear();
                 self.edge_edge.clear();
-                return;
+                self.looked_at.extend_from_slice(x);
+                return Ok(());
             }
         }
         if self.rest_in_order.len() != triangles.len() {
-            self.rest_in_order = self.tri_bvh.in_order(self.near.rest_boxes());
+            let rest_boxes = self.near.rest_boxes();
+            self.rest_in_order.clear();
+            self.rest_in_order
+                .try_reserve(rest_boxes.len())
+                .map_err(|_| oom("the rest boxes in the tree's order"))?;
+            self.tri_bvh.in_order_into(rest_boxes, &mut self.rest_in_order);
         }
-        let old_vt = std::mem::take(&mut self.vertex_triangle);
-        let old_ee = std::mem::take(&mut self.edge_edge);
+        // The remembered pairs copied aside (the new lists are made where they are), each
+        // list keeping its room from look to look.
+        self.old_vt.clear();
+        self.old_ee.clear();
+        self.old_vt
+            .try_reserve(self.vertex_triangle.len())
+            .and_then(|()| self.old_ee.try_reserve(self.edge_edge.len()))
+            .map_err(|_| oom("a copy of the pairs"))?;
+        self.old_vt.extend_from_slice(&self.vertex_triangle);
+        self.old_ee.extend_from_slice(&self.edge_edge);
         let search = Search {
             x,
             triangles,
@@ -629,8 +699,8 @@ impl SelfCollision {
             edge_boxes: &self.edge_boxes,
             owners: &self.owners,
             excluded: &self.excluded,
-            old_vt: &old_vt,
-            old_ee: &old_ee,
+            old_vt: &self.old_vt,
+            old_ee: &self.old_ee,
         };
         // The triangles' tree walked against itself (each overlapping pair of boxes once), in
         // tasks for the pool on a large cloth; triangles near each other at rest are left out
@@ -641,55 +711,79 @@ impl SelfCollision {
         // `collision_cost -- 5 0`: 1.34-1.40x the bake without on one thread, 1.46-1.73x on two).
         let par = crate::parallel::worth_it(x.len());
         let (tri_bvh, near, rest_in_order) = (&self.tri_bvh, &self.near, &self.rest_in_order);
-        let walk = |task: &(u32, u32)| -> Found {
-            let mut found = Found::default();
-            tri_bvh.self_overlapping_apart(*task, rest_in_order, |i, j| {
-                search.far_triangles(i, j, &mut found);
-            });
-            found
-        };
         let near_chunks = near
             .vertex_triangle
             .len()
             .max(near.edge_edge.len())
             .div_ceil(NEAR_CHUNK);
-        let tasks = tri_bvh.self_tasks(if par { 64 } else { 1 });
-        let found: Vec<Found> = if par {
-            let mut found: Vec<_> = tasks.par_iter().map(walk).collect();
-            found.par_extend(
-                (0..near_chunks)
-                    .into_par_iter()
-                    .map(|k| search.near_chunk(near, k)),
-            );
-            found
+        tri_bvh.self_tasks_into(if par { 64 } else { 1 }, &mut self.tasks, &mut self.tasks_spare);
+        let tasks = &self.tasks;
+        // One part a task and a chunk, and at least one (the orphans' queries below).
+        let parts = (tasks.len() + near_chunks).max(1);
+        if self.found.len() < parts {
+            self.found
+                .try_reserve(parts - self.found.len())
+                .map_err(|_| oom("the parts of a look"))?;
+            self.found.resize_with(parts, Found::default);
+        }
+        let part = |k: usize, found: &mut Found| {
+            found.clear();
+            if let Some(&task) = tasks.get(k) {
+                let Found { stack, .. } = found;
+                let mut stack = std::mem::take(stack);
+                tri_bvh.self_overlapping_apart(task, rest_in_order, &mut stack, |i, j| {
+                    search.far_triangles(i, j, found);
+                });
+                found.stack = stack;
+            } else if k - tasks.len() < near_chunks {
+                search.near_chunk(near, k - tasks.len(), found);
+            }
+        };
+        let found = &mut self.found[..parts];
+        if par {
+            found.par_iter_mut().enumerate().for_each(|(k, f)| part(k, f));
         } else {
-            tasks
-                .iter()
-                .map(walk)
-                .chain((0..near_chunks).map(|k| search.near_chunk(near, k)))
-                .collect()
-        };
-        let mut all = Found {
-            vt: Vec::with_capacity(found.iter().map(|f| f.vt.len()).sum()),
-            ee: Vec::with_capacity(found.iter().map(|f| f.ee.len()).sum()),
-        };
-        for f in found {
-            all.vt.extend(f.vt);
-            all.ee.extend(f.ee);
+            found.iter_mut().enumerate().for_each(|(k, f)| part(k, f));
         }
         // Vertices in no triangle, one query each.
+        let orphans = &mut found[0];
         for &p in self.owners.orphans() {
             let q = Aabb {
                 min: x[p as usize],
                 max: x[p as usize],
             }
             .inflated(0.5 * reach);
-            tri_bvh.overlapping(&q, |t| search.vertex_pair(p, t, &mut all.vt));
+            tri_bvh.overlapping(&q, |t| {
+                if room_for(&mut orphans.vt, 1) {
+                    search.vertex_pair(p, t, &mut orphans.vt);
+                } else {
+                    orphans.failed = true;
+                }
+            });
         }
-        all.vt.sort_unstable();
-        all.ee.sort_unstable();
-        self.vertex_triangle = all.vt;
-        self.edge_edge = all.ee;
+        if found.iter().any(|f| f.failed) {
+            return Err(oom("the pairs a look found"));
+        }
+        // Room for the gathered lists before they are emptied, so a refusal leaves the
+        // remembered pairs as they were.
+        let (vt, ee) = (&mut self.vertex_triangle, &mut self.edge_edge);
+        let (vt_len, ee_len) = (
+            found.iter().map(|f| f.vt.len()).sum::<usize>(),
+            found.iter().map(|f| f.ee.len()).sum::<usize>(),
+        );
+        vt.try_reserve(vt_len.saturating_sub(vt.len()))
+            .and_then(|()| ee.try_reserve(ee_len.saturating_sub(ee.len())))
+            .map_err(|_| oom("the pairs a look found"))?;
+        vt.clear();
+        ee.clear();
+        for f in found.iter() {
+            vt.extend_from_slice(&f.vt);
+            ee.extend_from_slice(&f.ee);
+        }
+        vt.sort_unstable();
+        ee.sort_unstable();
+        self.looked_at.extend_from_slice(x);
+        Ok(())
     }
 
     /// Forgets the positions of the last look (the next step looks again; sides are kept).
@@ -722,8 +816,19 @@ impl SelfCollision {
 
     /// Replaces the remembered pairs (a snapshot's).
     pub(crate) fn set_pairs(&mut self, vertex_triangle: Vec<Pair>, edge_edge: Vec<Pair>) {
-        self.vertex_triangle = vertex_triangle;
-        self.edge_edge = edge_edge;
+        // Into the lists already there when they have the room (a host stepping a shot again
+        // from a snapshot allocates nothing more), else the snapshot's are taken.
+        for (list, new) in [
+            (&mut self.vertex_triangle, vertex_triangle),
+            (&mut self.edge_edge, edge_edge),
+        ] {
+            if list.capacity() >= new.len() {
+                list.clear();
+                list.extend_from_slice(&new);
+            } else {
+                *list = new;
+            }
+        }
         self.looked_at.clear();
     }
 
@@ -874,7 +979,8 @@ mod tests {
         let (x, rest, triangles) = folded_sheet(12, 9);
         let (thickness, reach) = (0.004, 0.008);
         let mut sc = SelfCollision::new(&triangles);
-        sc.look(&x, &rest, &triangles, reach, EXCLUDED * thickness);
+        sc.look(&x, &rest, &triangles, reach, EXCLUDED * thickness)
+            .expect("room");
         assert!(
             sc.vertex_triangle.len() > 50 && sc.edge_edge.len() > 50,
             "a fold has pairs"
@@ -1063,7 +1169,8 @@ mod tests {
                 .expect("a pool");
             pool.install(|| {
                 let mut sc = SelfCollision::new(&triangles);
-                sc.look(&x, &rest, &triangles, reach, EXCLUDED * thickness);
+                sc.look(&x, &rest, &triangles, reach, EXCLUDED * thickness)
+                    .expect("room");
                 (sc.vertex_triangle, sc.edge_edge)
             })
         };
@@ -1097,7 +1204,7 @@ mod tests {
             .collect();
         let mut sc = SelfCollision::new(&t);
         let mut out = Vec::new();
-        sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out);
+        sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out).expect("room");
         assert!(!out.is_empty());
         for c in &out {
             let first_top = c.idx[0] >= 4;
@@ -1111,7 +1218,7 @@ mod tests {
         let far: Vec<Vec3> = rest.clone();
         sc.look_again();
         out.clear();
-        sc.contacts(&far, &rest, &t, 0.005, 0.0, &mut out);
+        sc.contacts(&far, &rest, &t, 0.005, 0.0, &mut out).expect("room");
         assert!(out.is_empty());
     }
 
@@ -1141,13 +1248,13 @@ mod tests {
         let (t, mut x, rest) = vertex_over_a_triangle();
         let mut sc = SelfCollision::new(&t);
         let mut out = Vec::new();
-        sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out);
+        sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out).expect("room");
         let up = out.iter().find(|c| c.idx[0] == 3).unwrap();
         assert!(up.dir.y > 0.99);
         // Through the triangle by 1 mm (less than the skin: no new look).
         x[3].y = -0.001;
         out.clear();
-        sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out);
+        sc.contacts(&x, &rest, &t, 0.005, 0.0, &mut out).expect("room");
         let up = out.iter().find(|c| c.idx[0] == 3).unwrap();
         assert!(up.dir.y > 0.99 && (up.depth - 0.006).abs() < 1e-12, "{up:?}");
     }
@@ -1161,13 +1268,13 @@ mod tests {
         let mut sc = SelfCollision::new(&t);
         let mut out = Vec::new();
         let h = 0.005;
-        sc.contacts(&x, &rest, &t, h, 0.0, &mut out);
+        sc.contacts(&x, &rest, &t, h, 0.0, &mut out).expect("room");
         assert!(out.iter().any(|c| c.idx[0] == 3));
         // Through by 1.5 thicknesses, in steps of less than the step limit's two vertices.
         for y in [0.0015, -0.001, -0.004, -0.0075] {
             x[3].y = y;
             out.clear();
-            sc.contacts(&x, &rest, &t, h, 0.0, &mut out);
+            sc.contacts(&x, &rest, &t, h, 0.0, &mut out).expect("room");
         }
         let up = out.iter().find(|c| c.idx[0] == 3).expect("still in contact");
         assert!(up.dir.y > 0.99 && (up.depth - 2.0 * h).abs() < 1e-12, "{up:?}");
@@ -1175,12 +1282,12 @@ mod tests {
         // (two thicknesses below) and back within it, too little for another look: the pair
         // learnt the new side as its own.
         sc.look_again();
-        sc.contacts(&x, &rest, &t, h, 0.0, &mut out);
+        sc.contacts(&x, &rest, &t, h, 0.0, &mut out).expect("room");
         assert!(sc.pairs().0.iter().any(|q| q.0 == 3 && q.2 == 1));
         for y in [-0.0105, -0.0075] {
             x[3].y = y;
             out.clear();
-            sc.contacts(&x, &rest, &t, h, 0.0, &mut out);
+            sc.contacts(&x, &rest, &t, h, 0.0, &mut out).expect("room");
         }
         assert!(out.iter().all(|c| c.idx[0] != 3), "{out:?}");
         assert!(sc.pairs().0.iter().any(|q| q.0 == 3 && q.2 == -1));
