@@ -607,7 +607,7 @@ impl Cloth {
     /// One call: the mesh colliders travel to where the host put them over it.
     fn step_substeps_here(&mut self, dt: f64, substeps: u32) -> Result<(), Error> {
         check_dt(dt)?;
-        self.begin_collider_motion(dt);
+        self.begin_collider_motion(dt)?;
         self.step_substeps_inner(dt, substeps)?;
         self.colliders_arrive();
         Ok(())

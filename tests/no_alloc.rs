@@ -249,6 +249,51 @@ fn steps_do_not_allocate() {
             "a fresh search allocates"
         );
     }
+    // A moving mesh collider (a 400-triangle ball pushed into the swinging towel and drawn
+    // back, set every frame as a host moves a skinned mesh) is refreshed into the lists of the
+    // last frame: no allocation once they have grown.
+    {
+        use fraccloth::collide::shapes::uv_sphere;
+        use fraccloth::Vec3;
+        let mut scene = SceneSpec::underwater_swing(15, 11, 0.5, 0.04, fraccloth::Model::underwater())
+            .build()
+            .unwrap();
+        let dt = scene.spec.dt;
+        let ball = |frame: usize| {
+            let t = frame as f64 * dt;
+            uv_sphere(
+                Vec3::new(0.3, -0.25, 0.07 - 0.06 * (t * 3.0).sin().abs()),
+                0.08,
+                20,
+                11,
+            )
+        };
+        let (x, tris) = ball(0);
+        assert!(tris.len() >= 400);
+        let id = scene.cloth.add_mesh_collider(&x, &tris, None).unwrap();
+        // The host's positions for every frame, made before counting.
+        let frames: Vec<Vec<Vec3>> = (1..=60).map(|f| ball(f).0).collect();
+        let (warm, counted) = frames.split_at(30);
+        for x in warm {
+            scene.cloth.set_mesh_collider(id, x, None).unwrap();
+            scene.step().unwrap();
+        }
+        let (before, mut touching) = (ALLOCATIONS.load(Ordering::Relaxed), 0);
+        for x in counted {
+            scene.cloth.set_mesh_collider(id, x, None).unwrap();
+            scene.step().unwrap();
+            touching += usize::from(!scene.cloth.contacts().is_empty());
+        }
+        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert!(
+            touching > 5,
+            "the ball touches the towel in {touching} of 30 frames"
+        );
+        assert_eq!(
+            during, 0,
+            "a moving mesh collider: {during} allocations in 30 frames"
+        );
+    }
     // The counter does count: building a cloth allocates.
     let before = ALLOCATIONS.load(Ordering::Relaxed);
     let _ = SceneSpec::paper(SceneKind::Swing, Variant::Fractional)

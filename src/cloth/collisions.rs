@@ -134,7 +134,7 @@ impl Cloth {
         for (id, slot) in self.mesh_slots.iter_mut().enumerate() {
             let Some(mesh) = slot else { continue };
             let (margin, skin) = Self::mesh_reach(model_margin, mesh);
-            mesh.refresh(margin + skin);
+            mesh.refresh(margin + skin)?;
             mesh.contacts(
                 &self.x,
                 &self.topology.triangles,
@@ -162,12 +162,13 @@ impl Cloth {
     }
 
     /// A step call of `dt` seconds begins: each mesh collider's velocities and swept boxes.
-    pub(super) fn begin_collider_motion(&mut self, dt: f64) {
+    pub(super) fn begin_collider_motion(&mut self, dt: f64) -> Result<(), Error> {
         let model_margin = self.config.model.collision_margin;
         for mesh in self.mesh_slots.iter_mut().flatten() {
             let (margin, skin) = Self::mesh_reach(model_margin, mesh);
-            mesh.begin_call(dt, margin + skin);
+            mesh.begin_call(dt, margin + skin)?;
         }
+        Ok(())
     }
 
     /// The call succeeded: every mesh collider is where the host put it.
@@ -189,7 +190,7 @@ impl Cloth {
             let Some(mesh) = slot else { continue };
             let (margin, skin) = Self::mesh_reach(m.collision_margin, mesh);
             // A step outside a call (a snapshot's trial step) finds the boxes made here.
-            mesh.refresh(margin + skin);
+            mesh.refresh(margin + skin)?;
             mesh.contacts(
                 &self.x,
                 &self.topology.triangles,

@@ -181,6 +181,9 @@ impl Bvh {
     /// count sets (the walk's own list of nodes to split is as deep as the tree).
     pub fn try_build(boxes: &[Aabb]) -> Result<Bvh, std::collections::TryReserveError> {
         let n = boxes.len();
+        if n == 0 {
+            return Ok(Bvh::default());
+        }
         // Leaves hold at least LEAF / 2 items (a node of more than LEAF is halved): at most
         // 2n / LEAF leaves, and fewer than twice that in nodes (`the_nodes_fit_their_room`).
         let (mut nodes, mut order, mut sorted, mut centres) =
@@ -195,9 +198,6 @@ impl Bvh {
             order,
             boxes: Vec::new(),
         };
-        if boxes.is_empty() {
-            return Ok(bvh);
-        }
         centres.extend(boxes.iter().map(Aabb::centre));
         bvh.nodes.push(Node {
             bounds: Aabb::empty(),
@@ -521,7 +521,8 @@ mod tests {
                     "{n} boxes: {} nodes",
                     bvh.nodes.len()
                 );
-                assert_eq!(bvh.nodes.capacity(), 4 * n / LEAF + 1, "{n} boxes: no growth");
+                let room = if n == 0 { 0 } else { 4 * n / LEAF + 1 };
+                assert_eq!(bvh.nodes.capacity(), room, "{n} boxes: no growth");
                 assert_eq!(bvh.len(), n);
             }
         }

@@ -347,7 +347,7 @@ impl MeshCollider {
     }
 
     /// A step call of `dt` seconds begins: velocities over it, boxes swept from start to target.
-    pub(crate) fn begin_call(&mut self, dt: f64, reach: f64) {
+    pub(crate) fn begin_call(&mut self, dt: f64, reach: f64) -> Result<(), Error> {
         if self.given_velocity.is_empty() {
             for ((v, s), t) in self.velocity.iter_mut().zip(&self.start).zip(&self.target) {
                 *v = (t - s) / dt;
@@ -362,69 +362,86 @@ impl MeshCollider {
             .map(|(s, t)| (t - s).norm_squared())
             .fold(0.0, f64::max)
             .sqrt();
-        self.refresh(reach);
+        self.refresh(reach)
     }
 
     /// The swept boxes and normals for the mesh's current start and target, if not yet made.
-    pub(crate) fn refresh(&mut self, reach: f64) {
+    pub(crate) fn refresh(&mut self, reach: f64) -> Result<(), Error> {
         if self.fresh_at == reach {
-            return;
+            return Ok(());
         }
-        self.face_normal = self
-            .triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| self.target[i as usize]);
-                (b - a)
-                    .cross(&(c - a))
-                    .try_normalize(0.0)
-                    .unwrap_or_else(Vec3::zeros)
-            })
-            .collect();
-        self.vertex_normal = angle_weighted_normals(&self.target, &self.triangles);
-        self.tri_boxes = self
-            .triangles
-            .iter()
-            .map(|t| {
-                Aabb::of(
-                    t.iter()
-                        .flat_map(|&i| [&self.start[i as usize], &self.target[i as usize]]),
-                )
-            })
-            .collect();
-        self.vert_boxes = self
-            .start
-            .iter()
-            .zip(&self.target)
-            .map(|(s, t)| Aabb::of([s, t]).inflated(reach))
-            .collect();
+        // Into the lists of the last refresh (a moving mesh refreshes every call), grown
+        // fallibly: the mesh's size is the host's.
+        let (t, n) = (self.triangles.len(), self.target.len());
+        for list in [&mut self.face_normal, &mut self.vertex_normal] {
+            list.clear();
+        }
+        for list in [&mut self.tri_boxes, &mut self.vert_boxes, &mut self.edge_boxes] {
+            list.clear();
+        }
+        self.edges.clear();
+        self.face_normal
+            .try_reserve(t)
+            .and_then(|()| self.vertex_normal.try_reserve(n))
+            .and_then(|()| self.tri_boxes.try_reserve(t))
+            .and_then(|()| self.vert_boxes.try_reserve(n))
+            // Each triangle has three edges: room for all of them active.
+            .and_then(|()| self.edges.try_reserve(3 * t))
+            .and_then(|()| self.edge_boxes.try_reserve(3 * t))
+            .map_err(|_| self.no_room())?;
+        self.face_normal.extend(self.triangles.iter().map(|t| {
+            let [a, b, c] = t.map(|i| self.target[i as usize]);
+            (b - a)
+                .cross(&(c - a))
+                .try_normalize(0.0)
+                .unwrap_or_else(Vec3::zeros)
+        }));
+        angle_weighted_normals(&self.target, &self.triangles, &mut self.vertex_normal);
+        self.tri_boxes.extend(self.triangles.iter().map(|t| {
+            Aabb::of(
+                t.iter()
+                    .flat_map(|&i| [&self.start[i as usize], &self.target[i as usize]]),
+            )
+        }));
+        self.vert_boxes.extend(
+            self.start
+                .iter()
+                .zip(&self.target)
+                .map(|(s, t)| Aabb::of([s, t]).inflated(reach)),
+        );
         self.active_edges();
-        self.edge_boxes = self
-            .edges
-            .iter()
-            .map(|e| {
-                Aabb::of(
-                    e.iter()
-                        .flat_map(|&i| [&self.start[i as usize], &self.target[i as usize]]),
-                )
-                .inflated(reach)
-            })
-            .collect();
+        self.edge_boxes.extend(self.edges.iter().map(|e| {
+            Aabb::of(
+                e.iter()
+                    .flat_map(|&i| [&self.start[i as usize], &self.target[i as usize]]),
+            )
+            .inflated(reach)
+        }));
         if self.tri_bvh.len() == self.tri_boxes.len() {
             self.tri_bvh.refit(&self.tri_boxes);
             self.vert_bvh.refit(&self.vert_boxes);
         } else {
-            self.tri_bvh = Bvh::build(&self.tri_boxes);
-            self.vert_bvh = Bvh::build(&self.vert_boxes);
+            self.tri_bvh = Bvh::try_build(&self.tri_boxes).map_err(|_| self.no_room())?;
+            self.vert_bvh = Bvh::try_build(&self.vert_boxes).map_err(|_| self.no_room())?;
         }
         // The active edges may change as the mesh deforms: rebuilt, unless the same count.
         if self.edge_bvh.len() == self.edge_boxes.len() && !self.edge_bvh.is_empty() {
             self.edge_bvh.refit(&self.edge_boxes);
         } else {
-            self.edge_bvh = Bvh::build(&self.edge_boxes);
+            self.edge_bvh = Bvh::try_build(&self.edge_boxes).map_err(|_| self.no_room())?;
         }
         self.fresh_at = reach;
         self.cache.stale = true;
+        Ok(())
+    }
+
+    /// The error when a refresh's lists cannot be allocated (the mesh is left to refresh
+    /// again: nothing is marked fresh).
+    fn no_room(&self) -> Error {
+        Error::out_of_memory(format!(
+            "mesh collider of {} triangles: its normals, boxes and trees cannot be allocated",
+            self.triangles.len()
+        ))
     }
 
     /// The active edges at the target (face normals already computed): borders, and folds
@@ -984,8 +1001,10 @@ fn neighbours(triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
 }
 
 /// Each vertex's normal, the sum of its triangles' unit normals weighted by their angles there.
-fn angle_weighted_normals(x: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
-    let mut n = vec![Vec3::zeros(); x.len()];
+/// Into `n`, which has room for one a vertex.
+fn angle_weighted_normals(x: &[Vec3], triangles: &[[u32; 3]], n: &mut Vec<Vec3>) {
+    n.clear();
+    n.resize(x.len(), Vec3::zeros());
     for tri in triangles {
         let p = tri.map(|i| x[i as usize]);
         let Some(face) = (p[1] - p[0]).cross(&(p[2] - p[0])).try_normalize(0.0) else {
@@ -999,10 +1018,9 @@ fn angle_weighted_normals(x: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
             }
         }
     }
-    for v in &mut n {
+    for v in n.iter_mut() {
         *v = v.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
     }
-    n
 }
 
 #[cfg(test)]
@@ -1017,7 +1035,7 @@ mod tests {
         let (x, t) = uv_sphere(Vec3::zeros(), 0.5, 24, 12);
         let mut m = MeshCollider::new(&x, &t, None).unwrap();
         assert!(m.is_closed());
-        m.begin_call(1.0 / 30.0, 0.03);
+        m.begin_call(1.0 / 30.0, 0.03).expect("room");
         let cloth_tris: Vec<[u32; 3]> = Vec::new();
         let probes = [
             Vec3::new(0.0, 0.52, 0.0),
@@ -1044,7 +1062,7 @@ mod tests {
         let (x, t) = uv_sphere(Vec3::zeros(), 0.5, 16, 8);
         let flipped: Vec<[u32; 3]> = t.iter().map(|t| [t[0], t[2], t[1]]).collect();
         let mut m = MeshCollider::new(&x, &flipped, None).unwrap();
-        m.begin_call(1.0 / 30.0, 0.03);
+        m.begin_call(1.0 / 30.0, 0.03).expect("room");
         let mut out = Vec::new();
         // Just outside (not in contact) and just inside (pushed out).
         m.contacts(
@@ -1075,13 +1093,13 @@ mod tests {
         ];
         let tris = [[0, 1, 2], [0, 2, 3]];
         let mut m = MeshCollider::new(&flat, &tris, None).unwrap();
-        m.begin_call(0.01, 0.01);
+        m.begin_call(0.01, 0.01).expect("room");
         assert_eq!(m.edges.len(), 4, "the four borders: {:?}", m.edges);
         assert!(!m.edges.contains(&[0, 2]));
         let mut folded = flat;
         folded[3] = Vec3::new(0.5, 0.5, 0.7);
         m.set(&folded, None).unwrap();
-        m.begin_call(0.01, 0.01);
+        m.begin_call(0.01, 0.01).expect("room");
         assert!(m.edges.contains(&[0, 2]), "the fold: {:?}", m.edges);
         // A cloth edge crossing under the fold, its ends far from the mesh, is pushed by it.
         let cloth = vec![
@@ -1100,7 +1118,7 @@ mod tests {
         );
         // Flat again: the diagonal is no longer active.
         m.set(&flat, None).unwrap();
-        m.begin_call(0.01, 0.01);
+        m.begin_call(0.01, 0.01).expect("room");
         assert_eq!(m.edges.len(), 4, "{:?}", m.edges);
     }
 
@@ -1109,7 +1127,7 @@ mod tests {
     fn a_thin_bar_pushes_the_cloth_triangle_it_is_under() {
         let (x, t) = bar(Vec3::new(0.3, 0.3, -1.0), Vec3::new(0.3, 0.3, 1.0), 0.002, 2);
         let mut m = MeshCollider::new(&x, &t, None).unwrap();
-        m.begin_call(0.01, 0.03);
+        m.begin_call(0.01, 0.03).expect("room");
         // One big cloth triangle 5 mm above the bar's middle.
         let cloth = vec![
             Vec3::new(-1.0, 0.305, -1.0),
@@ -1138,7 +1156,7 @@ mod tests {
             let mut m = MeshCollider::new(&x, &t, None).unwrap();
             let moved: Vec<Vec3> = x.iter().map(|p| p + Vec3::new(0.0, rise, 0.0)).collect();
             m.set(&moved, None).unwrap();
-            m.begin_call(0.01, 0.03);
+            m.begin_call(0.01, 0.03).expect("room");
             m.contacts(&cloth, &tris, 1.0, 0.01, 0.01, 1.0, &mut Vec::new())
                 .expect("room for a test mesh");
             let mut out = Vec::new();
@@ -1159,7 +1177,7 @@ mod tests {
     fn only_the_way_into_a_closed_mesh_is_a_passage() {
         let (x, t) = uv_sphere(Vec3::zeros(), 0.5, 24, 12);
         let mut m = MeshCollider::new(&x, &t, None).unwrap();
-        m.begin_call(1.0 / 30.0, 0.03);
+        m.begin_call(1.0 / 30.0, 0.03).expect("room");
         let outside = vec![Vec3::new(0.0, 0.51, 0.0)];
         let inside = vec![Vec3::new(0.0, 0.47, 0.0)];
         for (from, to, passes) in [(&outside, &inside, true), (&inside, &outside, false)] {
@@ -1193,7 +1211,7 @@ mod tests {
             .flat_map(|k| [[k, k + n, k + 1], [k + 1, k + n, k + n + 1]])
             .collect();
         let mut m = MeshCollider::new(&x, &t, None).unwrap();
-        m.begin_call(0.01, 0.015);
+        m.begin_call(0.01, 0.015).expect("room");
         // A 2 cm cloth square 5 mm above it, inside the margin of 1 cm.
         let cloth = vec![
             Vec3::new(0.0, 0.005, 0.0),
@@ -1221,7 +1239,7 @@ mod tests {
         x.extend(bx);
         t.extend(bt.iter().map(|tri| tri.map(|i| i + base)));
         let mut kept = MeshCollider::new(&x, &t, None).unwrap();
-        kept.begin_call(0.01, 0.015);
+        kept.begin_call(0.01, 0.015).expect("room");
         // A 12 x 12 sheet of 1 cm, swept across the ball and the bar with a wobble.
         let n = 12u32;
         let tris: Vec<[u32; 3]> = (0..n - 1)
