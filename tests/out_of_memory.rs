@@ -124,4 +124,82 @@ fn requests_too_large_for_memory_are_refused_not_aborted() {
         fc_cloth_destroy(c);
     }
     unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
+
+    self_collision_that_does_not_fit_is_refused();
+}
+
+/// A 201 x 201 cloth with self-collision, stepped flat (its buffers sized), then folded in two
+/// with its layers half a thickness apart: its next look finds some 10^5 pairs, and their lists
+/// and contacts (tens of MB) do not fit under a limit of 8 MB more than it uses. The step is
+/// refused with `FC_ERROR_OUT_OF_MEMORY` and the cloth left as it was; with the limit lifted,
+/// the same step succeeds.
+fn self_collision_that_does_not_fit_is_refused() {
+    let (w, h) = (201u32, 201u32);
+    let mut desc = fc_cloth_desc_default();
+    desc.width = w;
+    desc.height = h;
+    desc.integrator = 1;
+    desc.self_collision_relative = 0.4;
+    let mut c = null_mut();
+    assert_eq!(unsafe { fc_cloth_create_grid(&desc, &mut c) }, FC_OK);
+    let n = w as usize * h as usize;
+    let mut x = vec![0.0f64; 3 * n];
+    unsafe {
+        assert_eq!(fc_cloth_step(c, 1e-4), FC_OK);
+        assert_eq!(fc_cloth_get_positions_f64(c, x.as_mut_ptr(), x.len()), FC_OK);
+    }
+    // The grid's axes from its corner: along a row, across rows, and the normal.
+    let at = |x: &[f64], i: usize, j: usize| {
+        let k = 3 * (j * w as usize + i);
+        [x[k], x[k + 1], x[k + 2]]
+    };
+    let (o, r, u) = (at(&x, 0, 0), at(&x, 1, 0), at(&x, 0, 1));
+    let a: [f64; 3] = std::array::from_fn(|k| r[k] - o[k]);
+    let b: [f64; 3] = std::array::from_fn(|k| u[k] - o[k]);
+    let normal = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
+    let len = normal.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let spacing = a.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let gap = 0.5 * 0.4 * spacing;
+    // Rows past the middle laid back over the first half, `gap` above it.
+    let mid = h as usize / 2;
+    let flat = x.clone();
+    for j in mid + 1..h as usize {
+        for i in 0..w as usize {
+            let under = at(&flat, i, 2 * mid - j);
+            let k = 3 * (j * w as usize + i);
+            for d in 0..3 {
+                x[k + d] = under[d] + gap * normal[d] / len;
+            }
+        }
+    }
+    unsafe {
+        assert_eq!(fc_cloth_set_positions_f64(c, x.as_ptr(), x.len()), FC_OK);
+    }
+    let Some(vm) = vm_size() else { return };
+    let old = set_address_space_limit(vm + 8 * 1024 * 1024);
+    let refused = unsafe { fc_cloth_step(c, 1e-4) };
+    let message = unsafe { std::ffi::CStr::from_ptr(fc_last_error_message()) }
+        .to_string_lossy()
+        .into_owned();
+    let mut after = vec![0.0f64; 3 * n];
+    let read = unsafe { fc_cloth_get_positions_f64(c, after.as_mut_ptr(), after.len()) };
+    unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
+    assert_eq!(refused, FC_ERROR_OUT_OF_MEMORY);
+    assert_eq!(read, FC_OK);
+    assert!(after == x, "a refused step changes nothing");
+    assert!(message.contains("self-collision"), "{message}");
+    // The limit lifted, the same step goes: the layers are pushed apart.
+    unsafe {
+        assert_eq!(fc_cloth_step(c, 1e-4), FC_OK);
+        assert_eq!(
+            fc_cloth_get_positions_f64(c, after.as_mut_ptr(), after.len()),
+            FC_OK
+        );
+        fc_cloth_destroy(c);
+    }
+    assert!(after.iter().all(|v| v.is_finite()) && after != x);
 }
