@@ -1,13 +1,15 @@
 //! Steps the 61 x 41 throughput cloth in blocks of 1000 steps and prints the fastest block in
 //! ns per particle-step: the least noisy figure on a shared machine, for comparing two builds
 //! while optimising (the benchmark of record is `examples/throughput.rs`, which reports medians).
-//! `cargo run --release --example step_cycles -- [fractional|regular|memoryless|underwater|strain] [blocks] [WxH] [shuffled|jittered]`
+//! `cargo run --release --example step_cycles -- [fractional|regular|memoryless|underwater|underwater-self|strain] [blocks] [WxH] [shuffled|jittered]`
 //! (default 61x41; blocks of 1000 steps, fewer for big cloths; `jittered` builds it as the
 //! scenes' irregular triangle mesh, the grid's vertices in its order with random diagonals; `shuffled` builds the grid as a
 //! quad mesh with its vertices in a scrambled order, so the force pass cannot walk it in tiles). `memoryless` is the fractional
 //! model with the history switched off (`Scheme::Off`): the same step without the fractional
 //! memory's work and bytes, to tell what the history costs at a size from what the rest does.
-//! `underwater` is the underwater preset (normal added mass, form and skin drag, no history).
+//! `underwater` is the underwater preset (normal added mass, form and skin drag, no history);
+//! `underwater-self` the same with self-collision at 0.4 spacings (what it costs a cloth that
+//! does not fold: its checks each step; the first block also holds its first look).
 //! `strain` is the fractional model with rotation-invariant fractional springs (a history per
 //! spring beside the particles').
 
@@ -21,14 +23,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let variant_arg = args.get(1).map_or("fractional", String::as_str);
     let regular = variant_arg == "regular";
     let memoryless = variant_arg == "memoryless";
-    let underwater = variant_arg == "underwater";
+    let self_collision = variant_arg == "underwater-self";
+    let underwater = variant_arg == "underwater" || self_collision;
     let strain = variant_arg == "strain";
     if !matches!(
         variant_arg,
-        "fractional" | "regular" | "memoryless" | "underwater" | "strain"
+        "fractional" | "regular" | "memoryless" | "underwater" | "underwater-self" | "strain"
     ) {
         return Err(format!(
-            "unknown variant {variant_arg}: fractional, regular, memoryless, underwater or strain"
+            "unknown variant {variant_arg}: fractional, regular, memoryless, underwater, underwater-self or strain"
         )
         .into());
     }
@@ -98,6 +101,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let mut model = variant.model(0.01);
     model.current = Vec3::new(0.0, 0.0, 0.2);
+    if self_collision {
+        model.self_collision_relative = 0.4;
+    }
     if strain {
         model.spring_damping_mode = fraccloth::SpringDamping::FractionalStrain;
     }
