@@ -814,10 +814,10 @@ impl SelfCollision {
         (&self.vertex_triangle, &self.edge_edge)
     }
 
-    /// Replaces the remembered pairs (a snapshot's).
+    /// Replaces the remembered pairs (a snapshot's; none after a teleport).
     pub(crate) fn set_pairs(&mut self, vertex_triangle: Vec<Pair>, edge_edge: Vec<Pair>) {
-        // Into the lists already there when they have the room (a host stepping a shot again
-        // from a snapshot allocates nothing more), else the snapshot's are taken.
+        // Into the lists already there when they have the room (a teleport, which clears
+        // them, keeps their room for the next look), else the new ones are taken.
         for (list, new) in [
             (&mut self.vertex_triangle, vertex_triangle),
             (&mut self.edge_edge, edge_edge),
