@@ -209,9 +209,23 @@ impl Cloth {
             Scheme::SumOfExponentials { .. } => 24 * 64,
             Scheme::Off => 0,
         };
+        let self_collision_bytes = if config.model.self_collision_thickness > 0.0 {
+            crate::memory::SELF_COLLISION_BYTES_PER_PARTICLE
+        } else {
+            0
+        };
         crate::memory::ensure_available(
-            (n as u64).saturating_mul(crate::memory::STATE_BYTES_PER_PARTICLE + 2 * history_bytes),
-            &format!("a cloth of {n} particles"),
+            (n as u64).saturating_mul(
+                crate::memory::STATE_BYTES_PER_PARTICLE + 2 * history_bytes + self_collision_bytes,
+            ),
+            &format!(
+                "a cloth of {n} particles{}",
+                if self_collision_bytes > 0 {
+                    " with self-collision"
+                } else {
+                    ""
+                }
+            ),
         )?;
         forces::coarse_water::check(&topology, &config.model)?;
         let mut self_collision = SelfCollision::new(&topology.triangles);

@@ -126,6 +126,7 @@ fn requests_too_large_for_memory_are_refused_not_aborted() {
     unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
 
     self_collision_that_does_not_fit_is_refused();
+    a_cloth_whose_self_collision_does_not_fit_is_refused();
 }
 
 /// A 201 x 201 cloth with self-collision, stepped flat (its buffers sized), then folded in two
@@ -202,4 +203,63 @@ fn self_collision_that_does_not_fit_is_refused() {
         fc_cloth_destroy(c);
     }
     assert!(after.iter().all(|v| v.is_finite()) && after != x);
+}
+
+/// A 301 x 301 cloth under the least address-space limit (in 50 MB steps) at which it creates
+/// without self-collision: with self-collision (about 1.1 kB a particle more, checked up
+/// front) it is refused with `FC_ERROR_OUT_OF_MEMORY` and a message naming self-collision. And
+/// a description that turns self-collision on for a cloth stepping under a limit 20 MB above
+/// its use is refused, the cloth kept.
+fn a_cloth_whose_self_collision_does_not_fit_is_refused() {
+    let (w, h) = (301u32, 301u32);
+    let mut desc = fc_cloth_desc_default();
+    desc.width = w;
+    desc.height = h;
+    desc.integrator = 1;
+    let mut with = desc;
+    with.self_collision_relative = 0.4;
+    let Some(vm) = vm_size() else { return };
+    let message = || {
+        unsafe { std::ffi::CStr::from_ptr(fc_last_error_message()) }
+            .to_string_lossy()
+            .into_owned()
+    };
+    let mut plain = null_mut();
+    for step in 1..=40u64 {
+        let old = set_address_space_limit(vm + step * 50 * 1024 * 1024);
+        let s = unsafe { fc_cloth_create_grid(&desc, &mut plain) };
+        if s != FC_OK {
+            unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
+            assert_eq!(s, FC_ERROR_OUT_OF_MEMORY);
+            continue;
+        }
+        let mut d = null_mut();
+        let created = unsafe { fc_cloth_create_grid(&with, &mut d) };
+        let created_message = message();
+        unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
+        assert_eq!(created, FC_ERROR_OUT_OF_MEMORY, "{created_message}");
+        assert!(d.is_null());
+        assert!(created_message.contains("self-collision"), "{created_message}");
+        break;
+    }
+    assert!(!plain.is_null(), "the plain cloth never fitted");
+    unsafe { assert_eq!(fc_cloth_step(plain, 1e-4), FC_OK) };
+    let Some(now) = vm_size() else { return };
+    let old = set_address_space_limit(now + 20 * 1024 * 1024);
+    let turned_on = unsafe { fc_cloth_set_desc(plain, &with) };
+    let turned_on_message = message();
+    let stepped = unsafe { fc_cloth_step(plain, 1e-4) };
+    unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
+    assert_eq!(turned_on, FC_ERROR_OUT_OF_MEMORY, "{turned_on_message}");
+    assert!(
+        turned_on_message.contains("self-collision"),
+        "{turned_on_message}"
+    );
+    assert_eq!(stepped, FC_OK, "the cloth is kept");
+    // With room, it turns on.
+    unsafe {
+        assert_eq!(fc_cloth_set_desc(plain, &with), FC_OK);
+        assert_eq!(fc_cloth_step(plain, 1e-4), FC_OK);
+        fc_cloth_destroy(plain);
+    }
 }

@@ -379,6 +379,12 @@ impl SelfCollision {
         if thickness <= 0.0 || self.prepared(rest.len(), triangles.len(), EXCLUDED * thickness) {
             return Ok(());
         }
+        // Not all of it is asked for fallibly (the boxes and trees the lists are found with):
+        // the room for it is checked first.
+        crate::memory::ensure_available(
+            (rest.len() as u64).saturating_mul(crate::memory::SELF_COLLISION_BYTES_PER_PARTICLE),
+            &format!("self-collision for {} vertices", rest.len()),
+        )?;
         self.prepare_within(rest, triangles, EXCLUDED * thickness)
     }
 

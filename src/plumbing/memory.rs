@@ -17,6 +17,12 @@ pub const TOPOLOGY_BYTES_PER_PARTICLE: u64 = 1_100;
 /// and history, with margin; measured about 500-800 over the topology.
 pub const STATE_BYTES_PER_PARTICLE: u64 = 1_300;
 
+/// Bytes per particle self-collision adds (its neighbour lists, near pairs and guard, the
+/// triangles' trees and the first look), with margin: measured about 1 100 at 0.4 spacings on
+/// grids of 251 001 and 1 002 001 particles (peak resident size with and without). Its pair
+/// lists past that grow fallibly.
+pub const SELF_COLLISION_BYTES_PER_PARTICLE: u64 = 1_500;
+
 /// Fails with an out-of-memory error naming `what` unless `bytes` could be allocated now.
 pub fn ensure_available(bytes: u64, what: &str) -> Result<(), Error> {
     let fail = || {
