@@ -134,13 +134,27 @@ fn requests_too_large_for_memory_are_refused_not_aborted() {
 /// and contacts (tens of MB) do not fit under a limit of 8 MB more than it uses. The step is
 /// refused with `FC_ERROR_OUT_OF_MEMORY` and the cloth left as it was; with the limit lifted,
 /// the same step succeeds.
+/// A `width` x `height` grid's description, symplectic Euler, self-collision at `relative`
+/// spacings (0: off).
+fn grid_desc(width: u32, height: u32, relative: f64) -> FcClothDesc {
+    let mut desc = fc_cloth_desc_default();
+    desc.width = width;
+    desc.height = height;
+    desc.integrator = 1;
+    desc.self_collision_relative = relative;
+    desc
+}
+
+/// The calling thread's last error message.
+fn last_error() -> String {
+    unsafe { std::ffi::CStr::from_ptr(fc_last_error_message()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
 fn self_collision_that_does_not_fit_is_refused() {
     let (w, h) = (201u32, 201u32);
-    let mut desc = fc_cloth_desc_default();
-    desc.width = w;
-    desc.height = h;
-    desc.integrator = 1;
-    desc.self_collision_relative = 0.4;
+    let desc = grid_desc(w, h, 0.4);
     let mut c = null_mut();
     assert_eq!(unsafe { fc_cloth_create_grid(&desc, &mut c) }, FC_OK);
     let n = w as usize * h as usize;
@@ -183,9 +197,7 @@ fn self_collision_that_does_not_fit_is_refused() {
     let Some(vm) = vm_size() else { return };
     let old = set_address_space_limit(vm + 8 * 1024 * 1024);
     let refused = unsafe { fc_cloth_step(c, 1e-4) };
-    let message = unsafe { std::ffi::CStr::from_ptr(fc_last_error_message()) }
-        .to_string_lossy()
-        .into_owned();
+    let message = last_error();
     let mut after = vec![0.0f64; 3 * n];
     let read = unsafe { fc_cloth_get_positions_f64(c, after.as_mut_ptr(), after.len()) };
     unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
@@ -211,19 +223,8 @@ fn self_collision_that_does_not_fit_is_refused() {
 /// a description that turns self-collision on for a cloth stepping under a limit 20 MB above
 /// its use is refused, the cloth kept.
 fn a_cloth_whose_self_collision_does_not_fit_is_refused() {
-    let (w, h) = (301u32, 301u32);
-    let mut desc = fc_cloth_desc_default();
-    desc.width = w;
-    desc.height = h;
-    desc.integrator = 1;
-    let mut with = desc;
-    with.self_collision_relative = 0.4;
+    let (desc, with) = (grid_desc(301, 301, 0.0), grid_desc(301, 301, 0.4));
     let Some(vm) = vm_size() else { return };
-    let message = || {
-        unsafe { std::ffi::CStr::from_ptr(fc_last_error_message()) }
-            .to_string_lossy()
-            .into_owned()
-    };
     let mut plain = null_mut();
     for step in 1..=40u64 {
         let old = set_address_space_limit(vm + step * 50 * 1024 * 1024);
@@ -235,7 +236,7 @@ fn a_cloth_whose_self_collision_does_not_fit_is_refused() {
         }
         let mut d = null_mut();
         let created = unsafe { fc_cloth_create_grid(&with, &mut d) };
-        let created_message = message();
+        let created_message = last_error();
         unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
         assert_eq!(created, FC_ERROR_OUT_OF_MEMORY, "{created_message}");
         assert!(d.is_null());
@@ -247,7 +248,7 @@ fn a_cloth_whose_self_collision_does_not_fit_is_refused() {
     let Some(now) = vm_size() else { return };
     let old = set_address_space_limit(now + 20 * 1024 * 1024);
     let turned_on = unsafe { fc_cloth_set_desc(plain, &with) };
-    let turned_on_message = message();
+    let turned_on_message = last_error();
     let stepped = unsafe { fc_cloth_step(plain, 1e-4) };
     unsafe { libc::setrlimit(libc::RLIMIT_AS, &old) };
     assert_eq!(turned_on, FC_ERROR_OUT_OF_MEMORY, "{turned_on_message}");
