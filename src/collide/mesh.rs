@@ -417,11 +417,16 @@ impl MeshCollider {
             )
             .inflated(reach)
         }));
+        // Each tree refit when it holds as many items, else built (a build refused by the
+        // allocator last time is made again).
         if self.tri_bvh.len() == self.tri_boxes.len() {
             self.tri_bvh.refit(&self.tri_boxes);
-            self.vert_bvh.refit(&self.vert_boxes);
         } else {
             self.tri_bvh = Bvh::try_build(&self.tri_boxes).map_err(|_| self.no_room())?;
+        }
+        if self.vert_bvh.len() == self.vert_boxes.len() {
+            self.vert_bvh.refit(&self.vert_boxes);
+        } else {
             self.vert_bvh = Bvh::try_build(&self.vert_boxes).map_err(|_| self.no_room())?;
         }
         // The active edges may change as the mesh deforms: rebuilt, unless the same count.
