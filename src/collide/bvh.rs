@@ -498,6 +498,8 @@ impl Bvh {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     #[test]
     fn the_nodes_fit_their_room() {
         // `try_build` reserves 4n / LEAF + 1 nodes: the tree never needs more (a push past it
@@ -527,7 +529,6 @@ mod tests {
             }
         }
     }
-    use super::*;
 
     fn boxes(n: usize) -> Vec<Aabb> {
         let mut seed = 3u64;
