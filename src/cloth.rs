@@ -206,7 +206,8 @@ impl Cloth {
         let history_bytes = match scheme {
             Scheme::Truncated { u } => 24 * u64::from(u),
             Scheme::Full => 0, // grows step by step, each step's room reserved fallibly
-            Scheme::SumOfExponentials { .. } => 24 * 64,
+            // Up to 64 modes, and two more samples when folds are deferred.
+            Scheme::SumOfExponentials { .. } => 24 * (64 + 2),
             Scheme::Off => 0,
         };
         let self_collision_bytes = if config.model.self_collision_thickness > 0.0 {

@@ -294,6 +294,37 @@ fn steps_do_not_allocate() {
             "a moving mesh collider: {during} allocations in 30 frames"
         );
     }
+    // A cloth whose SOE history defers every other fold (its modes past
+    // `DEFER_FROM_BYTES`): the passes that take their sum ahead, those that fold two samples,
+    // and the substep snapshots that copy the pending sample allocate nothing. On the calling
+    // thread, which is the one counted.
+    {
+        let spec = SceneSpec {
+            width: 211,
+            height: 211,
+            scheme: Scheme::DEFAULT,
+            dt: 2e-4,
+            ..SceneSpec::paper(SceneKind::Swing, Variant::Fractional)
+        };
+        let mut scene = spec.build().unwrap();
+        scene.cloth.set_threads(1).unwrap();
+        let soe = match scene.cloth.history() {
+            fraccloth::history::History::SumOfExponentials(s) => s,
+            _ => unreachable!("the SOE scheme"),
+        };
+        assert!(soe.defers_folds());
+        for _ in 0..3 {
+            scene.step().unwrap();
+        }
+        scene.cloth.step_substeps(1e-3, 4).unwrap();
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for _ in 0..5 {
+            scene.step().unwrap();
+            scene.cloth.step_substeps(1e-3, 3).unwrap();
+        }
+        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert_eq!(during, 0, "a deferring SOE history: {during} allocations");
+    }
     // The counter does count: building a cloth allocates.
     let before = ALLOCATIONS.load(Ordering::Relaxed);
     let _ = SceneSpec::paper(SceneKind::Swing, Variant::Fractional)

@@ -3,7 +3,7 @@
 //! model, history scheme and integrator, with a collider. The cloth is large enough
 //! (> `parallel::MIN_PARALLEL` particles) for the passes to be split among threads.
 
-use fraccloth::history::Scheme;
+use fraccloth::history::{HalfDerivative, Scheme};
 use fraccloth::topology::grid_index;
 use fraccloth::{forces::Sphere, Cloth, ClothConfig, GridSpec, Integrator, RegularDrag, Vec3};
 use fraccloth_tools::scenes::Variant;
@@ -12,12 +12,16 @@ const W: u32 = 131;
 const H: u32 = 129;
 
 fn cloth(variant: Variant, scheme: Scheme, integrator: Integrator) -> Cloth {
+    cloth_sized(W, H, variant, scheme, integrator)
+}
+
+fn cloth_sized(w: u32, h: u32, variant: Variant, scheme: Scheme, integrator: Integrator) -> Cloth {
     let spacing = 0.01;
     let topology = GridSpec {
-        width: W,
-        height: H,
+        width: w,
+        height: h,
         spacing,
-        total_mass: 0.24 / 2501.0 * f64::from(W * H),
+        total_mass: 0.24 / 2501.0 * f64::from(w * h),
     }
     .build()
     .unwrap();
@@ -30,7 +34,7 @@ fn cloth(variant: Variant, scheme: Scheme, integrator: Integrator) -> Cloth {
         ..ClothConfig::default()
     };
     let mut c = Cloth::new(topology, config).unwrap();
-    let top: Vec<u32> = (0..W).map(|i| grid_index(W, i, 0)).collect();
+    let top: Vec<u32> = (0..w).map(|i| grid_index(w, i, 0)).collect();
     c.set_pinned(&top).unwrap();
     c.add_sphere(Sphere {
         center: Vec3::new(0.0, -0.6, 0.08),
@@ -42,7 +46,10 @@ fn cloth(variant: Variant, scheme: Scheme, integrator: Integrator) -> Cloth {
 }
 
 fn run(threads: usize, variant: Variant, scheme: Scheme, integrator: Integrator) -> Vec<u64> {
-    let mut c = cloth(variant, scheme, integrator);
+    run_cloth(threads, cloth(variant, scheme, integrator), variant, integrator)
+}
+
+fn run_cloth(threads: usize, mut c: Cloth, variant: Variant, integrator: Integrator) -> Vec<u64> {
     let dt = if integrator == Integrator::ImplicitEuler {
         1.0 / 60.0
     } else if variant == Variant::Underwater {
@@ -115,6 +122,44 @@ fn bitwise_identical_for_1_2_and_8_threads() {
             .count();
         assert!(moved > (W * H) as usize, "{moved}");
     }
+}
+
+/// A cloth whose SOE modes pass `DEFER_FROM_BYTES` folds every other step
+/// (`SumOfExponentials::with_deferred_fold`): its passes that take the sum ahead and those that
+/// fold two samples split over the pool as the others do, with the same bits.
+#[test]
+fn a_cloth_that_defers_its_folds_gives_the_same_bits_for_1_2_and_8_threads() {
+    let (w, h) = (211, 211); // 44 521 particles, 17 MB of modes
+    let make = || {
+        cloth_sized(
+            w,
+            h,
+            Variant::Fractional,
+            Scheme::DEFAULT,
+            Integrator::SymplecticEuler,
+        )
+    };
+    let small = cloth(Variant::Fractional, Scheme::DEFAULT, Integrator::SymplecticEuler);
+    // Two more samples a particle when deferring: the pending one and the sum ahead.
+    assert_eq!(
+        make().history().bytes_per_particle(),
+        small.history().bytes_per_particle() + 48
+    );
+    let one = run_cloth(1, make(), Variant::Fractional, Integrator::SymplecticEuler);
+    for threads in [2, 8] {
+        let many = run_cloth(threads, make(), Variant::Fractional, Integrator::SymplecticEuler);
+        let differing = one.iter().zip(&many).filter(|(a, b)| a != b).count();
+        assert_eq!(
+            differing, 0,
+            "{differing} numbers differ between 1 and {threads} threads"
+        );
+    }
+    let rest: Vec<u64> = make()
+        .positions()
+        .iter()
+        .flat_map(|p| p.iter().map(|x| x.to_bits()))
+        .collect();
+    assert!(rest.iter().zip(&one).filter(|(a, b)| a != b).count() > (w * h) as usize);
 }
 
 /// A cloth's own thread setting (`Cloth::set_threads`, `fc_cloth_set_threads`): the calling

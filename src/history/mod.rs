@@ -36,9 +36,9 @@ pub use scheme::{
     Scheme, DEFAULT_SOE_HORIZON, DEFAULT_SOE_MIN_DT, DEFAULT_SOE_TOLERANCE, MAX_HISTORY_BYTES,
     MAX_TRUNCATED_U,
 };
-pub use soe::SumOfExponentials;
 /// Particles per block of the SOE mode store (a step's pass hands the history whole blocks).
 pub(crate) use soe::LANES as SOE_BLOCK;
+pub use soe::{defers_folds, SumOfExponentials, DEFER_FROM_BYTES, DEFER_VARIABLE};
 pub use soe_kernel::SoeKernel;
 pub use state::History;
 pub use truncated::{eq6_weights, Truncated};

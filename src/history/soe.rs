@@ -61,6 +61,31 @@ fn phi(z: f64) -> (f64, f64) {
     }
 }
 
+/// Bytes of modes from which a cloth's SOE history defers every other fold
+/// ([`SumOfExponentials::with_deferred_fold`]): where the modes no longer fit the caches and
+/// the step streams them from memory. Measured with `step_cycles fractional` (docs/benchmarks.md,
+/// stop 52).
+pub const DEFER_FROM_BYTES: usize = 16 << 20;
+
+/// Environment variable that turns the deferred fold on (`1`) or off (`0`) at every size (read
+/// once), for measurement; the choice by size ([`DEFER_FROM_BYTES`]) when unset or not 0/1.
+pub const DEFER_VARIABLE: &str = "FRACCLOTH_SOE_DEFER";
+
+/// Whether a cloth's SOE history of `n` particles and `modes` modes defers every other fold.
+pub fn defers_folds(n: usize, modes: usize) -> bool {
+    static SET: std::sync::OnceLock<Option<bool>> = std::sync::OnceLock::new();
+    let set = *SET.get_or_init(|| match std::env::var(DEFER_VARIABLE).ok()?.trim() {
+        "1" => Some(true),
+        "0" => Some(false),
+        _ => None,
+    });
+    set.unwrap_or(
+        n.saturating_mul(modes)
+            .saturating_mul(std::mem::size_of::<Vec3>())
+            >= DEFER_FROM_BYTES,
+    )
+}
+
 /// Particles per block of the mode store: two AVX-512 registers of f64, four of AVX2 (16 was
 /// faster than 8, 32 or 256 on the 61 x 41 throughput cloth: `examples/step_cycles.rs`).
 pub(crate) const LANES: usize = 16;
@@ -103,6 +128,21 @@ pub struct SumOfExponentials {
     coef: ModeCoefficients,
     /// What the pass begun last does (read by [`Self::end`]).
     plan: Plan,
+    /// Whether folds are deferred every other step ([`Self::with_deferred_fold`]).
+    defer: bool,
+    /// Deferring: the sample of a step whose fold waits for the next pass that folds (with
+    /// the newest one after it); spare room otherwise. Empty when not deferring.
+    pending_v: Vec<Vec3>,
+    /// Deferring: per particle, `sum_l w_l e^{-2 s_l g} M_l` over the stored modes and the
+    /// gap `g = clock.gap`, the part of the next step's sum that needs the modes when that
+    /// step is of the same size (see [`Self::with_deferred_fold`]). Empty when not deferring.
+    ahead: Vec<Vec3>,
+    /// Whether `ahead` holds that sum for the stored modes and gap.
+    ahead_valid: bool,
+    /// The first panel's coefficients of a pass that folds two.
+    coef_first: ModeCoefficients,
+    /// `w_l e^{-2 s_l g}` of the pass that fills `ahead`.
+    ahead_coef: Vec<f64>,
 }
 
 /// Where the history stands in time.
@@ -116,6 +156,9 @@ struct Clock {
     gap: f64,
     /// The size of the step that followed `newest`, while it waits to be folded.
     recorded: Option<f64>,
+    /// Deferring: the size of the step that followed `pending_v`, which waits to be folded
+    /// before `newest` (set only while `recorded` is).
+    pending: Option<f64>,
 }
 
 impl Clock {
@@ -152,6 +195,14 @@ impl ModeCoefficients {
 struct Plan {
     /// Fold the recorded sample (which followed a step of this size) before summing.
     fold: Option<f64>,
+    /// Deferring: fold the pending sample first, over this many modes (its coefficients in
+    /// `coef_first`), so that the pass folds two panels.
+    first: Option<usize>,
+    /// Deferring: the sum is `ahead + light v_n` (the modes are not read), `light` being
+    /// `sum_l next_l b_l` of the fold this pass leaves for later.
+    light: Option<f64>,
+    /// Deferring: the pass also fills `ahead` for the modes it leaves.
+    ahead: bool,
     /// Modes folded and summed: a prefix, the others being negligible over the step.
     k: usize,
     /// `sum_l w_l g phi_o(s_l g)`: the shift's share of the sum (module docs).
@@ -168,6 +219,17 @@ struct Plan {
 /// summed nor folded; at 1/24 s steps that leaves out the four fastest of 16.
 fn active_modes(kernel: &SoeKernel, cut: f64, g: f64) -> usize {
     kernel.rates.partition_point(|&s| s * g <= cut)
+}
+
+/// Fills `out` with `S`'s coefficients `w_l e^{-2 s_l g}` for the modes that matter over a
+/// gap `g` (deferring; [`SumOfExponentials::with_deferred_fold`]) and returns their count.
+fn ahead_coefficients(kernel: &SoeKernel, cut: f64, g: f64, out: &mut [f64]) -> usize {
+    let k = active_modes(kernel, cut, g);
+    for l in 0..k {
+        let e = (-kernel.rates[l] * g).exp();
+        out[l] = kernel.weights[l] * e * e;
+    }
+    k
 }
 
 /// Plans the pass of the step about to be taken and fills `c` for its modes.
@@ -204,6 +266,7 @@ fn plan(kernel: &SoeKernel, cut: f64, clock: &Clock, c: &mut ModeCoefficients) -
             shift,
             restart: false,
             zero: clock.first,
+            ..Plan::default()
         };
     };
     let (needed, shift) = sum_over(c, h);
@@ -241,6 +304,7 @@ fn plan(kernel: &SoeKernel, cut: f64, clock: &Clock, c: &mut ModeCoefficients) -
         restart: clock.has_prev && needed > kept,
         // No history before the first sample: its sum is zero up to rounding, and taken as 0.
         zero: !clock.has_prev,
+        ..Plan::default()
     }
 }
 
@@ -259,6 +323,12 @@ impl Clone for SumOfExponentials {
             cut: self.cut,
             coef: self.coef.clone(),
             plan: self.plan,
+            defer: self.defer,
+            pending_v: self.pending_v.clone(),
+            ahead: self.ahead.clone(),
+            ahead_valid: self.ahead_valid,
+            coef_first: self.coef_first.clone(),
+            ahead_coef: self.ahead_coef.clone(),
         }
     }
 
@@ -273,6 +343,10 @@ impl Clone for SumOfExponentials {
         self.w_prev = source.w_prev;
         self.cut = source.cut;
         self.plan = source.plan;
+        self.defer = source.defer;
+        self.pending_v.clone_from(&source.pending_v);
+        self.ahead.clone_from(&source.ahead);
+        self.ahead_valid = source.ahead_valid;
         // Scratch: contents need not be copied, only room kept.
         let k = source.kernel.len();
         for mine in [
@@ -281,6 +355,12 @@ impl Clone for SumOfExponentials {
             &mut self.coef.b,
             &mut self.coef.next,
             &mut self.coef.alpha,
+            &mut self.coef_first.decay,
+            &mut self.coef_first.a,
+            &mut self.coef_first.b,
+            &mut self.coef_first.next,
+            &mut self.coef_first.alpha,
+            &mut self.ahead_coef,
         ] {
             mine.resize(k, 0.0);
         }
@@ -321,7 +401,58 @@ impl SumOfExponentials {
             w_prev: 0.0,
             coef: ModeCoefficients::new(k),
             plan: Plan::default(),
+            defer: false,
+            pending_v: Vec::new(),
+            ahead: Vec::new(),
+            ahead_valid: false,
+            coef_first: ModeCoefficients::new(k),
+            ahead_coef: vec![0.0; k],
         }
+    }
+
+    /// Defers every other fold (`on`), or folds every step (the default).
+    ///
+    /// A step's pass reads and writes every mode (`16 x 3` numbers a particle with the default
+    /// kernel): past the caches that is most of the bytes a fractional step streams. Deferring,
+    /// a pass that folds also sums, for each particle, `S = sum_l w_l e^{-2 s_l h} M_l` (`h`
+    /// the step just folded), the part of the next step's sum that needs the modes when that
+    /// step is of the same size `h`; the next pass then takes the sum as
+    /// `S + (sum_l next_l b_l) v_n` without reading the modes, and leaves `v_n` pending; the
+    /// pass after folds both samples, one after the other, with the same fused multiply-adds
+    /// as two passes would. So the modes are read and written every other step, and hold the
+    /// same bits as without deferring; the sums of the steps that do not read the modes differ
+    /// from the direct sum by rounding (the same terms, grouped otherwise). Steps of another
+    /// size, a refused step's retry, or a mode that restarts take a full pass.
+    pub fn with_deferred_fold(mut self, on: bool) -> Self {
+        self.defer = on;
+        let n = if on { self.n } else { 0 };
+        self.pending_v = vec![Vec3::zeros(); n];
+        self.ahead = vec![Vec3::zeros(); n];
+        self.ahead_valid = false;
+        self.clock.pending = None;
+        self
+    }
+
+    /// Whether folds are deferred every other step.
+    pub fn defers_folds(&self) -> bool {
+        self.defer
+    }
+
+    /// Whether the next pass may take its sum from `ahead`: deferring, nothing pending, and a
+    /// recorded sample after a step of the size the last fold's `ahead` was summed for.
+    fn light_eligible(&self) -> bool {
+        self.defer
+            && self.ahead_valid
+            && self.clock.has_prev
+            && self.clock.pending.is_none()
+            && self.clock.recorded == Some(self.clock.gap)
+    }
+
+    /// Whether a snapshot folds the recorded sample into its copy of the state (the bytes are
+    /// then those a refused step's pass would have left); not when the next pass would take
+    /// its sum from `ahead`, which the loaded state sums again from the same modes.
+    pub(crate) fn snapshot_folds(&self) -> bool {
+        self.clock.recorded.is_some() && !self.light_eligible()
     }
 
     /// Number of exponential modes.
@@ -350,24 +481,83 @@ impl SumOfExponentials {
     /// step recorded. The caller then fills `H_n` of every particle exactly once through the
     /// returned pass (in ranges that start on a block of `LANES`) and calls [`Self::end`].
     pub(crate) fn begin(&mut self) -> SoePass<'_> {
+        self.begin_pass(true)
+    }
+
+    /// [`Self::begin`]; `allow_light`: whether the pass may leave the recorded sample
+    /// pending (else it folds whatever waits).
+    fn begin_pass(&mut self, allow_light: bool) -> SoePass<'_> {
         self.set_weights();
-        self.plan = plan(&self.kernel, self.cut, &self.clock, &mut self.coef);
+        let light = allow_light && self.light_eligible();
+        let (kernel, cut) = (&self.kernel, self.cut);
+        let mut first = None;
+        if let Some(hp) = self.clock.pending {
+            // Two panels: the pending sample's (its plan is the one the pass that left it
+            // pending had), then the newest's, from the clock the first leaves.
+            let one = Clock {
+                recorded: Some(hp),
+                pending: None,
+                ..self.clock
+            };
+            let p1 = plan(kernel, cut, &one, &mut self.coef_first);
+            // Left pending only when its modes were those kept (`light_eligible`).
+            debug_assert!(!p1.restart && !p1.zero && p1.fold == Some(hp));
+            first = Some(p1.k);
+            let two = Clock {
+                has_prev: true,
+                first: false,
+                gap: hp,
+                recorded: self.clock.recorded,
+                pending: None,
+            };
+            self.plan = plan(kernel, cut, &two, &mut self.coef);
+        } else {
+            self.plan = plan(kernel, cut, &self.clock, &mut self.coef);
+        }
+        self.plan.first = first;
+        self.plan.light = None;
+        self.plan.ahead = false;
+        if light {
+            // `S + (sum_l next_l b_l) v_n`: the fold's sum without its modes.
+            let c = &self.coef;
+            let k = self.plan.k;
+            self.plan.light = Some((0..k).fold(0.0, |s, l| c.next[l].mul_add(c.b[l], s)));
+        } else if let (true, Some(h)) = (self.defer, self.plan.fold) {
+            self.plan.ahead = true;
+            let k = ahead_coefficients(&self.kernel, self.cut, h, &mut self.ahead_coef);
+            debug_assert_eq!(k, self.plan.k);
+        }
         let block = self.block();
-        let (c, v) = Coefficients::of(&self.coef, self.plan, self.w_prev, &self.prev, &self.newest);
+        let (mut c, v) = Coefficients::of(&self.coef, self.plan, self.w_prev, &self.prev, &self.newest);
+        c.first = first.map(|k| (&self.coef_first.decay[..k], &self.coef_first.b[..k]));
+        if self.plan.ahead {
+            c.ahead = &self.ahead_coef[..self.plan.k];
+        }
+        c.light = self.plan.light;
         SoePass {
             c,
             w0: self.w0,
             n: self.n,
             block,
-            prev: &self.prev,
+            // The panel before the newest: the pending one when two are folded.
+            prev: if first.is_some() {
+                &self.pending_v
+            } else {
+                &self.prev
+            },
             v,
             modes: parallel::Disjoint::new(&mut self.modes),
+            ahead: parallel::Disjoint::new(&mut self.ahead),
         }
     }
 
     /// Ends the pass begun by `Self::begin`, which covered every particle: the recorded
-    /// sample is now folded in.
+    /// sample (and a pending one) is now folded in, unless the pass left it pending.
     pub(crate) fn end(&mut self) {
+        if self.plan.light.take().is_some() {
+            // Nothing moved: `record` leaves the sample pending when the step is accepted.
+            return;
+        }
         if let Some(h) = self.plan.fold.take() {
             std::mem::swap(&mut self.prev, &mut self.newest);
             self.clock = Clock {
@@ -375,22 +565,26 @@ impl SumOfExponentials {
                 has_prev: true,
                 gap: h,
                 recorded: None,
+                pending: None,
             };
+            self.ahead_valid = std::mem::take(&mut self.plan.ahead);
+            self.plan.first = None;
         }
     }
 
     /// Records the velocities `v` (one per particle) of the accepted step of size `h`, for the
     /// next pass to fold, by swapping buffers: `v` receives spare room of the same length.
     pub(crate) fn record(&mut self, v: &mut Vec<Vec3>, h: f64) {
-        self.flush();
+        if self.light_eligible() {
+            // The sample the step's pass left for later waits for the next pass that folds.
+            std::mem::swap(&mut self.pending_v, &mut self.newest);
+            self.clock.pending = self.clock.recorded;
+        } else {
+            self.flush();
+        }
         debug_assert_eq!(v.len(), self.n);
         std::mem::swap(&mut self.newest, v);
         self.clock.recorded = Some(h);
-    }
-
-    /// True when a recorded sample waits to be folded by the next step's pass.
-    pub(crate) fn has_pending_fold(&self) -> bool {
-        self.clock.recorded.is_some()
     }
 
     /// Particles.
@@ -449,7 +643,7 @@ impl SumOfExponentials {
         }
         let n = self.n;
         {
-            let pass = self.begin();
+            let pass = self.begin_pass(false);
             parallel::for_chunks(parallel::worth_it(n), n, parallel::CHUNK, |first, len| {
                 // Whole blocks per tile, so every tile but a chunk's last starts on a block.
                 let mut out = [Vec3::zeros(); 16 * LANES];
@@ -466,6 +660,9 @@ impl SumOfExponentials {
 
     /// Writes the state a later step depends on (the step weights are recomputed by `prepare`).
     pub(crate) fn write_state(&self, w: &mut crate::bytes::ByteWriter) {
+        // A pending sample is folded into the copy written (`History::write_state`); only
+        // the count of bytes may be taken from a state that holds one (the same count).
+        debug_assert!(self.clock.pending.is_none() || w.is_counting());
         // Particle by particle, mode by mode, x y z: independent of the block layout in memory.
         w.u64((self.n * self.kernel.len() * 3) as u64);
         for p in 0..self.n {
@@ -516,9 +713,51 @@ impl SumOfExponentials {
             first: flags & 2 != 0,
             gap,
             recorded: (flags & 4 != 0).then_some(recorded),
+            pending: None,
         };
         self.plan = Plan::default();
+        self.recompute_ahead();
         Ok(())
+    }
+
+    /// Sums `ahead` again from the stored modes (deferring, after a state is read): the same
+    /// fused multiply-adds in the same order as the pass that filled it, so the same bits.
+    fn recompute_ahead(&mut self) {
+        self.ahead_valid = false;
+        if !(self.defer && self.clock.has_prev) {
+            return;
+        }
+        let k = ahead_coefficients(&self.kernel, self.cut, self.clock.gap, &mut self.ahead_coef);
+        let coef = &self.ahead_coef[..k];
+        // A summing pass: `next` is not used but must cover the same modes.
+        let c = Coefficients {
+            decay: coef,
+            a: coef,
+            b: coef,
+            next: coef,
+            shift: 0.0,
+            restart: false,
+            fold: false,
+            zero: false,
+            w_prev: 0.0,
+            first: None,
+            ahead: coef,
+            light: None,
+        };
+        let block = self.block();
+        let mut sums = [Vec3::zeros(); LANES];
+        for b in 0..self.n.div_ceil(LANES) {
+            let (p0, p1) = (b * LANES, ((b + 1) * LANES).min(self.n));
+            pass_blocks(
+                &c,
+                &self.prev[p0..p1],
+                &self.prev[p0..p1],
+                &mut self.modes[b * block..(b + 1) * block],
+                &mut sums[..p1 - p0],
+                &mut self.ahead[p0..p1],
+            );
+        }
+        self.ahead_valid = true;
     }
 }
 
@@ -532,6 +771,9 @@ pub(crate) struct SoePass<'a> {
     /// The newest sample: the recorded one when folding, else the newest folded one.
     v: &'a [Vec3],
     modes: parallel::Disjoint<'a, f64>,
+    /// Deferring: `S` per particle, read by a pass that leaves its fold for later, written by
+    /// one that fills it; empty otherwise.
+    ahead: parallel::Disjoint<'a, Vec3>,
 }
 
 impl SoePass<'_> {
@@ -554,13 +796,32 @@ impl SoePass<'_> {
             first % LANES == 0 && (end % LANES == 0 || end == self.n) && end <= self.n,
             "SOE pass range {first}..{end} is not aligned to blocks"
         );
+        if let Some(light) = self.c.light {
+            // SAFETY: this range's particles belong to no other live range (as above).
+            let ahead = unsafe { self.ahead.range(first..end) };
+            light_sums(&self.c, light, &self.v[first..end], ahead, out);
+            return;
+        }
         let blocks = first / LANES..end.div_ceil(LANES);
         // SAFETY: the blocks of this range belong to no other live range (the contract above).
         let modes = unsafe {
             self.modes
                 .range(blocks.start * self.block..blocks.end * self.block)
         };
-        pass_blocks_widest(&self.c, &self.prev[first..end], &self.v[first..end], modes, out);
+        let ahead: &mut [Vec3] = if self.c.ahead.is_empty() {
+            &mut []
+        } else {
+            // SAFETY: as the modes.
+            unsafe { self.ahead.range(first..end) }
+        };
+        pass_blocks_widest(
+            &self.c,
+            &self.prev[first..end],
+            &self.v[first..end],
+            modes,
+            out,
+            ahead,
+        );
     }
 }
 
@@ -576,6 +837,12 @@ impl HalfDerivative for SumOfExponentials {
     fn past_range(&self, first: usize, out: &mut [Vec3]) {
         // Read only: a recorded sample is folded into copies of the modes. Not on a step's
         // path (which uses `begin`), so it may allocate.
+        if self.clock.pending.is_some() {
+            // Two samples wait: fold both in a copy of the whole history.
+            let mut copy = self.clone();
+            copy.flush();
+            return copy.past_range(first, out);
+        }
         let mut coef = ModeCoefficients::new(self.kernel.len());
         let p = plan(&self.kernel, self.cut, &self.clock, &mut coef);
         let (c, v) = Coefficients::of(&coef, p, self.w_prev, &self.prev, &self.newest);
@@ -592,6 +859,7 @@ impl HalfDerivative for SumOfExponentials {
                 &v[p0..p1],
                 &mut modes,
                 &mut sums[..p1 - p0],
+                &mut [],
             );
             // The part of the block inside the range.
             let (a, z) = (p0.max(first), p1.min(end));
@@ -608,13 +876,17 @@ impl HalfDerivative for SumOfExponentials {
     }
 
     fn bytes_per_particle(&self) -> usize {
-        (self.kernel.len() + 2) * std::mem::size_of::<Vec3>()
+        // Deferring keeps two more samples a particle: the pending one and `ahead`.
+        (self.kernel.len() + 2 + 2 * usize::from(self.defer)) * std::mem::size_of::<Vec3>()
     }
 
     fn reset(&mut self) {
         self.modes.fill(0.0);
         self.prev.fill(Vec3::zeros());
         self.newest.fill(Vec3::zeros());
+        self.pending_v.fill(Vec3::zeros());
+        self.ahead.fill(Vec3::zeros());
+        self.ahead_valid = false;
         self.clock = Clock::default();
         self.plan = Plan::default();
     }
@@ -635,6 +907,13 @@ struct Coefficients<'a> {
     /// Whether the sum is taken as zero (the first sample).
     zero: bool,
     w_prev: f64,
+    /// A first panel folded before the newest (deferring): its `decay` and `b` per mode; its
+    /// sample is `prev` (no mode restarts in it).
+    first: Option<(&'a [f64], &'a [f64])>,
+    /// Deferring: the coefficients of `ahead` (empty when the pass does not fill it).
+    ahead: &'a [f64],
+    /// Deferring: the sum is `ahead + light v_n`, the modes not read.
+    light: Option<f64>,
 }
 
 impl<'a> Coefficients<'a> {
@@ -658,21 +937,33 @@ impl<'a> Coefficients<'a> {
             fold: p.fold.is_some(),
             zero: p.zero,
             w_prev,
+            first: None,
+            ahead: &[],
+            light: None,
         };
         (c, if p.fold.is_some() { newest } else { prev })
     }
 }
 
-crate::simd_dispatch! { fn pass_blocks_widest(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64], out: &mut [Vec3]) => pass_blocks }
+crate::simd_dispatch! { fn pass_blocks_widest(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64], out: &mut [Vec3], ahead: &mut [Vec3]) => pass_blocks }
 
 /// [`pass_block`] for consecutive blocks: `prev` and `v` hold their particles (the last block
-/// may be partial), `modes` and `out` their modes and sums.
+/// may be partial), `modes` and `out` their modes and sums, `ahead` their `S` when the pass
+/// fills it (else it is empty).
 #[inline(always)]
-fn pass_blocks(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64], out: &mut [Vec3]) {
+fn pass_blocks(
+    c: &Coefficients<'_>,
+    prev: &[Vec3],
+    v: &[Vec3],
+    modes: &mut [f64],
+    out: &mut [Vec3],
+    ahead: &mut [Vec3],
+) {
     // A block holds every mode of the kernel; `c` may cover only the first few (the rest are
     // negligible over this step and are left alone).
     let block = modes.len() / out.len().div_ceil(LANES);
     debug_assert!(block >= c.next.len() * 3 * LANES);
+    let with_ahead = !c.ahead.is_empty();
     for (b, (m, o)) in modes
         .chunks_exact_mut(block)
         .zip(out.chunks_mut(LANES))
@@ -681,10 +972,36 @@ fn pass_blocks(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64
         let p0 = b * LANES;
         let p1 = (p0 + LANES).min(v.len());
         let (prev, v) = (&prev[p0..p1], &v[p0..p1]);
-        match (c.fold, c.restart) {
-            (true, true) => pass_block::<true, true>(c, prev, v, m, o),
-            (true, false) => pass_block::<true, false>(c, prev, v, m, o),
-            (false, _) => pass_block::<false, false>(c, prev, v, m, o),
+        if let Some((decay, b)) = c.first {
+            fold_first(decay, b, prev, m);
+        }
+        let s: &mut [Vec3] = if with_ahead { &mut ahead[p0..p1] } else { &mut [] };
+        match (c.fold, c.restart, with_ahead) {
+            (true, true, false) => pass_block::<true, true, false>(c, prev, v, m, o, s),
+            (true, false, false) => pass_block::<true, false, false>(c, prev, v, m, o, s),
+            (true, true, true) => pass_block::<true, true, true>(c, prev, v, m, o, s),
+            (true, false, true) => pass_block::<true, false, true>(c, prev, v, m, o, s),
+            (false, _, false) => pass_block::<false, false, false>(c, prev, v, m, o, s),
+            (false, _, true) => pass_block::<false, false, true>(c, prev, v, m, o, s),
+        }
+    }
+}
+
+/// Folds the first of two panels (deferring) into one block's modes: `M <- decay M + b v`,
+/// the fused multiply-add of [`pass_block`]'s fold without a restarting mode, so the modes
+/// get the bits two passes would give them.
+#[inline(always)]
+fn fold_first(decay: &[f64], b: &[f64], v: &[Vec3], modes: &mut [f64]) {
+    const W: usize = 3 * LANES;
+    let mut vn = [0.0; W];
+    for (q, x) in v.iter().enumerate() {
+        for d in 0..3 {
+            vn[d * LANES + q] = x[d];
+        }
+    }
+    for ((mode, &decay), &b) in modes.chunks_exact_mut(W).zip(decay).zip(b) {
+        for k in 0..W {
+            mode[k] = decay.mul_add(mode[k], b * vn[k]);
         }
     }
 }
@@ -693,13 +1010,15 @@ fn pass_blocks(c: &Coefficients<'_>, prev: &[Vec3], v: &[Vec3], modes: &mut [f64
 /// `FOLD`, and writes each particle's `H` into `out`. Same arithmetic, in the same order, for
 /// every particle as a scalar loop over its modes; laid out so it vectorises across lanes.
 /// `WITH_PREV`: whether the `a v_{n-1}` term is added (some `a` is not zero).
+/// `AHEAD`: whether the block's `S` is summed into `ahead` (deferring).
 #[inline(always)]
-fn pass_block<const FOLD: bool, const WITH_PREV: bool>(
+fn pass_block<const FOLD: bool, const WITH_PREV: bool, const AHEAD: bool>(
     c: &Coefficients<'_>,
     prev: &[Vec3],
     v: &[Vec3],
     modes: &mut [f64],
     out: &mut [Vec3],
+    ahead: &mut [Vec3],
 ) {
     const W: usize = 3 * LANES;
     // Component-major, as the modes: entry d * LANES + q is component d of lane q.
@@ -714,8 +1033,10 @@ fn pass_block<const FOLD: bool, const WITH_PREV: bool>(
         }
     }
     let mut acc = [0.0; W];
+    let mut acc_ahead = [0.0; W];
     for (l, mode) in modes.chunks_exact_mut(W).take(c.next.len()).enumerate() {
         let next = c.next[l];
+        let ahead_l = if AHEAD { c.ahead[l] } else { 0.0 };
         if FOLD {
             let (decay, a, b) = (c.decay[l], c.a[l], c.b[l]);
             for k in 0..W {
@@ -728,11 +1049,22 @@ fn pass_block<const FOLD: bool, const WITH_PREV: bool>(
                 let m = decay.mul_add(mode[k], input);
                 mode[k] = m;
                 acc[k] = next.mul_add(m, acc[k]);
+                if AHEAD {
+                    acc_ahead[k] = ahead_l.mul_add(m, acc_ahead[k]);
+                }
             }
         } else {
             for k in 0..W {
                 acc[k] = next.mul_add(mode[k], acc[k]);
+                if AHEAD {
+                    acc_ahead[k] = ahead_l.mul_add(mode[k], acc_ahead[k]);
+                }
             }
+        }
+    }
+    if AHEAD {
+        for (q, s) in ahead.iter_mut().enumerate() {
+            *s = Vec3::new(acc_ahead[q], acc_ahead[LANES + q], acc_ahead[2 * LANES + q]);
         }
     }
     for (q, o) in out.iter_mut().enumerate().take(v.len()) {
@@ -759,6 +1091,16 @@ impl MulAddVec for f64 {
             self.mul_add(x.y, y.y),
             self.mul_add(x.z, y.z),
         )
+    }
+}
+
+/// A pass that leaves its fold for later (deferring): each particle's sum is
+/// `S + light v_n` instead of the modes' sum, then as in [`pass_block`].
+#[inline(always)]
+fn light_sums(c: &Coefficients<'_>, light: f64, v: &[Vec3], ahead: &[Vec3], out: &mut [Vec3]) {
+    for ((o, &v), &s) in out.iter_mut().zip(v).zip(ahead) {
+        let sum = light.mul_add_vec(v, s);
+        *o = c.w_prev * v + (-c.shift).mul_add_vec(v, sum);
     }
 }
 
@@ -912,5 +1254,149 @@ mod tests {
         approx::assert_relative_eq!(o1, (1.0 - e * (1.0 + z)) / (z * z), max_relative = 1e-9);
         approx::assert_relative_eq!(n1, (z - 1.0 + e) / (z * z), max_relative = 1e-9);
         assert_eq!(phi(0.0), (0.5, 0.5));
+    }
+
+    /// A step's pass over every particle, in tiles of one block as a step hands them out.
+    fn step_pass(h: &mut crate::history::History) -> Vec<Vec3> {
+        let mut out = vec![Vec3::zeros(); N];
+        let p = h.begin_step();
+        for (b, o) in out.chunks_mut(LANES).enumerate() {
+            // SAFETY: disjoint blocks, each once.
+            unsafe { p.past_range(b * LANES, o) };
+        }
+        h.end_step();
+        out
+    }
+
+    fn deferred(kernel: &SoeKernel) -> crate::history::History {
+        crate::history::History::SumOfExponentials(Box::new(
+            SumOfExponentials::new(kernel.clone(), N).with_deferred_fold(true),
+        ))
+    }
+
+    fn soe(h: &crate::history::History) -> &SumOfExponentials {
+        match h {
+            crate::history::History::SumOfExponentials(s) => s,
+            _ => unreachable!("an SOE history"),
+        }
+    }
+
+    fn sample(k: usize) -> Vec<Vec3> {
+        (0..N)
+            .map(|p| {
+                Vec3::new(
+                    (0.3 * k as f64 + p as f64).sin(),
+                    0.1 * p as f64 - 0.5,
+                    (0.7 * k as f64).cos(),
+                )
+            })
+            .collect()
+    }
+
+    /// Steps of one size with a run of coarser ones (four modes left out, then restarting)
+    /// and a change back; step 37 is refused once (its pass runs twice).
+    fn deferred_step(k: usize) -> f64 {
+        match k {
+            20..=22 => 1.0 / 24.0,
+            41..=45 => 2e-3,
+            _ => 1e-3,
+        }
+    }
+
+    #[test]
+    fn deferring_keeps_the_modes_bits_and_the_sums_within_rounding() {
+        let kernel = SoeKernel::build(1e-3, 1e-4, 3600.0).unwrap();
+        let mut every =
+            crate::history::History::SumOfExponentials(Box::new(SumOfExponentials::new(kernel.clone(), N)));
+        let mut other = deferred(&kernel);
+        assert!(soe(&other).defers_folds() && !soe(&every).defers_folds());
+        let (mut light, mut worst, mut scale) = (0, 0.0f64, 0.0f64);
+        for k in 0..70 {
+            for _ in 0..if k == 37 { 2 } else { 1 } {
+                let was_pending = soe(&other).clock.recorded.is_some();
+                let folded_before = soe(&other).clock.recorded.is_none();
+                let (a, b) = (step_pass(&mut every), step_pass(&mut other));
+                let s = soe(&other);
+                if was_pending && s.clock.recorded.is_some() {
+                    light += 1;
+                }
+                if s.clock.recorded.is_none() && !folded_before || k == 0 {
+                    // The deferred history folded everything that waited: the same modes.
+                    let (x, y) = (&soe(&every).modes[..], &s.modes[..]);
+                    assert!(
+                        x.iter().zip(y).all(|(x, y)| x.to_bits() == y.to_bits()),
+                        "step {k}"
+                    );
+                }
+                for (a, b) in a.iter().zip(&b) {
+                    worst = worst.max((a - b).amax());
+                    scale = scale.max(a.amax());
+                }
+            }
+            every.record(&mut sample(k), deferred_step(k));
+            other.record(&mut sample(k), deferred_step(k));
+        }
+        // Every other step of one size left its fold for later (70 steps, 9 of other sizes
+        // or after a change, one retry).
+        assert!(light >= 30, "{light} passes left their fold for later");
+        assert!(scale > 1e-3);
+        assert!(worst <= 1e-13 * scale, "{worst:e} of {scale:e}");
+        // After a flush both hold the same modes and give the same sum.
+        let (mut a, mut b) = (every.clone(), other.clone());
+        if let (
+            crate::history::History::SumOfExponentials(a),
+            crate::history::History::SumOfExponentials(b),
+        ) = (&mut a, &mut b)
+        {
+            a.flush();
+            b.flush();
+            assert!(a
+                .modes
+                .iter()
+                .zip(b.modes.iter())
+                .all(|(x, y)| x.to_bits() == y.to_bits()));
+        }
+        assert_eq!(step_pass(&mut a), step_pass(&mut b));
+    }
+
+    #[test]
+    fn a_deferred_state_written_and_read_continues_bitwise_and_its_bytes_are_canonical() {
+        let kernel = SoeKernel::build(1e-3, 1e-4, 3600.0).unwrap();
+        let bytes = |h: &crate::history::History| {
+            let mut w = crate::bytes::ByteWriter::default();
+            h.write_state(&mut w).unwrap();
+            w.buf
+        };
+        // Saved after every record: nothing pending and the next pass light, a sample
+        // pending, a size change, the coarse steps.
+        let mut phases = std::collections::BTreeSet::new();
+        for save in 1..50 {
+            let mut a = deferred(&kernel);
+            for k in 0..save {
+                step_pass(&mut a);
+                a.record(&mut sample(k), deferred_step(k));
+            }
+            let s = soe(&a);
+            phases.insert((s.clock.pending.is_some(), s.light_eligible()));
+            let written = bytes(&a);
+            // A refused step's pass leaves a state with the same bytes.
+            let mut refused = a.clone();
+            step_pass(&mut refused);
+            assert_eq!(bytes(&refused), written, "saved after {save} steps");
+            let mut b = deferred(&kernel);
+            b.read_state(&mut crate::bytes::ByteReader::new(&written))
+                .unwrap();
+            for k in save..save + 25 {
+                assert_eq!(
+                    step_pass(&mut a),
+                    step_pass(&mut b),
+                    "saved after {save}, step {k}"
+                );
+                a.record(&mut sample(k), deferred_step(k));
+                b.record(&mut sample(k), deferred_step(k));
+            }
+        }
+        // Every phase was saved: pending, light next, neither.
+        assert_eq!(phases.len(), 3, "{phases:?}");
     }
 }

@@ -60,10 +60,13 @@ impl History {
                 tolerance,
                 horizon,
                 min_dt,
-            } => History::SumOfExponentials(Box::new(SumOfExponentials::new(
-                SoeKernel::build(tolerance, min_dt, horizon)?,
-                n,
-            ))),
+            } => {
+                let kernel = SoeKernel::build(tolerance, min_dt, horizon)?;
+                let defer = soe::defers_folds(n, kernel.len());
+                History::SumOfExponentials(Box::new(
+                    SumOfExponentials::new(kernel, n).with_deferred_fold(defer),
+                ))
+            }
         })
     }
 
@@ -117,7 +120,7 @@ impl History {
             History::Off => {}
             History::Truncated(s) => s.write_state(w),
             History::Full(s) => s.write_state(w),
-            History::SumOfExponentials(s) if s.has_pending_fold() && !w.is_counting() => {
+            History::SumOfExponentials(s) if s.snapshot_folds() && !w.is_counting() => {
                 crate::memory::ensure_available(
                     s.bytes_per_particle() as u64 * s.particle_count() as u64,
                     "a snapshot of the SOE history",
@@ -192,6 +195,9 @@ impl History {
 }
 
 /// What one step's pass over the particles reads of the history, from `History::begin_step`.
+// One lives on the stack for the length of a pass; boxing the larger variant would allocate
+// every step.
+#[allow(clippy::large_enum_variant)]
 pub(crate) enum StepPast<'a> {
     /// Schemes whose past is read only.
     Read(&'a History),
