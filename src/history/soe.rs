@@ -799,7 +799,7 @@ impl SoePass<'_> {
         if let Some(light) = self.c.light {
             // SAFETY: this range's particles belong to no other live range (as above).
             let ahead = unsafe { self.ahead.range(first..end) };
-            light_sums(&self.c, light, &self.v[first..end], ahead, out);
+            light_sums_widest(&self.c, light, &self.v[first..end], ahead, out);
             return;
         }
         let blocks = first / LANES..end.div_ceil(LANES);
@@ -1093,6 +1093,8 @@ impl MulAddVec for f64 {
         )
     }
 }
+
+crate::simd_dispatch! { fn light_sums_widest(c: &Coefficients<'_>, light: f64, v: &[Vec3], ahead: &[Vec3], out: &mut [Vec3]) => light_sums }
 
 /// A pass that leaves its fold for later (deferring): each particle's sum is
 /// `S + light v_n` instead of the modes' sum, then as in [`pass_block`].
