@@ -959,11 +959,38 @@ fn pass_blocks(
     out: &mut [Vec3],
     ahead: &mut [Vec3],
 ) {
+    let with_ahead = !c.ahead.is_empty();
+    // A pass that folds two panels always fills `ahead` (`SumOfExponentials::begin_pass`).
+    debug_assert!(c.first.is_none() || (with_ahead && c.fold));
+    // Chosen once for all the blocks, so that each block's loop has no branch on them.
+    match (c.fold, c.restart, with_ahead, c.first.is_some()) {
+        (true, true, false, _) => blocks::<true, true, false, false>(c, prev, v, modes, out, ahead),
+        (true, false, false, _) => blocks::<true, false, false, false>(c, prev, v, modes, out, ahead),
+        (true, true, true, false) => blocks::<true, true, true, false>(c, prev, v, modes, out, ahead),
+        (true, false, true, false) => blocks::<true, false, true, false>(c, prev, v, modes, out, ahead),
+        (true, true, true, true) => blocks::<true, true, true, true>(c, prev, v, modes, out, ahead),
+        (true, false, true, true) => blocks::<true, false, true, true>(c, prev, v, modes, out, ahead),
+        (false, _, false, _) => blocks::<false, false, false, false>(c, prev, v, modes, out, ahead),
+        (false, _, true, _) => blocks::<false, false, true, false>(c, prev, v, modes, out, ahead),
+    }
+}
+
+/// [`pass_blocks`] for one choice of what the pass does: `FIRST`, fold a pending panel first
+/// (deferring; only with `AHEAD`, as every pass that folds two fills `ahead`).
+#[inline(always)]
+fn blocks<const FOLD: bool, const WITH_PREV: bool, const AHEAD: bool, const FIRST: bool>(
+    c: &Coefficients<'_>,
+    prev: &[Vec3],
+    v: &[Vec3],
+    modes: &mut [f64],
+    out: &mut [Vec3],
+    ahead: &mut [Vec3],
+) {
     // A block holds every mode of the kernel; `c` may cover only the first few (the rest are
     // negligible over this step and are left alone).
     let block = modes.len() / out.len().div_ceil(LANES);
     debug_assert!(block >= c.next.len() * 3 * LANES);
-    let with_ahead = !c.ahead.is_empty();
+    debug_assert!(!FIRST || AHEAD);
     for (b, (m, o)) in modes
         .chunks_exact_mut(block)
         .zip(out.chunks_mut(LANES))
@@ -972,18 +999,13 @@ fn pass_blocks(
         let p0 = b * LANES;
         let p1 = (p0 + LANES).min(v.len());
         let (prev, v) = (&prev[p0..p1], &v[p0..p1]);
-        if let Some((decay, b)) = c.first {
-            fold_first(decay, b, prev, m);
+        if FIRST {
+            if let Some((decay, b)) = c.first {
+                fold_first(decay, b, prev, m);
+            }
         }
-        let s: &mut [Vec3] = if with_ahead { &mut ahead[p0..p1] } else { &mut [] };
-        match (c.fold, c.restart, with_ahead) {
-            (true, true, false) => pass_block::<true, true, false>(c, prev, v, m, o, s),
-            (true, false, false) => pass_block::<true, false, false>(c, prev, v, m, o, s),
-            (true, true, true) => pass_block::<true, true, true>(c, prev, v, m, o, s),
-            (true, false, true) => pass_block::<true, false, true>(c, prev, v, m, o, s),
-            (false, _, false) => pass_block::<false, false, false>(c, prev, v, m, o, s),
-            (false, _, true) => pass_block::<false, false, true>(c, prev, v, m, o, s),
-        }
+        let s: &mut [Vec3] = if AHEAD { &mut ahead[p0..p1] } else { &mut [] };
+        pass_block::<FOLD, WITH_PREV, AHEAD>(c, prev, v, m, o, s);
     }
 }
 
