@@ -836,7 +836,8 @@ impl HalfDerivative for SumOfExponentials {
 
     fn past_range(&self, first: usize, out: &mut [Vec3]) {
         // Read only: a recorded sample is folded into copies of the modes. Not on a step's
-        // path (which uses `begin`), so it may allocate.
+        // path (which uses `begin`), so it may allocate. Deferring, this is the direct sum,
+        // which a pass that takes it from `ahead` gives within rounding.
         if self.clock.pending.is_some() {
             // Two samples wait: fold both in a copy of the whole history.
             let mut copy = self.clone();
@@ -963,28 +964,34 @@ fn pass_blocks(
     // A pass that folds two panels always fills `ahead` (`SumOfExponentials::begin_pass`).
     debug_assert!(c.first.is_none() || (with_ahead && c.fold));
     // Chosen once for all the blocks, so that each block's loop has no branch on them.
+    let s = (prev, v, modes, out, ahead);
     match (c.fold, c.restart, with_ahead, c.first.is_some()) {
-        (true, true, false, _) => blocks::<true, true, false, false>(c, prev, v, modes, out, ahead),
-        (true, false, false, _) => blocks::<true, false, false, false>(c, prev, v, modes, out, ahead),
-        (true, true, true, false) => blocks::<true, true, true, false>(c, prev, v, modes, out, ahead),
-        (true, false, true, false) => blocks::<true, false, true, false>(c, prev, v, modes, out, ahead),
-        (true, true, true, true) => blocks::<true, true, true, true>(c, prev, v, modes, out, ahead),
-        (true, false, true, true) => blocks::<true, false, true, true>(c, prev, v, modes, out, ahead),
-        (false, _, false, _) => blocks::<false, false, false, false>(c, prev, v, modes, out, ahead),
-        (false, _, true, _) => blocks::<false, false, true, false>(c, prev, v, modes, out, ahead),
+        (true, true, false, _) => blocks::<true, true, false, false>(c, s),
+        (true, false, false, _) => blocks::<true, false, false, false>(c, s),
+        (true, true, true, false) => blocks::<true, true, true, false>(c, s),
+        (true, false, true, false) => blocks::<true, false, true, false>(c, s),
+        (true, true, true, true) => blocks::<true, true, true, true>(c, s),
+        (true, false, true, true) => blocks::<true, false, true, true>(c, s),
+        (false, _, false, _) => blocks::<false, false, false, false>(c, s),
+        (false, _, true, _) => blocks::<false, false, true, false>(c, s),
     }
 }
+
+/// The slices of [`pass_blocks`]: `prev`, `v`, `modes`, `out`, `ahead`.
+type BlockSlices<'a> = (
+    &'a [Vec3],
+    &'a [Vec3],
+    &'a mut [f64],
+    &'a mut [Vec3],
+    &'a mut [Vec3],
+);
 
 /// [`pass_blocks`] for one choice of what the pass does: `FIRST`, fold a pending panel first
 /// (deferring; only with `AHEAD`, as every pass that folds two fills `ahead`).
 #[inline(always)]
 fn blocks<const FOLD: bool, const WITH_PREV: bool, const AHEAD: bool, const FIRST: bool>(
     c: &Coefficients<'_>,
-    prev: &[Vec3],
-    v: &[Vec3],
-    modes: &mut [f64],
-    out: &mut [Vec3],
-    ahead: &mut [Vec3],
+    (prev, v, modes, out, ahead): BlockSlices<'_>,
 ) {
     // A block holds every mode of the kernel; `c` may cover only the first few (the rest are
     // negligible over this step and are left alone).
@@ -1005,7 +1012,7 @@ fn blocks<const FOLD: bool, const WITH_PREV: bool, const AHEAD: bool, const FIRS
             }
         }
         let s: &mut [Vec3] = if AHEAD { &mut ahead[p0..p1] } else { &mut [] };
-        pass_block::<FOLD, WITH_PREV, AHEAD>(c, prev, v, m, o, s);
+        pass_block::<FOLD, WITH_PREV, AHEAD>(c, (prev, v, m, o, s));
     }
 }
 
@@ -1036,11 +1043,7 @@ fn fold_first(decay: &[f64], b: &[f64], v: &[Vec3], modes: &mut [f64]) {
 #[inline(always)]
 fn pass_block<const FOLD: bool, const WITH_PREV: bool, const AHEAD: bool>(
     c: &Coefficients<'_>,
-    prev: &[Vec3],
-    v: &[Vec3],
-    modes: &mut [f64],
-    out: &mut [Vec3],
-    ahead: &mut [Vec3],
+    (prev, v, modes, out, ahead): BlockSlices<'_>,
 ) {
     const W: usize = 3 * LANES;
     // Component-major, as the modes: entry d * LANES + q is component d of lane q.
@@ -1226,17 +1229,7 @@ mod tests {
                 .map(|p| Vec3::new((0.3 * k as f64 + p as f64).sin(), 0.1 * p as f64, -0.2))
                 .collect()
         };
-        let pass = |h: &mut SumOfExponentials| {
-            let mut out = vec![Vec3::zeros(); N];
-            let p = h.begin();
-            // Tiles of one block, last one partial: as a step's pass hands them out.
-            for (b, o) in out.chunks_mut(LANES).enumerate() {
-                // SAFETY: disjoint blocks, each once.
-                unsafe { p.past_range(b * LANES, o) };
-            }
-            h.end();
-            out
-        };
+        let pass = soe_pass;
         // Steps of two sizes, so that modes are left out and restart.
         let step = |k: usize| if k % 7 < 3 { 1.0 / 24.0 } else { 1e-3 };
         // Nothing recorded yet: no past at all.
@@ -1280,16 +1273,25 @@ mod tests {
         assert_eq!(phi(0.0), (0.5, 0.5));
     }
 
-    /// A step's pass over every particle, in tiles of one block as a step hands them out.
-    fn step_pass(h: &mut crate::history::History) -> Vec<Vec3> {
+    /// A step's pass over every particle, in tiles of one block (the last one partial) as a
+    /// step hands them out.
+    fn soe_pass(h: &mut SumOfExponentials) -> Vec<Vec3> {
         let mut out = vec![Vec3::zeros(); N];
-        let p = h.begin_step();
+        let p = h.begin();
         for (b, o) in out.chunks_mut(LANES).enumerate() {
             // SAFETY: disjoint blocks, each once.
             unsafe { p.past_range(b * LANES, o) };
         }
-        h.end_step();
+        h.end();
         out
+    }
+
+    /// [`soe_pass`] of a history holding SOE.
+    fn step_pass(h: &mut crate::history::History) -> Vec<Vec3> {
+        match h {
+            crate::history::History::SumOfExponentials(s) => soe_pass(s),
+            _ => unreachable!("an SOE history"),
+        }
     }
 
     fn deferred(kernel: &SoeKernel) -> crate::history::History {
