@@ -721,7 +721,8 @@ impl SumOfExponentials {
     }
 
     /// Sums `ahead` again from the stored modes (deferring, after a state is read): the same
-    /// fused multiply-adds in the same order as the pass that filled it, so the same bits.
+    /// fused multiply-adds in the same order as the pass that filled it, so the same bits (at
+    /// the CPU's widest vectors, as the pass).
     fn recompute_ahead(&mut self) {
         self.ahead_valid = false;
         if !(self.defer && self.clock.has_prev) {
@@ -748,7 +749,7 @@ impl SumOfExponentials {
         let mut sums = [Vec3::zeros(); LANES];
         for b in 0..self.n.div_ceil(LANES) {
             let (p0, p1) = (b * LANES, ((b + 1) * LANES).min(self.n));
-            pass_blocks(
+            pass_blocks_widest(
                 &c,
                 &self.prev[p0..p1],
                 &self.prev[p0..p1],
