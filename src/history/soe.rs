@@ -137,8 +137,6 @@ pub struct SumOfExponentials {
     /// gap `g = clock.gap`, the part of the next step's sum that needs the modes when that
     /// step is of the same size (see [`Self::with_deferred_fold`]). Empty when not deferring.
     ahead: Vec<Vec3>,
-    /// Whether `ahead` holds that sum for the stored modes and gap.
-    ahead_valid: bool,
     /// The first panel's coefficients of a pass that folds two.
     coef_first: ModeCoefficients,
     /// `w_l e^{-2 s_l g}` of the pass that fills `ahead`.
@@ -195,14 +193,9 @@ impl ModeCoefficients {
 struct Plan {
     /// Fold the recorded sample (which followed a step of this size) before summing.
     fold: Option<f64>,
-    /// Deferring: fold the pending sample first, over this many modes (its coefficients in
-    /// `coef_first`), so that the pass folds two panels.
-    first: Option<usize>,
     /// Deferring: the sum is `ahead + light v_n` (the modes are not read), `light` being
     /// `sum_l next_l b_l` of the fold this pass leaves for later.
     light: Option<f64>,
-    /// Deferring: the pass also fills `ahead` for the modes it leaves.
-    ahead: bool,
     /// Modes folded and summed: a prefix, the others being negligible over the step.
     k: usize,
     /// `sum_l w_l g phi_o(s_l g)`: the shift's share of the sum (module docs).
@@ -326,7 +319,6 @@ impl Clone for SumOfExponentials {
             defer: self.defer,
             pending_v: self.pending_v.clone(),
             ahead: self.ahead.clone(),
-            ahead_valid: self.ahead_valid,
             coef_first: self.coef_first.clone(),
             ahead_coef: self.ahead_coef.clone(),
         }
@@ -346,7 +338,6 @@ impl Clone for SumOfExponentials {
         self.defer = source.defer;
         self.pending_v.clone_from(&source.pending_v);
         self.ahead.clone_from(&source.ahead);
-        self.ahead_valid = source.ahead_valid;
         // Scratch: contents need not be copied, only room kept.
         let k = source.kernel.len();
         for mine in [
@@ -404,7 +395,6 @@ impl SumOfExponentials {
             defer: false,
             pending_v: Vec::new(),
             ahead: Vec::new(),
-            ahead_valid: false,
             coef_first: ModeCoefficients::new(k),
             ahead_coef: vec![0.0; k],
         }
@@ -428,8 +418,9 @@ impl SumOfExponentials {
         let n = if on { self.n } else { 0 };
         self.pending_v = vec![Vec3::zeros(); n];
         self.ahead = vec![Vec3::zeros(); n];
-        self.ahead_valid = false;
         self.clock.pending = None;
+        // A history that already holds samples gets its `ahead` now.
+        self.recompute_ahead();
         self
     }
 
@@ -439,10 +430,11 @@ impl SumOfExponentials {
     }
 
     /// Whether the next pass may take its sum from `ahead`: deferring, nothing pending, and a
-    /// recorded sample after a step of the size the last fold's `ahead` was summed for.
+    /// recorded sample after a step of the size the last fold's `ahead` was summed for. While
+    /// deferring, `ahead` always holds the sum for the stored modes once they hold a sample:
+    /// every pass that folds fills it, and so do reading a state and turning deferring on.
     fn light_eligible(&self) -> bool {
         self.defer
-            && self.ahead_valid
             && self.clock.has_prev
             && self.clock.pending.is_none()
             && self.clock.recorded == Some(self.clock.gap)
@@ -514,23 +506,22 @@ impl SumOfExponentials {
         } else {
             self.plan = plan(kernel, cut, &self.clock, &mut self.coef);
         }
-        self.plan.first = first;
         self.plan.light = None;
-        self.plan.ahead = false;
+        let mut fills_ahead = false;
         if light {
             // `S + (sum_l next_l b_l) v_n`: the fold's sum without its modes.
             let c = &self.coef;
             let k = self.plan.k;
             self.plan.light = Some((0..k).fold(0.0, |s, l| c.next[l].mul_add(c.b[l], s)));
         } else if let (true, Some(h)) = (self.defer, self.plan.fold) {
-            self.plan.ahead = true;
+            fills_ahead = true;
             let k = ahead_coefficients(&self.kernel, self.cut, h, &mut self.ahead_coef);
             debug_assert_eq!(k, self.plan.k);
         }
         let block = self.block();
         let (mut c, v) = Coefficients::of(&self.coef, self.plan, self.w_prev, &self.prev, &self.newest);
         c.first = first.map(|k| (&self.coef_first.decay[..k], &self.coef_first.b[..k]));
-        if self.plan.ahead {
+        if fills_ahead {
             c.ahead = &self.ahead_coef[..self.plan.k];
         }
         c.light = self.plan.light;
@@ -567,8 +558,6 @@ impl SumOfExponentials {
                 recorded: None,
                 pending: None,
             };
-            self.ahead_valid = std::mem::take(&mut self.plan.ahead);
-            self.plan.first = None;
         }
     }
 
@@ -720,11 +709,11 @@ impl SumOfExponentials {
         Ok(())
     }
 
-    /// Sums `ahead` again from the stored modes (deferring, after a state is read): the same
-    /// fused multiply-adds in the same order as the pass that filled it, so the same bits (at
-    /// the CPU's widest vectors, as the pass).
+    /// Sums `ahead` again from the stored modes (deferring, after a state is read or deferring
+    /// is turned on; nothing before the first sample): the same fused multiply-adds in the
+    /// same order as the pass that filled it, so the same bits (at the CPU's widest vectors,
+    /// as the pass).
     fn recompute_ahead(&mut self) {
-        self.ahead_valid = false;
         if !(self.defer && self.clock.has_prev) {
             return;
         }
@@ -758,7 +747,6 @@ impl SumOfExponentials {
                 &mut self.ahead[p0..p1],
             );
         }
-        self.ahead_valid = true;
     }
 }
 
@@ -888,7 +876,6 @@ impl HalfDerivative for SumOfExponentials {
         self.newest.fill(Vec3::zeros());
         self.pending_v.fill(Vec3::zeros());
         self.ahead.fill(Vec3::zeros());
-        self.ahead_valid = false;
         self.clock = Clock::default();
         self.plan = Plan::default();
     }
