@@ -162,6 +162,42 @@ fn a_cloth_that_defers_its_folds_gives_the_same_bits_for_1_2_and_8_threads() {
     assert!(rest.iter().zip(&one).filter(|(a, b)| a != b).count() > (w * h) as usize);
 }
 
+/// An irregular triangle mesh (random diagonals, jittered) large enough for the pool and for
+/// several groups of the tile walk: its bend springs are summed from choice runs
+/// (`topology::Choice`), and the bits do not depend on the thread count.
+#[test]
+fn an_irregular_mesh_gives_the_same_bits_for_1_2_and_8_threads() {
+    let make = || {
+        let grid = GridSpec {
+            width: W,
+            height: H,
+            spacing: 0.01,
+            total_mass: 1.0,
+        }
+        .build()
+        .unwrap();
+        let topology = fraccloth_tools::scenes::jittered_mesh(&grid, W, 0.5, 7).unwrap();
+        assert_eq!(topology.tile_runs.choices.iter().flatten().count(), 2);
+        let config = ClothConfig {
+            model: Variant::Fractional.model(0.01),
+            ..ClothConfig::default()
+        };
+        let mut c = Cloth::new(topology, config).unwrap();
+        let top: Vec<u32> = (0..W).map(|i| grid_index(W, i, 0)).collect();
+        c.set_pinned(&top).unwrap();
+        c
+    };
+    let one = run_cloth(1, make(), Variant::Fractional, Integrator::SymplecticEuler);
+    for threads in [2, 8] {
+        let many = run_cloth(threads, make(), Variant::Fractional, Integrator::SymplecticEuler);
+        let differing = one.iter().zip(&many).filter(|(a, b)| a != b).count();
+        assert_eq!(
+            differing, 0,
+            "{differing} numbers differ between 1 and {threads} threads"
+        );
+    }
+}
+
 /// A cloth's own thread setting (`Cloth::set_threads`, `fc_cloth_set_threads`): the calling
 /// thread only, its own pool of 3, and the shared pool give the same bits.
 #[test]

@@ -19,7 +19,7 @@ use super::ForceInput;
 use crate::model::SpringDamping;
 use crate::parallel;
 use crate::soa::Soa3;
-use crate::topology::{for_each_piece, SpringKind, SpringRun};
+use crate::topology::{for_each_piece, Choice, SpringKind, SpringRun};
 
 /// What the spring pass reads besides the springs.
 #[derive(Clone, Copy)]
@@ -135,6 +135,33 @@ pub(super) fn compute(p: &Params<'_>, runs: &[SpringRun], parallel: bool, out: &
     });
 }
 
+/// One spring's force on its first end as a multiple `s` of `l` (the force is `s l`), with a
+/// bool, `(f64, bool)`, from `l = x_i - x_j`, the
+/// expression `$dq` giving `q_i - q_j` (evaluated only when damped), the spring's `(k_s, k_d,
+/// rest)` and `$undamped`; the bool says the squared length is outside `[SEED_MIN, SEED_MAX]`
+/// (or NaN), where the slice must be done again exactly. A macro, so that it is expanded in
+/// the dispatched kernels' bodies (a closure left out of line there is compiled without their
+/// vector width and fused multiply-add).
+macro_rules! slot_force {
+    ($l:expr, $dq:expr, $slot:expr, $undamped:expr) => {{
+        let [lx, ly, lz]: [f64; 3] = $l;
+        let (ks, kd, r): (f64, f64, f64) = $slot;
+        let l2 = lx.mul_add(lx, ly.mul_add(ly, lz * lz));
+        let outside = !(SEED_MIN..=SEED_MAX).contains(&l2);
+        let inv = inverse_length(l2);
+        let len = l2 * inv;
+        // F = (mag / |l|) l with mag = -k_s (|l| - r) - k_d (dq . l) / |l|.
+        let mag = if $undamped {
+            -ks * (len - r)
+        } else {
+            let [dx, dy, dz]: [f64; 3] = $dq;
+            let dql = dx.mul_add(lx, dy.mul_add(ly, dz * lz));
+            (-ks).mul_add(len - r, -(kd * inv) * dql)
+        };
+        (mag * inv, outside)
+    }};
+}
+
 crate::simd_dispatch! { pub(super) fn run_widest(p: &Params<'_>, run: &SpringRun, first_spring: usize, out: [&mut [f64]; 3]) => run_kernel_each }
 crate::simd_dispatch! { pub(super) fn run_uniform_widest(p: &Params<'_>, run: &SpringRun, first_spring: usize, rest: f64, out: [&mut [f64]; 3]) => run_kernel_uniform }
 
@@ -206,24 +233,18 @@ fn run_kernel<'a, const UNIFORM: bool, const TWO: bool>(
     // Fused multiply-adds where they save an operation: one rounding each, the same bits on
     // every CPU (see crate::simd).
     for t in 0..n {
-        let (lx, ly, lz) = (xi[t] - xj[t], yi[t] - yj[t], zi[t] - zj[t]);
-        let l2 = lx.mul_add(lx, ly.mul_add(ly, lz * lz));
-        outside |= !(SEED_MIN..=SEED_MAX).contains(&l2);
-        let inv = inverse_length(l2);
-        let len = l2 * inv;
-        let (ks, kd, r) = slot(t);
-        // F = (mag / |l|) l with mag = -k_s (|l| - r) - k_d (dq . l) / |l|.
-        let mag = if undamped {
-            -ks * (len - r)
-        } else {
-            let (dx, dy, dz) = (qxi[t] - qxj[t], qyi[t] - qyj[t], qzi[t] - qzj[t]);
-            let dql = dx.mul_add(lx, dy.mul_add(ly, dz * lz));
-            (-ks).mul_add(len - r, -(kd * inv) * dql)
-        };
-        let s = mag * inv;
-        fx[t] = s * lx;
-        fy[t] = s * ly;
-        fz[t] = s * lz;
+        let l = [xi[t] - xj[t], yi[t] - yj[t], zi[t] - zj[t]];
+        // The rates' difference, read only when damped (the macro expands it there).
+        let (s, out) = slot_force!(
+            l,
+            [qxi[t] - qxj[t], qyi[t] - qyj[t], qzi[t] - qzj[t]],
+            slot(t),
+            undamped
+        );
+        outside |= out;
+        fx[t] = s * l[0];
+        fy[t] = s * l[1];
+        fz[t] = s * l[2];
     }
     if outside {
         exact_kernel(
@@ -235,6 +256,116 @@ fn run_kernel<'a, const UNIFORM: bool, const TWO: bool>(
             slot,
             [&mut *fx, &mut *fy, &mut *fz],
         );
+    }
+}
+
+crate::simd_dispatch! { pub(super) fn run_choice_widest(p: &Params<'_>, run: &SpringRun, choice: &Choice, select: &[u8], first_slot: usize, out: [&mut [f64]; 3]) => run_kernel_choice }
+
+/// Slots `first_slot ..` of the choice run `run` (`crate::topology::Choice`: slot t's ends are at
+/// `key + a[select & 1]` and `key + b[(select >> 1) & 1]`, `key = first_vertex + t`), as many as
+/// `out` holds; `select` holds those slots' select bytes. Each slot loads both places of each
+/// end and keeps one (a select, no gather), then takes the arithmetic of [`run_kernel`]; padding
+/// comes out as garbage, as there.
+#[inline(always)]
+fn run_kernel_choice<'a>(
+    p: &Params<'a>,
+    run: &SpringRun,
+    choice: &Choice,
+    select: &[u8],
+    first_slot: usize,
+    out: [&mut [f64]; 3],
+) {
+    let [fx, fy, fz] = out;
+    let n = fx.len();
+    let (fy, fz, select) = (&mut fy[..n], &mut fz[..n], &select[..n]);
+    let key = run.first_vertex as usize + (first_slot - run.first_spring as usize) - p.base;
+    let ends = |a: [&'a [f64]; 3], s: u32| {
+        let s = key + s as usize;
+        [&a[0][s..s + n], &a[1][s..s + n], &a[2][s..s + n]]
+    };
+    let (xa, xb, xc, xd) = (
+        ends(p.x, choice.a[0]),
+        ends(p.x, choice.a[1]),
+        ends(p.x, choice.b[0]),
+        ends(p.x, choice.b[1]),
+    );
+    let (qa, qb, qc, qd) = (
+        ends(p.q, choice.a[0]),
+        ends(p.q, choice.a[1]),
+        ends(p.q, choice.b[0]),
+        ends(p.q, choice.b[1]),
+    );
+    let rest = &p.rest[first_slot..first_slot + n];
+    let (ks, kd) = (p.stiffness[usize::from(run.kind)], p.kd[usize::from(run.kind)]);
+    let undamped = kd == 0.0;
+    // Slot t's place of one end: `second` when `on`, else `first`. Both are loaded and one kept
+    // by a mask on the bits (a select of two loads would be compiled as a gather, slower).
+    macro_rules! pick {
+        ($first:expr, $second:expr, $on:expr, $t:expr) => {{
+            let (f, s, t) = ($first, $second, $t);
+            let m = 0u64.wrapping_sub(u64::from($on));
+            let keep = |a: f64, b: f64| f64::from_bits((a.to_bits() & !m) | (b.to_bits() & m));
+            [
+                keep(f[0][t], s[0][t]),
+                keep(f[1][t], s[1][t]),
+                keep(f[2][t], s[2][t]),
+            ]
+        }};
+    }
+    let mut outside = false;
+    for t in 0..n {
+        let (i_at, j_at) = (select[t] & 1 != 0, select[t] & 2 != 0);
+        let (xi, xj) = (pick!(xa, xb, i_at, t), pick!(xc, xd, j_at, t));
+        let l = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
+        let dq = {
+            let (qi, qj) = (pick!(qa, qb, i_at, t), pick!(qc, qd, j_at, t));
+            [qi[0] - qj[0], qi[1] - qj[1], qi[2] - qj[2]]
+        };
+        let (s, out) = slot_force!(l, dq, (ks, kd, rest[t]), undamped);
+        outside |= out;
+        fx[t] = s * l[0];
+        fy[t] = s * l[1];
+        fz[t] = s * l[2];
+    }
+    if outside {
+        // The selected places, then the exact pass over them.
+        let mut places = [[0.0; crate::parallel::TILE]; 12];
+        for start in (0..n).step_by(crate::parallel::TILE) {
+            let m = (n - start).min(crate::parallel::TILE);
+            for t in 0..m {
+                let s = start + t;
+                let (i_at, j_at) = (select[s] & 1 != 0, select[s] & 2 != 0);
+                let v = [
+                    pick!(xa, xb, i_at, s),
+                    pick!(xc, xd, j_at, s),
+                    pick!(qa, qb, i_at, s),
+                    pick!(qc, qd, j_at, s),
+                ];
+                for (k, w) in v.iter().enumerate() {
+                    for c in 0..3 {
+                        places[3 * k + c][t] = w[c];
+                    }
+                }
+            }
+            let [x0, x1, x2, y0, y1, y2, q0, q1, q2, r0, r1, r2] = &places;
+            fn part(a: &[f64; crate::parallel::TILE], m: usize) -> &[f64] {
+                &a[..m]
+            }
+            let part = |a| part(a, m);
+            exact_kernel(
+                undamped,
+                [part(x0), part(x1), part(x2)],
+                [part(y0), part(y1), part(y2)],
+                [part(q0), part(q1), part(q2)],
+                [part(r0), part(r1), part(r2)],
+                |t| (ks, kd, rest[start + t]),
+                [
+                    &mut fx[start..start + m],
+                    &mut fy[start..start + m],
+                    &mut fz[start..start + m],
+                ],
+            );
+        }
     }
 }
 

@@ -26,9 +26,9 @@
 //! the sums do not depend on the thread count.
 
 use super::inputs::InputWindow;
-use super::springs::{run_uniform_widest, run_widest, zero_pads_widest, Params};
+use super::springs::{run_choice_widest, run_uniform_widest, run_widest, zero_pads_widest, Params};
 pub use crate::parallel::TILE;
-use crate::topology::{TileLayout as Layout, TileRuns, Topology, GATHER_RUNS};
+use crate::topology::{Choice, TileLayout as Layout, TileRuns, Topology, GATHER_RUNS};
 
 /// Numbers of scratch one task of the walk needs: the window of sums, or the gather path's
 /// force windows (one per run) and a tile of sums; then its window of spring inputs.
@@ -39,7 +39,7 @@ pub(super) fn scratch(l: &Layout) -> usize {
 /// The part of [`scratch`] before the window of spring inputs.
 pub(super) fn sums_scratch(l: &Layout) -> usize {
     if l.gather_runs > 0 {
-        3 * l.force_window * l.gather_runs + 3 * TILE
+        l.force_window * l.gather_components + 3 * TILE
     } else {
         3 * l.window
     }
@@ -151,7 +151,23 @@ pub(super) fn spring_forces_gathered<F>(
     let (runs, w, lead) = (&tr.runs, layout.force_window, layout.lead);
     debug_assert!(runs.len() == layout.gather_runs && w >= lead + TILE && lead >= tr.max_offset);
     let p = &Params { rest: &tr.rest, ..*p };
-    let (forces, sums) = scratch.split_at_mut(3 * w * runs.len());
+    // Each run's force window, from component `first[k]` on: the force's three components, and
+    // for a choice run a fourth, each key's select byte (as the bits of a number).
+    let mut first = [0usize; GATHER_RUNS + 1];
+    for (k, c) in tr.choices.iter().enumerate() {
+        first[k + 1] = first[k] + if c.is_some() { 4 } else { 3 };
+    }
+    let (forces, sums) = scratch.split_at_mut(w * first[runs.len()]);
+    let of_run = |k: usize| -> std::ops::Range<usize> { w * first[k]..w * first[k + 1] };
+    // The plain runs' entries for the gather: where each window starts, and its offset.
+    let (mut start, mut offset, mut plain) = ([0usize; GATHER_RUNS], [0usize; GATHER_RUNS], 0);
+    for (k, run) in runs.iter().enumerate() {
+        if tr.choices[k].is_none() {
+            (start[plain], offset[plain]) = (w * first[k], run.offset as usize);
+            plain += 1;
+        }
+    }
+    let choices = plain < runs.len();
     let c1 = c0 + len;
     // Particle i's entry in a force window is `i + lead - origin`: the windows start `lead`
     // particles before `origin`, so particles before 0 have entries too.
@@ -162,11 +178,12 @@ pub(super) fn spring_forces_gathered<F>(
     let pt = inputs.params(p);
     for (k, run) in runs.iter().enumerate() {
         let off = run.offset as usize;
-        let window = &mut forces[3 * w * k..3 * w * (k + 1)];
-        for c in 0..3 {
+        let range = of_run(k);
+        let window = &mut forces[range];
+        for c in 0..window.len() / w {
             window[c * w + lead - off..c * w + lead].fill(0.0);
         }
-        evaluate(&pt, t, k, c0.saturating_sub(off), c0, window, lead, origin);
+        evaluate(&pt, t, k, c0.saturating_sub(off), c0, window, w, lead, origin);
     }
     let mut base = c0;
     while base < c1 {
@@ -176,8 +193,8 @@ pub(super) fn spring_forces_gathered<F>(
             let shift = base - origin;
             for (k, run) in runs.iter().enumerate() {
                 let off = run.offset as usize;
-                for c in 0..3 {
-                    let comp = &mut forces[(3 * k + c) * w..(3 * k + c + 1) * w];
+                let range = of_run(k);
+                for comp in forces[range].chunks_exact_mut(w) {
                     comp.copy_within(shift + lead - off..shift + lead, lead - off);
                 }
             }
@@ -186,34 +203,37 @@ pub(super) fn spring_forces_gathered<F>(
         inputs.cover(base, end + tr.max_offset);
         let pt = inputs.params(p);
         for k in 0..runs.len() {
-            let window = &mut forces[3 * w * k..3 * w * (k + 1)];
-            evaluate(&pt, t, k, base, end, window, lead, origin);
+            let range = of_run(k);
+            evaluate(&pt, t, k, base, end, &mut forces[range], w, lead, origin);
         }
         let m = end - base;
         let (sx, rest) = sums.split_at_mut(TILE);
         let (sy, sz) = rest.split_at_mut(TILE);
         let mut plus = [0usize; GATHER_RUNS];
         let mut minus = [0usize; GATHER_RUNS];
-        for (k, run) in runs.iter().enumerate() {
-            plus[k] = 3 * w * k + at(base, origin);
-            minus[k] = plus[k] - run.offset as usize;
+        for e in 0..plain {
+            plus[e] = start[e] + at(base, origin);
+            minus[e] = plus[e] - offset[e];
         }
-        gather_widest(
-            forces,
-            w,
-            runs.len(),
-            plus,
-            minus,
-            [&mut sx[..m], &mut sy[..m], &mut sz[..m]],
-        );
+        let out = [&mut sx[..m], &mut sy[..m], &mut sz[..m]];
+        gather_widest(forces, w, plain, plus, minus, out);
+        if choices {
+            for (k, c) in tr.choices.iter().enumerate() {
+                if let Some(c) = c {
+                    let out = [&mut sx[..m], &mut sy[..m], &mut sz[..m]];
+                    gather_choice_widest(&forces[of_run(k)], w, at(base, origin), c, out);
+                }
+            }
+        }
         finish(base, [&mut sx[..m], &mut sy[..m], &mut sz[..m]], inputs);
         base = end;
     }
 }
 
-/// Writes the forces of run `k`'s springs with `i` end in `[from, to)` into its force `window`
-/// (3 components of `window.len() / 3` numbers; particle `i` at `i + lead - origin`): zero
-/// where the run has no spring or a padding slot.
+/// Writes the forces of run `k`'s springs with `i` end (a choice run: key) in `[from, to)` into
+/// its force `windows` (each 3 components of `w` numbers; particle `i` at `i + lead - origin`):
+/// zero where the run has no spring or a padding slot. A choice run's four windows are split
+/// from the first ([`split_choice`]).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn evaluate(
@@ -222,30 +242,70 @@ fn evaluate(
     k: usize,
     from: usize,
     to: usize,
-    window: &mut [f64],
+    windows: &mut [f64],
+    w: usize,
     lead: usize,
     origin: usize,
 ) {
     let tr = &t.tile_runs;
     let run = &tr.runs[k];
     let i0 = run.first_vertex as usize;
-    let w = window.len() / 3;
     let at = |i: usize| i + lead - origin;
     // The run's springs in [from, to) are [lo, hi); zero around them (everywhere when none).
     let lo = from.max(i0).min(to);
     let hi = to.min(i0 + run.len as usize).max(lo);
-    for c in 0..3 {
-        window[c * w + at(from)..c * w + at(lo)].fill(0.0);
-        window[c * w + at(hi)..c * w + at(to)].fill(0.0);
+    for comp in windows.chunks_exact_mut(w) {
+        comp[at(from)..at(lo)].fill(0.0);
+        comp[at(hi)..at(to)].fill(0.0);
     }
     if lo == hi {
         return;
     }
     let (a, b) = (at(lo), at(hi));
-    let (x, rest) = window.split_at_mut(w);
-    let (y, z) = rest.split_at_mut(w);
+    let (x, rest) = windows.split_at_mut(w);
+    let (y, rest) = rest.split_at_mut(w);
+    let (z, others) = rest.split_at_mut(w);
     let s = run.first_spring as usize + (lo - i0);
     evaluate_slots(p, tr, k, s, [&mut x[a..b], &mut y[a..b], &mut z[a..b]]);
+    if tr.choices[k].is_some() {
+        let select = tr.select_of(s..s + (b - a));
+        for (o, &sel) in others[a..b].iter_mut().zip(select) {
+            *o = f64::from_bits(u64::from(sel));
+        }
+    }
+}
+
+crate::simd_dispatch! { fn gather_choice_widest(window: &[f64], w: usize, at: usize, c: &Choice, out: [&mut [f64]; 3]) => gather_choice }
+
+/// Adds to `out[c][q]` a choice run's forces on particle `p = tile start + q` from its window
+/// (the force's components, then each key's select byte; particle `p` at `at + q`): `+f` of the
+/// key `p - a[e]` whose first end takes place `e`, `-f` of the key `p - b[e]` whose second end
+/// does, for `e` = 0 and 1.
+#[inline(always)]
+fn gather_choice(window: &[f64], w: usize, at: usize, c: &Choice, out: [&mut [f64]; 3]) {
+    let m = out[0].len();
+    let [a0, a1, b0, b1] = [c.a[0], c.a[1], c.b[0], c.b[1]].map(|s| at - s as usize);
+    let sel = &window[3 * w..4 * w];
+    let (sa0, sa1, sb0, sb1) = (
+        &sel[a0..a0 + m],
+        &sel[a1..a1 + m],
+        &sel[b0..b0 + m],
+        &sel[b1..b1 + m],
+    );
+    for (comp, o) in out.into_iter().enumerate() {
+        let f = &window[comp * w..(comp + 1) * w];
+        let (fa0, fa1, fb0, fb1) = (&f[a0..a0 + m], &f[a1..a1 + m], &f[b0..b0 + m], &f[b1..b1 + m]);
+        let o = &mut o[..m];
+        for q in 0..m {
+            // Each term when the key's end is at this place, else 0.
+            let on = |s: f64, bit: u64, want: u64| (s.to_bits() >> bit) & 1 == want;
+            let pa0 = if on(sa0[q], 0, 0) { fa0[q] } else { 0.0 };
+            let pa1 = if on(sa1[q], 0, 1) { fa1[q] } else { 0.0 };
+            let mb0 = if on(sb0[q], 1, 0) { fb0[q] } else { 0.0 };
+            let mb1 = if on(sb1[q], 1, 1) { fb1[q] } else { 0.0 };
+            o[q] += (pa0 - mb0) + (pa1 - mb1);
+        }
+    }
 }
 
 /// Evaluates the slots `s .. s + out[0].len()` of run `k` into `out`; padding slots were
@@ -257,9 +317,17 @@ fn evaluate_slots(p: &Params<'_>, tr: &TileRuns, k: usize, s: usize, out: [&mut 
     let run = &tr.runs[k];
     let [x, y, z] = out;
     let slots = s..s + x.len();
-    match tr.uniform_rest[k] {
-        Some(r) => run_uniform_widest(p, run, s, r, [&mut *x, &mut *y, &mut *z]),
-        None => run_widest(p, run, s, [&mut *x, &mut *y, &mut *z]),
+    match (&tr.choices[k], tr.uniform_rest[k]) {
+        (Some(c), _) => run_choice_widest(
+            p,
+            run,
+            c,
+            tr.select_of(slots.clone()),
+            s,
+            [&mut *x, &mut *y, &mut *z],
+        ),
+        (None, Some(r)) => run_uniform_widest(p, run, s, r, [&mut *x, &mut *y, &mut *z]),
+        (None, None) => run_widest(p, run, s, [&mut *x, &mut *y, &mut *z]),
     }
     if tr.many_pads[k] {
         zero_pads_widest(&tr.rest[slots], [x, y, z]);
@@ -292,7 +360,7 @@ fn gather(
             }
         };
     }
-    by_count!(1 2 3 4 5 6 7 8 9 10 11 12)
+    by_count!(0 1 2 3 4 5 6 7 8 9 10 11 12)
 }
 
 #[inline(always)]
@@ -627,11 +695,18 @@ mod tests {
             .count();
         assert!(two >= 2, "runs of two families: {two}");
         assert!(gathered(&jittered));
+        // Its bend springs across the rows' and the columns' edges: one choice run each.
+        let choices = jittered.tile_runs.choices.iter().filter(|c| c.is_some()).count();
+        assert_eq!(choices, 2);
         let x_jittered: Vec<Vec3> = jittered
             .rest_positions
             .iter()
             .map(|p| p + 0.002 * Vec3::new(rnd(), rnd(), rnd()))
             .collect();
+        // The same shape a hundred trillion times smaller: every squared length under the
+        // fast inverse length's range, so each slice is done again by the exact pass (the
+        // choice runs pick their places for it too).
+        let x_tiny: Vec<Vec3> = x_jittered.iter().map(|p| 1e-14 * p).collect();
         // A second-family spring of rest length 0 (its slot holds -0.0): still the second's.
         let shared = jittered
             .tile_runs
@@ -660,6 +735,7 @@ mod tests {
             .any(|r| *r == 0.0 && r.is_sign_negative()));
         for (topology, x, q) in [
             (&jittered, &x_jittered, &q),
+            (&jittered, &x_tiny, &q),
             (&zero_rest, &x_jittered, &q),
             (&t, &x, &q),
             (&buffered, &x, &q),

@@ -126,7 +126,7 @@ impl Topology {
             spring_kinds: springs.iter().map(|s| s.kind as u8).collect(),
             vertex_springs: Adjacency::springs(n, &springs),
             chunk_runs: Adjacency::chunk_runs(n, &spring_runs),
-            tile_runs: TileRuns::new(n, &springs, &spring_runs),
+            tile_runs: TileRuns::new(n, &springs, &spring_runs, &triangles),
             tiled: None,
             spring_runs,
             vertex_triangles: Adjacency::triangles(n, &triangles),

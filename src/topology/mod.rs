@@ -6,6 +6,7 @@
 
 mod adjacency;
 mod assemble;
+mod choice;
 mod grid;
 mod mesh;
 mod runs;
@@ -14,6 +15,7 @@ mod tiling;
 
 pub use adjacency::Adjacency;
 pub use assemble::Topology;
+pub use choice::Choice;
 pub use grid::{grid_index, GridSpec};
 pub use mesh::{MeshMass, MeshSpec, MAX_MESH_VERTICES};
 pub use runs::{for_each_piece, SpringRun, TileRuns, PAD_REST};

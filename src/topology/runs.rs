@@ -7,6 +7,7 @@
 //! numbered in rows (most are) into fairly long ones. A spring that fits no run is a run of
 //! one: the layout is never wrong, only less fast.
 
+use super::choice::{self, Choice, ChoiceRun};
 use super::Spring;
 
 /// `len` springs starting at spring index `first_spring`; spring `first_spring + t` joins
@@ -154,6 +155,17 @@ pub struct TileRuns {
     /// Per run: whether padding is more than a sixteenth of its slots, so that the force pass
     /// sets padding to no force by a mask over the rest lengths rather than from `pads`.
     pub many_pads: Vec<bool>,
+    /// Per run: the shifts of its ends when it is a choice run (bend springs indexed by the
+    /// edge they cross, `super::choice`): then `first_vertex + t` is slot t's key, `offset` the
+    /// largest shift, and `select` says which shift each end takes. Only the gathered tile walk
+    /// is given choice runs ([`TileRuns::gather_entries`]).
+    pub choices: Vec<Option<Choice>>,
+    /// The choice runs' slots' select bytes (they are the last runs, so their slots are the
+    /// last, from `select_from` on): bit 0 set when the slot's first end is at its run's
+    /// `a[1]`, bit 1 when its second is at `b[1]`. Empty without choice runs.
+    pub select: Vec<u8>,
+    /// The first choice slot (the slot count when there is none).
+    pub select_from: usize,
     /// Runs touching each chunk of vertices.
     pub chunk_runs: super::Adjacency,
     /// Largest offset of any run.
@@ -164,8 +176,125 @@ impl TileRuns {
     /// Pads `runs` (from `order_into_runs` on `springs`) for `n` vertices: every run of a family
     /// and offset joined into one when the padding stays within `MAX_PADDED` slots a spring,
     /// else only over gaps of at most `MAX_GAP`. Two families sharing an offset share its runs
-    /// when that takes fewer slots.
-    pub fn new(n: usize, springs: &[Spring], runs: &[SpringRun]) -> Self {
+    /// when that takes fewer slots. A triangle mesh's bend springs that the padded runs hold
+    /// sparsely become choice runs (`super::choice`) when that takes fewer slots and the walk
+    /// stays gathered.
+    pub fn new(n: usize, springs: &[Spring], runs: &[SpringRun], triangles: &[[u32; 3]]) -> Self {
+        let best = Self::best(n, springs, runs);
+        best.with_choices(n, springs, triangles).unwrap_or(best)
+    }
+
+    /// Entries the gathered tile walk sums per particle: one per run, two per choice run (its
+    /// first ends' two shifts, each with its second ends' one).
+    pub fn gather_entries(&self) -> usize {
+        self.choices.iter().map(|c| if c.is_some() { 2 } else { 1 }).sum()
+    }
+
+    /// The runs again with the sparsely held springs of a family in choice runs, when that
+    /// costs less (a choice slot reads twice the places, counted as 3/2 of a slot) and leaves
+    /// at most [`super::GATHER_RUNS`] entries to gather; None when it would not.
+    fn with_choices(&self, n: usize, springs: &[Spring], triangles: &[[u32; 3]]) -> Option<Self> {
+        if triangles.is_empty() {
+            return None;
+        }
+        // The springs of a family and offset whose plain run is mostly padding.
+        let sparse: std::collections::HashSet<(u8, u32)> = self
+            .runs
+            .iter()
+            .zip(&self.many_pads)
+            .filter(|(r, &many)| many && r.second.is_none())
+            .map(|(r, _)| (r.kind, r.offset))
+            .collect();
+        if sparse.is_empty() {
+            return None;
+        }
+        let (candidates, kinds): (Vec<usize>, Vec<u8>) = springs
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| sparse.contains(&(s.kind as u8, s.j - s.i)))
+            .map(|(k, s)| (k, s.kind as u8))
+            .unzip();
+        let mut families: Vec<u8> = kinds.clone();
+        families.sort_unstable();
+        families.dedup();
+        let (mut found, mut taken) = (Vec::new(), Vec::new());
+        for kind in families {
+            let of_kind: Vec<usize> = candidates
+                .iter()
+                .zip(&kinds)
+                .filter(|(_, &k)| k == kind)
+                .map(|(&s, _)| s)
+                .collect();
+            let (runs, held) = choice::choice_runs(n, springs, &of_kind, kind, triangles);
+            found.extend(runs);
+            taken.extend(held);
+        }
+        if found.is_empty() {
+            return None;
+        }
+        taken.sort_unstable();
+        let mut others: Vec<Spring> = springs
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| taken.binary_search(k).is_err())
+            .map(|(_, s)| *s)
+            .collect();
+        let runs = order_into_runs(&mut others);
+        let mut t = Self::best(n, &others, &runs);
+        for run in &found {
+            t.push_choice(run);
+        }
+        t.finish(n);
+        let cost = |t: &Self| -> usize {
+            let choice: usize = t
+                .runs
+                .iter()
+                .zip(&t.choices)
+                .filter(|(_, c)| c.is_some())
+                .map(|(r, _)| r.len as usize)
+                .sum();
+            2 * t.rest.len() + choice
+        };
+        (t.gather_entries() <= super::GATHER_RUNS && cost(&t) < cost(self)).then_some(t)
+    }
+
+    /// The select bytes of the choice slots `slots`.
+    pub fn select_of(&self, slots: std::ops::Range<usize>) -> &[u8] {
+        &self.select[slots.start - self.select_from..slots.end - self.select_from]
+    }
+
+    /// Appends a choice run's slots (after every other run's).
+    fn push_choice(&mut self, run: &ChoiceRun) {
+        if self.select.is_empty() {
+            self.select_from = self.rest.len();
+        }
+        self.runs.push(SpringRun {
+            first_spring: self.rest.len() as u32,
+            first_vertex: run.first_key,
+            offset: run.choice.reach(),
+            len: run.slots.len() as u32,
+            kind: run.kind,
+            second: None,
+        });
+        self.choices.resize(self.runs.len() - 1, None);
+        self.choices.push(Some(run.choice));
+        for slot in &run.slots {
+            match *slot {
+                Some((rest, select)) => {
+                    self.rest.push(rest);
+                    self.select.push(select);
+                }
+                None => {
+                    self.pads.push(self.rest.len() as u32);
+                    self.rest.push(PAD_REST);
+                    self.select.push(0);
+                }
+            }
+        }
+    }
+
+    /// The plain runs or the runs two families share, whichever takes fewer slots.
+    fn best(n: usize, springs: &[Spring], runs: &[SpringRun]) -> Self {
         let plain = Self::bounded(n, springs, runs);
         match mixed_order(springs) {
             Some((sorted, mixed_runs)) => {
@@ -218,7 +347,24 @@ impl TileRuns {
                 t.rest.push(if second { -s.rest } else { s.rest });
             }
         }
-        t.uniform_rest = t.runs.iter().map(|r| t.uniform(r)).collect();
+        t.finish(n);
+        t
+    }
+
+    /// What follows from the runs and slots: which runs have one rest length or many pads,
+    /// the runs of each chunk, the largest offset; the lists' spare capacity dropped.
+    fn finish(&mut self, n: usize) {
+        let t = self;
+        t.choices.resize(t.runs.len(), None);
+        if t.select.is_empty() {
+            t.select_from = t.rest.len();
+        }
+        t.uniform_rest = t
+            .runs
+            .iter()
+            .zip(&t.choices)
+            .map(|(r, c)| if c.is_some() { None } else { t.uniform(r) })
+            .collect();
         t.many_pads = t
             .runs
             .iter()
@@ -231,9 +377,10 @@ impl TileRuns {
         t.rest.shrink_to_fit();
         t.pads.shrink_to_fit();
         t.runs.shrink_to_fit();
+        t.select.shrink_to_fit();
+        t.choices.shrink_to_fit();
         t.chunk_runs = super::Adjacency::chunk_runs(n, &t.runs);
         t.max_offset = t.runs.iter().map(|r| r.offset as usize).max().unwrap_or(0);
-        t
     }
 
     /// The rest length shared by every spring (not padding) of `run`, if there is one (never
@@ -360,12 +507,69 @@ mod tests {
         assert!(p.uniform_rest.iter().all(|r| r.is_some()));
     }
 
+    /// A triangle mesh with random diagonals: its bend springs across the rows' and the
+    /// columns' edges become two choice runs, and every spring is held once, by a plain run's
+    /// slot or by a choice slot whose selected places are its two ends.
+    #[test]
+    fn choice_runs_and_plain_runs_hold_every_spring_once() {
+        let t = crate::testing::jittered_mesh(23, 17);
+        let p = &t.tile_runs;
+        let choices: Vec<_> = p.choices.iter().flatten().collect();
+        assert_eq!(choices.len(), 2);
+        assert_eq!(p.select_from + p.select.len(), p.rest.len());
+        let mut seen = vec![0; t.springs.len()];
+        let find = |a: u32, b: u32| {
+            let (i, j) = (a.min(b), a.max(b));
+            t.springs.iter().position(|s| s.i == i && s.j == j)
+        };
+        for (r, choice) in p.runs.iter().zip(&p.choices) {
+            let slots = r.first_spring as usize..(r.first_spring + r.len) as usize;
+            let pads: Vec<usize> = p.pads_in(slots.clone()).collect();
+            for (k, slot) in slots.enumerate() {
+                let key = r.first_vertex + k as u32;
+                let (i, j) = match choice {
+                    None => (key, key + r.offset),
+                    Some(c) => {
+                        let sel = p.select_of(slot..slot + 1)[0];
+                        let (i, j) = (
+                            key + c.a[(sel & 1) as usize],
+                            key + c.b[((sel >> 1) & 1) as usize],
+                        );
+                        // Every place a slot loads is a vertex of the mesh.
+                        assert!((key + c.reach()) < t.vertex_count() as u32);
+                        (i, j)
+                    }
+                };
+                if pads.contains(&slot) {
+                    assert!(p.rest[slot].is_nan());
+                    continue;
+                }
+                let s = find(i, j).expect("a slot's ends are a spring's");
+                let same_family =
+                    r.kind == t.springs[s].kind as u8 || r.second == Some(t.springs[s].kind as u8);
+                assert!(same_family);
+                assert_eq!(p.rest[slot].abs(), t.springs[s].rest);
+                seen[s] += 1;
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 1));
+        // No pad-heavy run is left: the choice runs took the scattered bend springs.
+        assert!(p
+            .many_pads
+            .iter()
+            .zip(&p.choices)
+            .all(|(&many, c)| !many || c.is_some()));
+        // A grid has none (its bend springs are in dense runs already).
+        assert!(grid_7x5().tile_runs.choices.iter().all(Option::is_none));
+        assert!(grid_7x5().tile_runs.select.is_empty());
+    }
+
     #[test]
     fn a_run_with_two_rest_lengths_has_no_uniform_one() {
         let mut t = grid_7x5();
         // Stretch one spring of the first family: the topology is rebuilt from the springs.
         t.springs[0].rest *= 1.5;
-        let p = super::TileRuns::new(t.vertex_count(), &t.springs, &t.spring_runs);
+        let p = super::TileRuns::new(t.vertex_count(), &t.springs, &t.spring_runs, &t.triangles);
         let kind = t.springs[0].kind as u8;
         let (with, without): (Vec<_>, Vec<_>) = p
             .runs

@@ -24,6 +24,9 @@ pub struct TileLayout {
     /// allow a grid with holes or a row-ordered mesh), and the
     /// tiles are summed by the gathered tile walk; 0 otherwise.
     pub gather_runs: usize,
+    /// Components of the gathered tile walk's force windows: three a run, four a choice run
+    /// (its select bytes); 0 when not gathered.
+    pub gather_components: usize,
     /// Entries before a tile in each force window of the gather path: the largest offset,
     /// rounded up to whole cache lines so that a tile's entries start on one.
     pub lead: usize,
@@ -44,7 +47,7 @@ const GATHER_TILES: usize = 4;
 /// window (nine component arrays) smaller than 4 and slides half as often as 1.
 const INPUT_TILES: usize = 2;
 
-/// Most runs the gathered tile walk keeps force windows for.
+/// Most entries (runs, and two a choice run) the gathered tile walk sums per particle.
 pub const GATHER_RUNS: usize = 12;
 
 impl TileLayout {
@@ -56,14 +59,20 @@ impl TileLayout {
         }
         let chunk = crate::parallel::CHUNK;
         let tiles = tr.max_offset.div_ceil(TILE).max(1);
+        let gathered = tr.gather_entries() <= GATHER_RUNS;
+        // Choice runs are only made for the gathered walk (`TileRuns::gather_entries`).
+        if !gathered && tr.choices.iter().any(Option::is_some) {
+            return None;
+        }
         Some(Self {
             // Whole cache lines per component, so each component starts on one.
             window: (tr.max_offset + tiles * TILE).next_multiple_of(8),
             // At least 8 offsets long: the springs evaluated twice at a group's start (see
             // the module's doc) are then a few percent of the group's.
             group: (8 * tr.max_offset).div_ceil(chunk).max(1) * chunk,
-            gather_runs: if tr.runs.len() <= GATHER_RUNS {
-                tr.runs.len()
+            gather_runs: if gathered { tr.runs.len() } else { 0 },
+            gather_components: if gathered {
+                tr.choices.iter().map(|c| if c.is_some() { 4 } else { 3 }).sum()
             } else {
                 0
             },
