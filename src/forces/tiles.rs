@@ -135,7 +135,7 @@ pub(super) fn spring_forces<F>(
 /// [`spring_forces`] does. `scratch` holds [`Layout::sums_scratch`] numbers; `layout` is
 /// this topology's; `inputs` as for [`spring_forces`].
 #[allow(clippy::too_many_arguments)]
-pub(super) fn spring_forces_gathered<F>(
+pub(super) fn spring_forces_gathered<const CHOICES: bool, F>(
     p: &Params<'_>,
     t: &Topology,
     layout: &Layout,
@@ -167,7 +167,7 @@ pub(super) fn spring_forces_gathered<F>(
             plain += 1;
         }
     }
-    let choices = plain < runs.len();
+    let choices = CHOICES && plain < runs.len();
     let c1 = c0 + len;
     // Particle i's entry in a force window is `i + lead - origin`: the windows start `lead`
     // particles before `origin`, so particles before 0 have entries too.
@@ -183,7 +183,7 @@ pub(super) fn spring_forces_gathered<F>(
         for c in 0..window.len() / w {
             window[c * w + lead - off..c * w + lead].fill(0.0);
         }
-        evaluate(&pt, t, k, c0.saturating_sub(off), c0, window, w, lead, origin);
+        evaluate::<CHOICES>(&pt, t, k, c0.saturating_sub(off), c0, window, w, lead, origin);
     }
     let mut base = c0;
     while base < c1 {
@@ -204,7 +204,7 @@ pub(super) fn spring_forces_gathered<F>(
         let pt = inputs.params(p);
         for k in 0..runs.len() {
             let range = of_run(k);
-            evaluate(&pt, t, k, base, end, &mut forces[range], w, lead, origin);
+            evaluate::<CHOICES>(&pt, t, k, base, end, &mut forces[range], w, lead, origin);
         }
         let m = end - base;
         let (sx, rest) = sums.split_at_mut(TILE);
@@ -236,7 +236,7 @@ pub(super) fn spring_forces_gathered<F>(
 /// from the first ([`split_choice`]).
 #[allow(clippy::too_many_arguments)]
 #[inline]
-fn evaluate(
+fn evaluate<const CHOICES: bool>(
     p: &Params<'_>,
     t: &Topology,
     k: usize,
@@ -254,20 +254,25 @@ fn evaluate(
     // The run's springs in [from, to) are [lo, hi); zero around them (everywhere when none).
     let lo = from.max(i0).min(to);
     let hi = to.min(i0 + run.len as usize).max(lo);
-    for comp in windows.chunks_exact_mut(w) {
+    let (x, rest) = windows.split_at_mut(w);
+    let (y, rest) = rest.split_at_mut(w);
+    let (z, others) = rest.split_at_mut(w);
+    for comp in [&mut *x, &mut *y, &mut *z] {
         comp[at(from)..at(lo)].fill(0.0);
         comp[at(hi)..at(to)].fill(0.0);
+    }
+    // A choice run's select bytes: zero there too.
+    if CHOICES && !others.is_empty() {
+        others[at(from)..at(lo)].fill(0.0);
+        others[at(hi)..at(to)].fill(0.0);
     }
     if lo == hi {
         return;
     }
     let (a, b) = (at(lo), at(hi));
-    let (x, rest) = windows.split_at_mut(w);
-    let (y, rest) = rest.split_at_mut(w);
-    let (z, others) = rest.split_at_mut(w);
     let s = run.first_spring as usize + (lo - i0);
-    evaluate_slots(p, tr, k, s, [&mut x[a..b], &mut y[a..b], &mut z[a..b]]);
-    if tr.choices[k].is_some() {
+    evaluate_slots::<CHOICES>(p, tr, k, s, [&mut x[a..b], &mut y[a..b], &mut z[a..b]]);
+    if CHOICES && tr.choices[k].is_some() {
         let select = tr.select_of(s..s + (b - a));
         for (o, &sel) in others[a..b].iter_mut().zip(select) {
             *o = f64::from_bits(u64::from(sel));
@@ -313,21 +318,25 @@ fn gather_choice(window: &[f64], w: usize, at: usize, c: &Choice, out: [&mut [f6
 /// (a grid's, at its row ends), by a mask over the rest lengths where they are many (an
 /// irregular mesh's runs).
 #[inline]
-fn evaluate_slots(p: &Params<'_>, tr: &TileRuns, k: usize, s: usize, out: [&mut [f64]; 3]) {
+fn evaluate_slots<const CHOICES: bool>(
+    p: &Params<'_>,
+    tr: &TileRuns,
+    k: usize,
+    s: usize,
+    out: [&mut [f64]; 3],
+) {
     let run = &tr.runs[k];
     let [x, y, z] = out;
     let slots = s..s + x.len();
-    match (&tr.choices[k], tr.uniform_rest[k]) {
-        (Some(c), _) => run_choice_widest(
-            p,
-            run,
-            c,
-            tr.select_of(slots.clone()),
-            s,
-            [&mut *x, &mut *y, &mut *z],
-        ),
-        (None, Some(r)) => run_uniform_widest(p, run, s, r, [&mut *x, &mut *y, &mut *z]),
+    // A choice run never has one rest length: a grid's runs take the first arm, as before.
+    let choice = if CHOICES { tr.choices[k].as_ref() } else { None };
+    match (tr.uniform_rest[k], choice) {
+        (Some(r), _) => run_uniform_widest(p, run, s, r, [&mut *x, &mut *y, &mut *z]),
         (None, None) => run_widest(p, run, s, [&mut *x, &mut *y, &mut *z]),
+        (None, Some(c)) => {
+            let select = tr.select_of(slots.clone());
+            run_choice_widest(p, run, c, select, s, [&mut *x, &mut *y, &mut *z]);
+        }
     }
     if tr.many_pads[k] {
         zero_pads_widest(&tr.rest[slots], [x, y, z]);
@@ -434,7 +443,7 @@ fn add_range(
             let m = (hi - lo).min(TILE);
             let s = run.first_spring as usize + (lo - i0);
             let [tx, ty, tz] = temp;
-            evaluate_slots(p, tr, r as usize, s, [&mut tx[..m], &mut ty[..m], &mut tz[..m]]);
+            evaluate_slots::<false>(p, tr, r as usize, s, [&mut tx[..m], &mut ty[..m], &mut tz[..m]]);
             // +f at the i ends and -f at the j ends inside the group.
             let ends = Ends {
                 i: (lo.max(c0), (lo + m).min(c1)),
