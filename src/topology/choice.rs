@@ -53,42 +53,37 @@ pub fn choice_runs(
     kind: u8,
     triangles: &[[u32; 3]],
 ) -> (Vec<ChoiceRun>, Vec<usize>) {
-    // Each interior edge's two opposite vertices, as the mesh's bend springs were made (an
-    // edge of more than two triangles, which a mesh refuses, gets none).
-    const NONE: u32 = u32::MAX;
-    let mut opposite: HashMap<(u32, u32), [u32; 2]> = HashMap::with_capacity(3 * triangles.len() / 2);
-    for t in triangles {
-        for a in 0..3 {
-            let (p, q) = (t[a], t[(a + 1) % 3]);
-            let ends = opposite.entry((p.min(q), p.max(q))).or_insert([NONE, NONE]);
-            match ends {
-                [NONE, _] => ends[0] = t[(a + 2) % 3],
-                [_, NONE] => ends[1] = t[(a + 2) % 3],
-                _ => *ends = [NONE - 1, NONE - 1],
-            }
-        }
-    }
-    let mut crossed: HashMap<(u32, u32), (u32, u32)> = HashMap::with_capacity(opposite.len());
-    for (&edge, &[p, q]) in &opposite {
-        if p >= NONE - 1 || q >= NONE - 1 {
-            continue;
-        }
-        // A spring across two edges (three vertices in a line: the mesh made it once) is
-        // indexed by the first of them; the other edge has no spring of its own.
-        let key = (p.min(q), p.max(q));
-        crossed
-            .entry(key)
-            .and_modify(|e| *e = (*e).min(edge))
-            .or_insert(edge);
-    }
-    drop(opposite);
+    // Each triangle edge with the triangle's third vertex, sorted by edge: an interior edge's
+    // two entries are then side by side (sorting, not hashing: a million-vertex mesh has six
+    // million entries).
+    let key = |p: u32, q: u32| (u64::from(p.min(q)) << 32) | u64::from(p.max(q));
+    let mut sides: Vec<(u64, u32)> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |a| (key(t[a], t[(a + 1) % 3]), t[(a + 2) % 3])))
+        .collect();
+    sides.sort_unstable();
+    // (the spring across the edge, the edge), for each edge of exactly two triangles (as the
+    // mesh's bend springs were made), sorted by spring then edge.
+    let mut crossed: Vec<(u64, u64)> = sides
+        .chunk_by(|a, b| a.0 == b.0)
+        .filter_map(|e| match e {
+            [(edge, p), (_, q)] => Some((key(*p, *q), *edge)),
+            _ => None,
+        })
+        .collect();
+    drop(sides);
+    crossed.sort_unstable();
+    // A spring across two edges (three vertices in a line: the mesh made it once) is indexed
+    // by the first of them; the other edge has no spring of its own.
+    crossed.dedup_by_key(|c| c.0);
     // By direction: (edge's first vertex, spring index, its ends relative to it).
     let mut groups: HashMap<u32, Vec<(u32, usize, [i64; 2])>> = HashMap::new();
     for &s in candidates {
         let sp = &springs[s];
-        let Some(&(u, w)) = crossed.get(&(sp.i, sp.j)) else {
+        let Ok(at) = crossed.binary_search_by_key(&key(sp.i, sp.j), |c| c.0) else {
             continue;
         };
+        let (u, w) = ((crossed[at].1 >> 32) as u32, crossed[at].1 as u32);
         let rel = [i64::from(sp.i) - i64::from(u), i64::from(sp.j) - i64::from(u)];
         groups.entry(w - u).or_default().push((u, s, rel));
     }
