@@ -79,6 +79,21 @@ fn run_cloth(threads: usize, mut c: Cloth, variant: Variant, integrator: Integra
         .collect()
 }
 
+/// Steps the fractional cloth `make` gives on 1, 2 and 8 threads, asserts the same bits, and
+/// returns them.
+fn same_bits_on_1_2_and_8_threads(make: impl Fn() -> Cloth) -> Vec<u64> {
+    let one = run_cloth(1, make(), Variant::Fractional, Integrator::SymplecticEuler);
+    for threads in [2, 8] {
+        let many = run_cloth(threads, make(), Variant::Fractional, Integrator::SymplecticEuler);
+        let differing = one.iter().zip(&many).filter(|(a, b)| a != b).count();
+        assert_eq!(
+            differing, 0,
+            "{differing} numbers differ between 1 and {threads} threads"
+        );
+    }
+    one
+}
+
 #[test]
 fn bitwise_identical_for_1_2_and_8_threads() {
     const { assert!((W * H) as usize >= fraccloth::MIN_PARALLEL) };
@@ -145,15 +160,7 @@ fn a_cloth_that_defers_its_folds_gives_the_same_bits_for_1_2_and_8_threads() {
         make().history().bytes_per_particle(),
         small.history().bytes_per_particle() + 48
     );
-    let one = run_cloth(1, make(), Variant::Fractional, Integrator::SymplecticEuler);
-    for threads in [2, 8] {
-        let many = run_cloth(threads, make(), Variant::Fractional, Integrator::SymplecticEuler);
-        let differing = one.iter().zip(&many).filter(|(a, b)| a != b).count();
-        assert_eq!(
-            differing, 0,
-            "{differing} numbers differ between 1 and {threads} threads"
-        );
-    }
+    let one = same_bits_on_1_2_and_8_threads(make);
     let rest: Vec<u64> = make()
         .positions()
         .iter()
@@ -187,15 +194,7 @@ fn an_irregular_mesh_gives_the_same_bits_for_1_2_and_8_threads() {
         c.set_pinned(&top).unwrap();
         c
     };
-    let one = run_cloth(1, make(), Variant::Fractional, Integrator::SymplecticEuler);
-    for threads in [2, 8] {
-        let many = run_cloth(threads, make(), Variant::Fractional, Integrator::SymplecticEuler);
-        let differing = one.iter().zip(&many).filter(|(a, b)| a != b).count();
-        assert_eq!(
-            differing, 0,
-            "{differing} numbers differ between 1 and {threads} threads"
-        );
-    }
+    same_bits_on_1_2_and_8_threads(make);
 }
 
 /// A cloth's own thread setting (`Cloth::set_threads`, `fc_cloth_set_threads`): the calling

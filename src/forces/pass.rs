@@ -272,30 +272,7 @@ fn spring_sums<T>(
                 let start = c0.saturating_sub(t.tile_runs.max_offset);
                 let mut window = InputWindow::new(sources, buf, start);
                 if layout.gather_runs > 0 {
-                    // Compiled without the choice runs' steps for topologies that have none.
-                    if t.tile_runs.select.is_empty() {
-                        tiles::spring_forces_gathered::<false, _>(
-                            &params,
-                            t,
-                            layout,
-                            c0,
-                            len,
-                            sums,
-                            &mut window,
-                            finish,
-                        );
-                    } else {
-                        tiles::spring_forces_gathered::<true, _>(
-                            &params,
-                            t,
-                            layout,
-                            c0,
-                            len,
-                            sums,
-                            &mut window,
-                            finish,
-                        );
-                    }
+                    tiles::spring_forces_gathered(&params, t, layout, c0, len, sums, &mut window, finish);
                 } else {
                     tiles::spring_forces(&params, t, c0, len, sums, &mut window, finish);
                 }

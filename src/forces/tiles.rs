@@ -135,12 +135,33 @@ pub(super) fn spring_forces<F>(
 /// [`spring_forces`] does. `scratch` holds [`Layout::sums_scratch`] numbers; `layout` is
 /// this topology's; `inputs` as for [`spring_forces`].
 #[allow(clippy::too_many_arguments)]
-pub(super) fn spring_forces_gathered<const CHOICES: bool, F>(
+pub(super) fn spring_forces_gathered<F>(
     p: &Params<'_>,
     t: &Topology,
     layout: &Layout,
     c0: usize,
     len: usize,
+    scratch: &mut [f64],
+    inputs: &mut InputWindow<'_>,
+    finish: F,
+) where
+    F: FnMut(usize, [&mut [f64]; 3], &InputWindow<'_>),
+{
+    // Compiled without the choice runs' steps for topologies that have none.
+    let args = (p, t, layout, c0, len);
+    if t.tile_runs.select.is_empty() {
+        gathered_walk::<false, F>(args, scratch, inputs, finish);
+    } else {
+        gathered_walk::<true, F>(args, scratch, inputs, finish);
+    }
+}
+
+/// The arguments of [`spring_forces_gathered`] that [`gathered_walk`] reads whole.
+type WalkArgs<'a, 'p> = (&'a Params<'p>, &'a Topology, &'a Layout, usize, usize);
+
+/// [`spring_forces_gathered`], with (`CHOICES`) or without the choice runs' steps.
+fn gathered_walk<const CHOICES: bool, F>(
+    (p, t, layout, c0, len): WalkArgs<'_, '_>,
     scratch: &mut [f64],
     inputs: &mut InputWindow<'_>,
     mut finish: F,
