@@ -317,11 +317,16 @@ fn run_kernel_choice<'a>(
         let (i_at, j_at) = (select[t] & 1 != 0, select[t] & 2 != 0);
         let (xi, xj) = (pick!(xa, xb, i_at, t), pick!(xc, xd, j_at, t));
         let l = [xi[0] - xj[0], xi[1] - xj[1], xi[2] - xj[2]];
-        let dq = {
-            let (qi, qj) = (pick!(qa, qb, i_at, t), pick!(qc, qd, j_at, t));
-            [qi[0] - qj[0], qi[1] - qj[1], qi[2] - qj[2]]
-        };
-        let (s, out) = slot_force!(l, dq, (ks, kd, rest[t]), undamped);
+        // The rates' places, picked and read only when damped (the macro expands them there).
+        let (s, out) = slot_force!(
+            l,
+            {
+                let (qi, qj) = (pick!(qa, qb, i_at, t), pick!(qc, qd, j_at, t));
+                [qi[0] - qj[0], qi[1] - qj[1], qi[2] - qj[2]]
+            },
+            (ks, kd, rest[t]),
+            undamped
+        );
         outside |= out;
         fx[t] = s * l[0];
         fy[t] = s * l[1];

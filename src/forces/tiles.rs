@@ -18,7 +18,9 @@
 //! (zero where it has none). A tile evaluates its runs into their windows and then each particle
 //! `p` sums `F_k[p] - F_k[p - offset_k]` over the runs in registers and writes it once, where the
 //! window of sums above is read and written once per run. The windows keep each run's last
-//! `offset` forces when they slide.
+//! `offset` forces when they slide. A choice run (a mesh's bend springs by the edge they cross,
+//! `topology::Choice`) keeps its keys' select bytes beside its forces, and each particle adds
+//! the forces of the keys whose ends take its place ([`gather_choice`]).
 //!
 //! Everything a tile touches (positions around it, the windows) stays in L1 or L2 cache, and a
 //! spring's force is used where it is computed instead of being written out and read back.
@@ -172,11 +174,10 @@ fn gathered_walk<const CHOICES: bool, F>(
     let (runs, w, lead) = (&tr.runs, layout.force_window, layout.lead);
     debug_assert!(runs.len() == layout.gather_runs && w >= lead + TILE && lead >= tr.max_offset);
     let p = &Params { rest: &tr.rest, ..*p };
-    // Each run's force window, from component `first[k]` on: the force's three components, and
-    // for a choice run a fourth, each key's select byte (as the bits of a number).
+    // Each run's force window, from component `first[k]` on (`TileRuns::components`).
     let mut first = [0usize; GATHER_RUNS + 1];
-    for (k, c) in tr.choices.iter().enumerate() {
-        first[k + 1] = first[k] + if c.is_some() { 4 } else { 3 };
+    for k in 0..runs.len() {
+        first[k + 1] = first[k] + tr.components(k);
     }
     let (forces, sums) = scratch.split_at_mut(w * first[runs.len()]);
     let of_run = |k: usize| -> std::ops::Range<usize> { w * first[k]..w * first[k + 1] };
@@ -252,9 +253,9 @@ fn gathered_walk<const CHOICES: bool, F>(
 }
 
 /// Writes the forces of run `k`'s springs with `i` end (a choice run: key) in `[from, to)` into
-/// its force `windows` (each 3 components of `w` numbers; particle `i` at `i + lead - origin`):
-/// zero where the run has no spring or a padding slot. A choice run's four windows are split
-/// from the first ([`split_choice`]).
+/// its force window (`TileRuns::components` arrays of `w` numbers: the force's three
+/// components, and a choice run's select bytes; particle `i` at `i + lead - origin`): zero
+/// where the run has no spring or a padding slot.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn evaluate<const CHOICES: bool>(

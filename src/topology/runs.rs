@@ -190,6 +190,16 @@ impl TileRuns {
         self.choices.iter().map(|c| if c.is_some() { 2 } else { 1 }).sum()
     }
 
+    /// Arrays in run `k`'s force window of the gathered tile walk: the force's three
+    /// components, and for a choice run its keys' select bytes (as the bits of numbers).
+    pub fn components(&self, k: usize) -> usize {
+        if self.choices[k].is_some() {
+            4
+        } else {
+            3
+        }
+    }
+
     /// The runs again with the sparsely held springs of a family in choice runs, when that
     /// costs less (a choice slot reads twice the places, counted as 3/2 of a slot) and leaves
     /// at most [`super::GATHER_RUNS`] entries to gather; None when it would not.

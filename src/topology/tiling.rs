@@ -72,7 +72,7 @@ impl TileLayout {
             group: (8 * tr.max_offset).div_ceil(chunk).max(1) * chunk,
             gather_runs: if gathered { tr.runs.len() } else { 0 },
             gather_components: if gathered {
-                tr.choices.iter().map(|c| if c.is_some() { 4 } else { 3 }).sum()
+                (0..tr.runs.len()).map(|k| tr.components(k)).sum()
             } else {
                 0
             },
