@@ -325,6 +325,31 @@ fn steps_do_not_allocate() {
         let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
         assert_eq!(during, 0, "a deferring SOE history: {during} allocations");
     }
+    // Loading a snapshot keeps the cloth's own buffers: the steps after a load allocate
+    // nothing (a host that rewinds to a saved state mid-bake keeps its frame budget). The
+    // brisk underwater swing with self-collision, whose looks keep lists between steps. (A
+    // mesh collider is loaded as a new one, whose lists grow again in the first steps.)
+    {
+        let mut model = fraccloth::Model::underwater();
+        model.self_collision_relative = 0.4;
+        let mut scene = SceneSpec::underwater_swing(15, 11, 2.0, 0.08, model)
+            .build()
+            .unwrap();
+        for _ in 0..40 {
+            scene.step().unwrap();
+        }
+        let saved = scene.cloth.save_snapshot().unwrap();
+        for _ in 0..40 {
+            scene.step().unwrap();
+        }
+        scene.cloth.load_snapshot(&saved).unwrap();
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for _ in 0..40 {
+            scene.step().unwrap();
+        }
+        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert_eq!(during, 0, "steps after a load: {during} allocations in 40 steps");
+    }
     // The counter does count: building a cloth allocates.
     let before = ALLOCATIONS.load(Ordering::Relaxed);
     let _ = SceneSpec::paper(SceneKind::Swing, Variant::Fractional)

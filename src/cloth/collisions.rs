@@ -558,13 +558,6 @@ impl Cloth {
             edge_edge,
         })
     }
-
-    /// Takes a snapshot's collision state.
-    pub(super) fn set_collision_state(&mut self, state: CollisionState) {
-        self.mesh_slots = state.meshes;
-        self.self_collision
-            .set_pairs(state.vertex_triangle, state.edge_edge);
-    }
 }
 
 /// A collider's own margin as a snapshot holds it: -1 for the model's, else the margin (m).

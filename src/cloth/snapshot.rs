@@ -36,10 +36,12 @@ use super::step::{Stage, StepPlan};
 use super::{check_weight, checked_collider, Cloth, Histories};
 use crate::bytes::{ByteReader, ByteWriter};
 use crate::cloth::MAX_COORDINATE;
+use crate::collide::MeshCollider;
 use crate::error::{check_finite_vec, Error};
 use crate::forces::{Capsule, Collider, Plane, Sphere};
 use crate::history::Scheme;
 use crate::integrate::SolverSettings;
+use crate::math::Vec3;
 
 const MAGIC: &[u8; 8] = b"FCSNAP\0\0";
 /// Current format version.
@@ -147,6 +149,33 @@ fn read_collider(r: &mut ByteReader<'_>) -> Result<Collider, Error> {
         }),
         k => return Err(Error::invalid(format!("snapshot: unknown collider kind {k}"))),
     })
+}
+
+/// Exchanges the contents of two vectors, in place when they are as long (no buffer changes
+/// hands).
+fn swap_contents<T>(a: &mut Vec<T>, b: &mut Vec<T>) {
+    if a.len() == b.len() {
+        a.swap_with_slice(b);
+    } else {
+        std::mem::swap(a, b);
+    }
+}
+
+/// A decoded snapshot's state, before it is a cloth's (or a cloth's, after it was replaced):
+/// what [`Cloth::swap_state`] exchanges.
+struct LoadedState {
+    time: f64,
+    steps: u64,
+    current: Vec3,
+    solver: SolverSettings,
+    x: Vec<Vec3>,
+    v: Vec<Vec3>,
+    weights: Vec<f64>,
+    pin_list: Vec<u32>,
+    targets: Vec<Vec3>,
+    collider_slots: Vec<Option<super::ColliderSlot>>,
+    histories: Histories,
+    meshes: Vec<Option<MeshCollider>>,
 }
 
 impl Cloth {
@@ -368,25 +397,58 @@ impl Cloth {
                 "snapshot: pin list does not match the pin weights",
             ));
         }
-        // The loaded cloth, then a trial step on a copy of it: a snapshot that loads can step.
-        let mut next = self.clone();
-        next.time = time;
-        next.steps = steps;
-        next.config.model.current = current;
-        next.config.solver = solver;
-        next.pinned = weights.iter().map(|&w| w == 1.0).collect();
-        next.x = crate::aligned::AlignedVec3::from_slice(&x);
-        next.v = crate::aligned::AlignedVec3::from_slice(&v);
-        next.pin_weight = weights;
-        next.pin_list = pin_list;
-        next.pin_target = targets;
-        next.collider_slots = collider_slots;
-        next.rebuild_colliders();
-        next.histories = histories;
-        next.set_collision_state(collisions);
-        next.trial_step()?;
-        *self = next;
+        // The loaded state goes into this cloth, in its own buffers where it can (its scratch
+        // and lists keep their room: the steps after a load allocate nothing); a trial step on
+        // a copy says whether it can step (`trial_step`), and the state it replaced comes back
+        // when it cannot.
+        let (old_vt, old_ee) = {
+            let (vt, ee) = self.self_collision.pairs();
+            (vt.to_vec(), ee.to_vec())
+        };
+        let mut state = LoadedState {
+            time,
+            steps,
+            current,
+            solver,
+            x,
+            v,
+            weights,
+            pin_list,
+            targets,
+            collider_slots,
+            histories,
+            meshes: collisions.meshes,
+        };
+        self.swap_state(&mut state);
+        self.self_collision
+            .set_pairs(collisions.vertex_triangle, collisions.edge_edge);
+        if let Err(e) = self.trial_step() {
+            self.swap_state(&mut state);
+            self.self_collision.set_pairs(old_vt, old_ee);
+            return Err(e);
+        }
         Ok(())
+    }
+
+    /// Exchanges this cloth's state with `s` (each vector of particles in place), and derives
+    /// what follows from it (which particles are fully pinned, the colliders).
+    fn swap_state(&mut self, s: &mut LoadedState) {
+        std::mem::swap(&mut self.time, &mut s.time);
+        std::mem::swap(&mut self.steps, &mut s.steps);
+        std::mem::swap(&mut self.config.model.current, &mut s.current);
+        std::mem::swap(&mut self.config.solver, &mut s.solver);
+        self.x.swap_with_slice(&mut s.x);
+        self.v.swap_with_slice(&mut s.v);
+        swap_contents(&mut self.pin_weight, &mut s.weights);
+        swap_contents(&mut self.pin_target, &mut s.targets);
+        std::mem::swap(&mut self.pin_list, &mut s.pin_list);
+        std::mem::swap(&mut self.collider_slots, &mut s.collider_slots);
+        std::mem::swap(&mut self.histories, &mut s.histories);
+        std::mem::swap(&mut self.mesh_slots, &mut s.meshes);
+        for (p, &w) in self.pinned.iter_mut().zip(&self.pin_weight) {
+            *p = w == 1.0;
+        }
+        self.rebuild_colliders();
     }
 
     /// Refuses a loaded state that cannot take one step: one step on a copy, at the mean step

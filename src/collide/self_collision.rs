@@ -139,9 +139,6 @@ pub(super) fn edge_edge(x: &[Vec3], e: &[u32; 2], f: &[u32; 2]) -> (f64, f64, f6
     (r.norm(), s, t, r, (p1 - p0).cross(&(q1 - q0)))
 }
 
-/// Whether vertex `p` and triangle `t` of positions `x` are surely further than `reach` apart:
-/// the vertex's distance from the triangle's centroid less the farthest corner's is.
-#[inline]
 /// The mean length of the edges `edges` at positions `x` (0 with no edge).
 fn mean_edge(x: &[Vec3], edges: &[[u32; 2]]) -> f64 {
     let total: f64 = edges
@@ -151,6 +148,9 @@ fn mean_edge(x: &[Vec3], edges: &[[u32; 2]]) -> f64 {
     total / edges.len().max(1) as f64
 }
 
+/// Whether vertex `p` and triangle `t` of positions `x` are surely further than `reach` apart:
+/// the vertex's distance from the triangle's centroid less the farthest corner's is.
+#[inline]
 fn ball_apart(x: &[Vec3], p: u32, t: &[u32; 3], reach: f64) -> bool {
     let [a, b, c] = t.map(|i| x[i as usize]);
     let centre = (a + b + c) / 3.0;
@@ -838,7 +838,6 @@ impl SelfCollision {
         self.looked_at.clear();
     }
 
-    /// Edge count (for checking a snapshot's pairs).
     /// Sets the side of every pair in `stopped` to the sign it started its step with (the
     /// impact zones kept it there).
     pub(crate) fn relearn_sides(&mut self, stopped: &[Passage]) {
