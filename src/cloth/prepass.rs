@@ -2,7 +2,123 @@
 //! vector unit the CPU has ([`crate::simd`]): they move every particle's numbers between
 //! `Vec3` arrays and component arrays, which vectorises only with wide shuffles.
 
+use super::pins::PinSampling;
+use crate::forces::{SpringRate, TILE};
+use crate::history::StepPast;
 use crate::math::Vec3;
+use crate::parallel::Disjoint;
+
+/// The step's first pass over the particles, range by range: the step's velocities `v_step`
+/// (pins' from their goals), the velocity relative to the water `v_rel`, D^{1/2}x = w0 v_rel + H
+/// of it (`half`; the history folds the last accepted step in here), and the component arrays
+/// of positions `sx` and of the springs' damping rate `sq` (empty unless an untiled topology's
+/// spring pass reads them). Run over every particle once a step, in ranges that may be run
+/// on different threads ([`FirstPass::run`]).
+pub(super) struct FirstPass<'a> {
+    pub x: &'a [Vec3],
+    pub v: &'a [Vec3],
+    /// The pins' goals at the end of the step, and the fully pinned particles, ascending.
+    pub goal: &'a [Vec3],
+    pub hard_pins: &'a [u32],
+    pub h: f64,
+    pub sampling: PinSampling,
+    /// The water's velocity, m/s.
+    pub current: Vec3,
+    pub rate: SpringRate,
+    /// The particles' history this step, when they keep one.
+    pub past: Option<&'a StepPast<'a>>,
+    pub v_step: Disjoint<'a, Vec3>,
+    pub v_rel: Disjoint<'a, Vec3>,
+    pub half: Disjoint<'a, Vec3>,
+    pub sx: [Disjoint<'a, f64>; 3],
+    pub sq: [Disjoint<'a, f64>; 3],
+}
+
+impl<'a> FirstPass<'a> {
+    /// The weight w0 of the current rate in D^{1/2}x this step (0 without a history).
+    pub fn w0(&self) -> f64 {
+        self.past.map_or(0.0, StepPast::current_weight)
+    }
+
+    /// The pass over particles `r`, tile by tile (so that its loops find a tile's numbers in
+    /// L1).
+    ///
+    /// # Safety
+    /// Every particle is covered once a step; ranges that may run at the same time do not
+    /// overlap, and start on multiples of `TILE` and end on one or at the last particle (the
+    /// history's blocks of 16, [`StepPast::past_range`]); nothing reads a range while it runs.
+    pub unsafe fn run(&self, r: std::ops::Range<usize>) {
+        let first = r.start;
+        let len = r.len();
+        let with_history = self.past.is_some();
+        // SAFETY: this range only (the caller's contract).
+        let (v_step, v_rel, half) = unsafe {
+            (
+                self.v_step.range(r.clone()),
+                self.v_rel.range(r.clone()),
+                self.half.range(r.clone()),
+            )
+        };
+        let arrays = !self.sx[0].is_empty();
+        // This range's part of a component array, or nothing when the arrays are not kept.
+        let part = |a: &Disjoint<'a, f64>| -> &'a mut [f64] {
+            if a.is_empty() {
+                return &mut [];
+            }
+            // SAFETY: this range only (the caller's contract).
+            unsafe { a.range(r.clone()) }
+        };
+        let [sx, sy, sz] = self.sx.each_ref().map(part);
+        let [qx, qy, qz] = self.sq.each_ref().map(part);
+        let (x, v, goal, hard_pins) = (&self.x[r.clone()], &self.v[r.clone()], self.goal, self.hard_pins);
+        for t0 in (0..len).step_by(TILE) {
+            let t = t0..(t0 + TILE).min(len);
+            // The tile in the component arrays: nothing when they are not kept.
+            let ts = if arrays { t.clone() } else { 0..0 };
+            velocities_and_positions(
+                &x[t.clone()],
+                &v[t.clone()],
+                self.current,
+                &mut v_step[t.clone()],
+                &mut v_rel[t.clone()],
+                [&mut sx[ts.clone()], &mut sy[ts.clone()], &mut sz[ts.clone()]],
+            );
+            // Fully pinned particles move to their goals: that is their velocity.
+            let (lo, hi) = (first + t.start, first + t.end);
+            let pins = &hard_pins[hard_pins.partition_point(|&i| (i as usize) < lo)..];
+            for &i in pins.iter().take_while(|&&i| (i as usize) < hi) {
+                let (p, k) = (i as usize, i as usize - first);
+                v_step[k] = (goal[p] - x[k]) / self.h;
+                v_rel[k] = self.sampling.rate(v[k], v_step[k]) - self.current;
+            }
+            if let Some(past) = self.past {
+                // SAFETY: every particle once; tiles start on multiples of TILE and end on
+                // one or at the last particle, so on blocks of 16 (the caller's contract).
+                unsafe { past.past_range(lo, &mut half[t.clone()]) };
+            }
+            // The damping rate's component arrays: none for undamped springs.
+            let (rate, q): (Option<&[Vec3]>, [&mut [f64]; 3]) = match self.rate {
+                SpringRate::None if !with_history => continue,
+                SpringRate::None => (None, [&mut [], &mut [], &mut []]),
+                SpringRate::HalfDerivative => (
+                    None,
+                    [&mut qx[ts.clone()], &mut qy[ts.clone()], &mut qz[ts.clone()]],
+                ),
+                SpringRate::Velocity => (
+                    Some(&v_step[t.clone()]),
+                    [&mut qx[ts.clone()], &mut qy[ts.clone()], &mut qz[ts.clone()]],
+                ),
+            };
+            add_current_and_split(
+                with_history.then_some(self.w0()),
+                &v_rel[t.clone()],
+                &mut half[t.clone()],
+                rate,
+                q,
+            );
+        }
+    }
+}
 
 crate::simd_dispatch! { pub(super) fn velocities_and_positions(x: &[Vec3], v: &[Vec3], current: Vec3, v_step: &mut [Vec3], v_rel: &mut [Vec3], sx: [&mut [f64]; 3]) => velocities_and_positions_kernel }
 

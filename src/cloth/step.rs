@@ -209,14 +209,20 @@ impl Cloth {
         let h = plan.h;
         self.prepare()?;
         self.pin_goals(&plan);
-        let mut weights = self.step_velocities(&plan);
+        // The first pass inside the force pass when nothing between them reads it.
+        let fused = self.fused_route();
+        let mut weights = match fused {
+            Some(_) => Weights::default(),
+            None => self.step_velocities(&plan),
+        };
         self.element_forces(&mut weights);
         self.water_turning()?;
         self.wide_form_drag();
         self.collisions(plan.fraction)?;
-        let integrated_sound = match Route::of(self.config.integrator) {
-            Route::ExplicitTiles(step) => self.forces_and_explicit_step(h, weights, step),
-            Route::Implicit => self.forces_and_implicit_step(h, weights)?,
+        let integrated_sound = match (fused, Route::of(self.config.integrator)) {
+            (Some(step), _) => self.velocities_forces_and_explicit_step(&plan, weights, step),
+            (None, Route::ExplicitTiles(step)) => self.forces_and_explicit_step(h, weights, step),
+            (None, Route::Implicit) => self.forces_and_implicit_step(h, weights)?,
         };
         let friction = self.friction(h) | self.contact_friction(h);
         let limited = self.limit_collision_step() > 0;
@@ -253,97 +259,35 @@ impl Cloth {
     /// accepted step in here), and, for an untiled topology, the component arrays the spring
     /// pass reads. Returns the memories' weights, the particles' w0 filled in.
     fn step_velocities(&mut self, plan: &StepPlan) -> Weights {
-        let (h, sampling) = (plan.h, plan.sampling);
         let n = self.vertex_count();
         let s = &mut self.scratch;
-        let par = parallel::worth_it(n);
         let history = self.histories.get_mut(Memory::Particles);
         let with_history = !history.is_off();
         // The history folds the last accepted step in during this pass (SOE).
         let past = with_history.then(|| history.begin_step());
-        let w0 = past.as_ref().map_or(0.0, |p| p.current_weight());
-        let hard_pins = &s.pins.hard;
-        let rate = forces::spring_rate(&self.config.model);
-        let current = self.config.model.current;
         // A tile walk transposes its own spring inputs; only other topologies need them here.
         let arrays = self.topology.tiled.is_none();
         let (sx, sq) = s.force_pass.spring_arrays(if arrays { n } else { 0 });
-        // This chunk's part of a component array, or nothing when the arrays are not kept.
-        fn part<'a>(a: &parallel::Disjoint<'a, f64>, r: std::ops::Range<usize>) -> &'a mut [f64] {
-            if a.is_empty() {
-                return &mut [];
-            }
-            // SAFETY: every task borrows only its own chunk `r` of each array.
-            unsafe { a.range(r) }
-        }
-        let (x, v, goal) = (&self.x, &self.v, &s.pins.goal);
-        let (v_step, v_rel, half) = (
-            parallel::Disjoint::new(&mut s.v_step),
-            parallel::Disjoint::new(&mut s.v_rel),
-            parallel::Disjoint::new(&mut s.half),
-        );
-        let [sx, sy, sz] = sx.slices_mut().map(parallel::Disjoint::new);
-        let [qx, qy, qz] = sq.slices_mut().map(parallel::Disjoint::new);
-        parallel::for_chunks(par, n, parallel::CHUNK, |first, len| {
-            let r = first..first + len;
-            // SAFETY: every task borrows only its own chunk `r` of each array.
-            let (v_step, v_rel, half) = unsafe {
-                (
-                    v_step.range(r.clone()),
-                    v_rel.range(r.clone()),
-                    half.range(r.clone()),
-                )
-            };
-            let (sx, sy, sz) = (part(&sx, r.clone()), part(&sy, r.clone()), part(&sz, r.clone()));
-            let (qx, qy, qz) = (part(&qx, r.clone()), part(&qy, r.clone()), part(&qz, r.clone()));
-            let (x, v) = (&x[r.clone()], &v[r.clone()]);
-            // Tile by tile, so that the loops below find the tile's numbers in L1.
-            for t0 in (0..len).step_by(TILE) {
-                let t = t0..(t0 + TILE).min(len);
-                // The tile in the component arrays: nothing when they are not kept.
-                let ts = if arrays { t.clone() } else { 0..0 };
-                prepass::velocities_and_positions(
-                    &x[t.clone()],
-                    &v[t.clone()],
-                    current,
-                    &mut v_step[t.clone()],
-                    &mut v_rel[t.clone()],
-                    [&mut sx[ts.clone()], &mut sy[ts.clone()], &mut sz[ts.clone()]],
-                );
-                // Fully pinned particles move to their goals: that is their velocity.
-                let (lo, hi) = (first + t.start, first + t.end);
-                let pins = &hard_pins[hard_pins.partition_point(|&i| (i as usize) < lo)..];
-                for &i in pins.iter().take_while(|&&i| (i as usize) < hi) {
-                    let (p, k) = (i as usize, i as usize - first);
-                    v_step[k] = (goal[p] - x[k]) / h;
-                    v_rel[k] = sampling.rate(v[k], v_step[k]) - current;
-                }
-                if let Some(past) = &past {
-                    // SAFETY: every particle once; tiles start on multiples of TILE and
-                    // end on one or at the last particle, so on blocks of 16.
-                    unsafe { past.past_range(lo, &mut half[t.clone()]) };
-                }
-                // The damping rate's component arrays: none for undamped springs.
-                let (rate, q): (Option<&[Vec3]>, [&mut [f64]; 3]) = match rate {
-                    forces::SpringRate::None if !with_history => continue,
-                    forces::SpringRate::None => (None, [&mut [], &mut [], &mut []]),
-                    forces::SpringRate::HalfDerivative => (
-                        None,
-                        [&mut qx[ts.clone()], &mut qy[ts.clone()], &mut qz[ts.clone()]],
-                    ),
-                    forces::SpringRate::Velocity => (
-                        Some(&v_step[t.clone()]),
-                        [&mut qx[ts.clone()], &mut qy[ts.clone()], &mut qz[ts.clone()]],
-                    ),
-                };
-                prepass::add_current_and_split(
-                    with_history.then_some(w0),
-                    &v_rel[t.clone()],
-                    &mut half[t.clone()],
-                    rate,
-                    q,
-                );
-            }
+        let first = prepass::FirstPass {
+            x: &self.x,
+            v: &self.v,
+            goal: &s.pins.goal,
+            hard_pins: &s.pins.hard,
+            h: plan.h,
+            sampling: plan.sampling,
+            current: self.config.model.current,
+            rate: forces::spring_rate(&self.config.model),
+            past: past.as_ref(),
+            v_step: parallel::Disjoint::new(&mut s.v_step),
+            v_rel: parallel::Disjoint::new(&mut s.v_rel),
+            half: parallel::Disjoint::new(&mut s.half),
+            sx: sx.slices_mut().map(parallel::Disjoint::new),
+            sq: sq.slices_mut().map(parallel::Disjoint::new),
+        };
+        let w0 = first.w0();
+        parallel::for_chunks(parallel::worth_it(n), n, parallel::CHUNK, |lo, len| {
+            // SAFETY: every particle once, in chunks (which start on multiples of TILE).
+            unsafe { first.run(lo..lo + len) };
         });
         if with_history {
             self.histories.get_mut(Memory::Particles).end_step();
@@ -351,6 +295,90 @@ impl Cloth {
         let mut weights = Weights::default();
         weights.0[Memory::Particles.index()] = w0;
         weights
+    }
+
+    /// The explicit step whose first pass over the particles ([`Self::step_velocities`]) runs
+    /// inside the force pass, when nothing between the two reads what it writes: a tiled
+    /// topology, no water carried along the normal, no wide form drag, no pair element with a
+    /// pass of its own, no mesh collider and no self-collision. `FRACCLOTH_FUSE=0` (read once)
+    /// turns it off, for measuring. The same operations in the same order for each particle as
+    /// the two passes one after the other: the same bits.
+    fn fused_route(&self) -> Option<StepSoa> {
+        let Route::ExplicitTiles(step) = Route::of(self.config.integrator) else {
+            return None;
+        };
+        let m = &self.config.model;
+        let fusable = self.topology.tiled.is_some()
+            && !m.water.normal_water()
+            && !forces::wide_drag(m)
+            && !forces::prior_elements_on(m)
+            && self.mesh_slots.iter().all(Option::is_none)
+            && m.self_collision_thickness <= 0.0
+            && fuse_enabled();
+        fusable.then_some(step)
+    }
+
+    /// [`Self::step_velocities`] and [`Self::forces_and_explicit_step`] in one pass over
+    /// memory ([`Self::fused_route`]); returns whether every result it wrote was sound.
+    fn velocities_forces_and_explicit_step(
+        &mut self,
+        plan: &StepPlan,
+        mut weights: Weights,
+        step: StepSoa,
+    ) -> bool {
+        let s = &mut self.scratch;
+        let history = self.histories.get_mut(Memory::Particles);
+        let with_history = !history.is_off();
+        let past = with_history.then(|| history.begin_step());
+        let first = prepass::FirstPass {
+            x: &self.x,
+            v: &self.v,
+            goal: &s.pins.goal,
+            hard_pins: &s.pins.hard,
+            h: plan.h,
+            sampling: plan.sampling,
+            current: self.config.model.current,
+            rate: forces::spring_rate(&self.config.model),
+            past: past.as_ref(),
+            v_step: parallel::Disjoint::new(&mut s.v_step),
+            v_rel: parallel::Disjoint::new(&mut s.v_rel),
+            half: parallel::Disjoint::new(&mut s.half),
+            sx: std::array::from_fn(|_| parallel::Disjoint::new(&mut [])),
+            sq: std::array::from_fn(|_| parallel::Disjoint::new(&mut [])),
+        };
+        weights.0[Memory::Particles.index()] = first.w0();
+        // SAFETY: the force pass runs every particle once, in ranges that start on multiples
+        // of TILE, and reads none while it runs (`forces::Ahead`).
+        let run = |r: std::ops::Range<usize>| unsafe { first.run(r) };
+        let ahead = forces::Ahead {
+            run: &run,
+            v: &first.v_step,
+            half: &first.half,
+        };
+        let input = ForceInput {
+            model: &self.config.model,
+            topology: &self.topology,
+            x: &self.x,
+            v: &[],
+            half_derivative: &[],
+            colliders: &self.colliders,
+            prior_forces: &s.prior_forces,
+            weights,
+        };
+        let sound = explicit_tiles(
+            &input,
+            &mut s.force_pass,
+            Some(&ahead),
+            (&mut s.x_new, &mut s.v_new),
+            &s.projected,
+            self.config.max_speed,
+            plan.h,
+            step,
+        );
+        if with_history {
+            self.histories.get_mut(Memory::Particles).end_step();
+        }
+        sound
     }
 
     /// The pair elements with a pass of their own (`forces::elements`): each memory's rates
@@ -448,52 +476,16 @@ impl Cloth {
         }
         let s = &mut self.scratch;
         let input = force_input!(self, s, weights);
-        let (masses, areas) = (&self.topology.masses, &self.topology.areas);
-        let projected = &s.projected;
-        let model = &self.config.model;
-        let max_speed2 = self.config.max_speed * self.config.max_speed;
-        let all_sound = AtomicBool::new(true);
-        let (x_new, v_new) = (
-            parallel::Disjoint::new(&mut s.x_new),
-            parallel::Disjoint::new(&mut s.v_new),
-        );
-        forces::for_each_tile(&input, &mut s.force_pass, SpringInputs::Filled, |tile| {
-            let r = tile.p0..tile.p0 + tile.force[0].len();
-            // SAFETY: each tile is handed over once and tiles are disjoint.
-            let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
-            // With the water's inertia the step needs M^{-1} f (`forces/inertia.rs`).
-            let mut effective;
-            let force = match (forces::carries_water(model), tile.normals) {
-                (true, Some(n)) => {
-                    let len = r.len();
-                    effective = [[0.0; TILE]; 3];
-                    forces::effective_forces(
-                        model,
-                        &masses[r.clone()],
-                        &areas[r.clone()],
-                        n,
-                        projected.get(r.clone()).unwrap_or(&[]),
-                        tile.force,
-                        &mut effective,
-                    );
-                    let [a, b, c] = &effective;
-                    [&a[..len], &b[..len], &c[..len]]
-                }
-                _ => tile.force,
-            };
-            let input = integrate::StepInput {
-                h,
-                x: tile.x,
-                v: tile.v,
-                force,
-                masses: &masses[r],
-                max_speed2,
-            };
-            if !step(&input, xn, vn) {
-                all_sound.store(false, Ordering::Relaxed);
-            }
-        });
-        all_sound.into_inner()
+        explicit_tiles(
+            &input,
+            &mut s.force_pass,
+            None,
+            (&mut s.x_new, &mut s.v_new),
+            &s.projected,
+            self.config.max_speed,
+            h,
+            step,
+        )
     }
 
     /// The force pass into the one force array (`scratch.force_array`).
@@ -685,6 +677,169 @@ impl Cloth {
                 self.config.integrator.name(),
                 self.scratch.x_new[i].amax()
             ))),
+        }
+    }
+}
+
+/// Whether the first pass may run inside the force pass (`FRACCLOTH_FUSE`, read once: `0`
+/// turns it off).
+fn fuse_enabled() -> bool {
+    #[cfg(test)]
+    if tests::UNFUSED.load(Ordering::Relaxed) {
+        return false;
+    }
+    static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ON.get_or_init(|| std::env::var("FRACCLOTH_FUSE").map_or(true, |v| v.trim() != "0"))
+}
+
+/// The force pass with an explicit integrator stepping each tile in cache into `x_new`,
+/// `v_new` (`ahead`: the first pass run as it goes); returns whether every result it wrote
+/// was sound.
+#[allow(clippy::too_many_arguments)] // the step's arrays, borrowed apart
+fn explicit_tiles(
+    input: &ForceInput<'_>,
+    force_pass: &mut ForceScratch,
+    ahead: Option<&forces::Ahead<'_>>,
+    (x_new, v_new): (&mut [Vec3], &mut [Vec3]),
+    projected: &[f64],
+    max_speed: f64,
+    h: f64,
+    step: StepSoa,
+) -> bool {
+    let model = input.model;
+    let (masses, areas) = (&input.topology.masses, &input.topology.areas);
+    let max_speed2 = max_speed * max_speed;
+    let all_sound = AtomicBool::new(true);
+    let (x_new, v_new) = (parallel::Disjoint::new(x_new), parallel::Disjoint::new(v_new));
+    forces::for_each_tile_ahead(input, force_pass, SpringInputs::Filled, ahead, |tile| {
+        let r = tile.p0..tile.p0 + tile.force[0].len();
+        // SAFETY: each tile is handed over once and tiles are disjoint.
+        let (xn, vn) = unsafe { (x_new.range(r.clone()), v_new.range(r.clone())) };
+        // With the water's inertia the step needs M^{-1} f (`forces/inertia.rs`).
+        let mut effective;
+        let force = match (forces::carries_water(model), tile.normals) {
+            (true, Some(n)) => {
+                let len = r.len();
+                effective = [[0.0; TILE]; 3];
+                forces::effective_forces(
+                    model,
+                    &masses[r.clone()],
+                    &areas[r.clone()],
+                    n,
+                    projected.get(r.clone()).unwrap_or(&[]),
+                    tile.force,
+                    &mut effective,
+                );
+                let [a, b, c] = &effective;
+                [&a[..len], &b[..len], &c[..len]]
+            }
+            _ => tile.force,
+        };
+        let input = integrate::StepInput {
+            h,
+            x: tile.x,
+            v: tile.v,
+            force,
+            masses: &masses[r],
+            max_speed2,
+        };
+        if !step(&input, xn, vn) {
+            all_sound.store(false, Ordering::Relaxed);
+        }
+    });
+    all_sound.into_inner()
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    use crate::forces::{Collider, Sphere};
+    use crate::history::Scheme;
+    use crate::model::{Model, SpringDamping};
+    use crate::{Cloth, ClothConfig, GridSpec, Integrator, Vec3};
+
+    /// Set by the test below: steps run their two passes apart (on whichever thread a cloth
+    /// steps; other tests stepping meanwhile take the same bits either way).
+    pub(super) static UNFUSED: AtomicBool = AtomicBool::new(false);
+
+    /// A `w` x `h` cloth of `model` with a pinned top row moving sideways, a half-weight pin,
+    /// a current and a sphere, stepped `steps` times on `threads` threads with the first pass
+    /// inside the force pass or apart; its positions and velocities.
+    fn stepped(
+        w: usize,
+        h: usize,
+        model: &Model,
+        scheme: Scheme,
+        threads: u32,
+        steps: usize,
+        unfused: bool,
+    ) -> Vec<Vec3> {
+        let t = GridSpec {
+            width: w as u32,
+            height: h as u32,
+            spacing: 0.01,
+            total_mass: 1e-4 * (w * h) as f64,
+        }
+        .build()
+        .unwrap();
+        let config = ClothConfig {
+            model: *model,
+            scheme,
+            integrator: Integrator::SymplecticEuler,
+            ..ClothConfig::default()
+        };
+        let mut c = Cloth::new(t, config).unwrap();
+        c.set_threads(threads).unwrap();
+        let top: Vec<u32> = (0..w as u32).collect();
+        c.set_pinned(&top).unwrap();
+        c.pin_group(&[(w + 3) as u32], 0.5).unwrap();
+        c.set_current(Vec3::new(0.02, 0.0, 0.05)).unwrap();
+        c.add_collider(Collider::Sphere(Sphere {
+            center: Vec3::new(0.05, -0.04, 0.02),
+            radius: 0.03,
+            velocity: Vec3::zeros(),
+        }))
+        .unwrap();
+        UNFUSED.store(unfused, Ordering::Relaxed);
+        for k in 0..steps {
+            let targets: Vec<Vec3> = top
+                .iter()
+                .map(|&i| c.positions()[i as usize] + Vec3::new(1e-4 * k as f64, 0.0, 0.0))
+                .collect();
+            c.set_pin_targets(&top, &targets).unwrap();
+            c.step(2e-4).unwrap();
+        }
+        UNFUSED.store(false, Ordering::Relaxed);
+        c.positions().iter().chain(c.velocities()).copied().collect()
+    }
+
+    /// The first pass run inside the force pass gives the bits of the two passes apart: a
+    /// 211 x 211 cloth (whose SOE history defers its folds) on one, two and three threads
+    /// (the walk's tasks meet in bands the first pass runs before them), and small cloths with
+    /// velocity damping and a truncated history.
+    #[test]
+    fn the_first_pass_inside_the_force_pass_gives_the_bits_of_the_two_apart() {
+        let fractional = Model::fractional();
+        for threads in [1, 2, 3] {
+            let fused = stepped(211, 211, &fractional, Scheme::DEFAULT, threads, 5, false);
+            let apart = stepped(211, 211, &fractional, Scheme::DEFAULT, threads, 5, true);
+            assert!(fused.iter().all(|p| p.iter().all(|c| c.is_finite())));
+            assert!(fused == apart, "211 x 211 on {threads} threads");
+        }
+        let velocity = Model {
+            spring_damping_mode: SpringDamping::Velocity,
+            spring_damping: 0.01,
+            ..Model::fractional()
+        };
+        for (model, scheme) in [
+            (&velocity, Scheme::PAPER),
+            (&fractional, Scheme::Off),
+            (&fractional, Scheme::PAPER),
+        ] {
+            let fused = stepped(31, 21, model, scheme, 1, 30, false);
+            let apart = stepped(31, 21, model, scheme, 1, 30, true);
+            assert!(fused == apart, "31 x 21, {}", scheme.name());
         }
     }
 }

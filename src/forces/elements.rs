@@ -182,6 +182,14 @@ pub struct ElementScratch {
 /// The forces of every element with a [`Kernel::Prior`] pass into `out`: emptied, then sized
 /// to the particles and summed into when any runs; says whether any ran. `memory_past` gives a
 /// memory's weight and writes its past part into the buffer (the caller owns the histories).
+/// Whether the model has a pair element with a pass of its own before the force pass
+/// ([`prior_forces`], which reads the step's velocities).
+pub fn prior_elements_on(model: &Model) -> bool {
+    PAIR_ELEMENTS
+        .iter()
+        .any(|e| (e.on)(model) && matches!(e.kernel, Kernel::Prior { .. }))
+}
+
 pub fn prior_forces(
     model: &Model,
     topology: &Topology,

@@ -15,7 +15,7 @@ use super::springs::{Params, SpringRate};
 use crate::math::Vec3;
 
 /// The step's arrays a window copies from: positions always, velocities and half-derivatives
-/// when some reader needs them (all of one length).
+/// when some reader needs them (all of one length), from particle `base` on.
 #[derive(Clone, Copy)]
 pub(super) struct Sources<'a> {
     pub x: &'a [Vec3],
@@ -23,6 +23,8 @@ pub(super) struct Sources<'a> {
     pub half: Option<&'a [Vec3]>,
     /// What the spring damping acts on: the velocities, the half-derivatives, or nothing.
     pub rate: SpringRate,
+    /// The particle the slices start at (0: the whole arrays).
+    pub base: usize,
 }
 
 /// Component arrays of a tile's particles: positions, and velocities and half-derivatives
@@ -35,8 +37,10 @@ pub(super) struct TileState<'b> {
 
 /// A window of component arrays over particles `[origin, origin + cap)`, filled up to `filled`.
 pub(super) struct InputWindow<'a> {
-    /// Positions, velocities, half-derivatives: groups 0, 1, 2 of `buf`.
+    /// Positions, velocities, half-derivatives: groups 0, 1, 2 of `buf`; from particle
+    /// `base` on.
     sources: [Option<&'a [Vec3]>; 3],
+    base: usize,
     rate: SpringRate,
     /// Three groups of three component arrays of `cap` numbers each (x, y, z per group); a
     /// group without a source is not written.
@@ -61,8 +65,10 @@ impl<'a> InputWindow<'a> {
             SpringRate::HalfDerivative => s.half.is_some(),
         });
         let cap = buf.len() / 9;
+        debug_assert!(start >= s.base);
         Self {
             sources: [Some(s.x), s.v, s.half],
+            base: s.base,
             rate: s.rate,
             buf,
             cap,
@@ -75,7 +81,7 @@ impl<'a> InputWindow<'a> {
     /// before `keep` when the window has to slide. `keep` never decreases between calls, and
     /// `upto - keep` is at most the window's capacity.
     pub fn cover(&mut self, keep: usize, upto: usize) {
-        let n = self.sources[0].map_or(0, <[Vec3]>::len);
+        let n = self.base + self.sources[0].map_or(0, <[Vec3]>::len);
         let upto = upto.min(n);
         debug_assert!(keep >= self.origin && upto - keep.min(upto) <= self.cap);
         if upto <= self.filled {
@@ -102,7 +108,7 @@ impl<'a> InputWindow<'a> {
                 let (px, rest) = group.split_at_mut(cap);
                 let (py, pz) = rest.split_at_mut(cap);
                 transpose_widest(
-                    &src[self.filled..upto],
+                    &src[self.filled - self.base..upto - self.base],
                     [&mut px[a..b], &mut py[a..b], &mut pz[a..b]],
                 );
             }
@@ -185,6 +191,7 @@ mod tests {
                 v: vs,
                 half: hs,
                 rate,
+                base: 0,
             };
             let mut w = InputWindow::new(sources, &mut buf, 30);
             // Steps of 23 keeping the last 40: slides many times, ends clamped at n.

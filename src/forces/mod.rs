@@ -51,9 +51,9 @@ pub use wide_drag::{add_wide_form_drag, wide as wide_drag, WideDragScratch};
 // The step's machinery, for the crate only.
 pub(crate) use assemble::add_spring_values;
 pub(crate) use contact::{apply_friction, friction_active};
-pub(crate) use elements::{prior_forces, spring_damping, ElementScratch};
+pub(crate) use elements::{prior_elements_on, prior_forces, spring_damping, ElementScratch};
 pub(crate) use inertia::{carries_water, effective_forces, patch_normals, turning_forces, TurningScratch};
 pub(crate) use jacobian::{linearise, Linearisation, SpringBlock};
 pub(crate) use normals::vertex_normals_with;
-pub(crate) use pass::{for_each_tile, total_forces_with, SpringInputs};
+pub(crate) use pass::{for_each_tile_ahead, total_forces_with, Ahead, SpringInputs};
 pub(crate) use tiles::TILE;

@@ -100,6 +100,23 @@ pub enum SpringInputs {
     Copy,
 }
 
+/// The step's first pass over the particles, run by the force pass itself just ahead of the
+/// particles its tile walk reads: on a cloth larger than the cache, the walk then reads what
+/// the first pass wrote from cache instead of memory. For a step whose passes between the two
+/// read none of it (no water carried, no pair elements, no contacts), on a tiled topology
+/// ([`Topology::tiled`]; the caller runs the first pass itself on others).
+pub struct Ahead<'a> {
+    /// The first pass over a range of particles: every particle once, in ranges that start on
+    /// multiples of [`TILE`] and end on one or at the last particle, never two overlapping
+    /// ones at a time (what the force pass asks of it).
+    pub run: &'a (dyn Fn(std::ops::Range<usize>) + Sync),
+    /// What it writes that the force pass reads: the step's velocities and the
+    /// half-derivatives D^{1/2}x (in place of [`ForceInput::v`] and
+    /// [`ForceInput::half_derivative`], which are then empty).
+    pub v: &'a parallel::Disjoint<'a, Vec3>,
+    pub half: &'a parallel::Disjoint<'a, Vec3>,
+}
+
 /// A tile's total forces and state as component arrays, each `[x, y, z]` of one length.
 pub struct TileTotals<'a> {
     /// The tile's first particle.
@@ -143,6 +160,20 @@ pub fn for_each_tile<S>(input: &ForceInput<'_>, scratch: &mut ForceScratch, inpu
 where
     S: Fn(TileTotals<'_>) + Sync,
 {
+    for_each_tile_ahead(input, scratch, inputs, None, sink);
+}
+
+/// [`for_each_tile`], running the step's first pass (`ahead`) as it goes when given one (on a
+/// tiled topology only).
+pub fn for_each_tile_ahead<S>(
+    input: &ForceInput<'_>,
+    scratch: &mut ForceScratch,
+    inputs: SpringInputs,
+    ahead: Option<&Ahead<'_>>,
+    sink: S,
+) where
+    S: Fn(TileTotals<'_>) + Sync,
+{
     let m = input.model;
     let reads = terms::reads(m, !input.colliders.is_empty());
     if reads.normals && !std::mem::take(&mut scratch.normals_ready) {
@@ -156,7 +187,7 @@ where
         colliders: input.colliders,
     };
     let (masses, areas) = (&input.topology.masses, &input.topology.areas);
-    let half = (!input.half_derivative.is_empty()).then_some(input.half_derivative);
+    let half = (!input.half_derivative.is_empty() || ahead.is_some()).then_some(input.half_derivative);
     let finish = |p0: usize, s: [&mut [f64]; 3], state: &TileState<'_>| {
         let len = s[0].len();
         let Some(v) = state.v else {
@@ -194,6 +225,7 @@ where
             None
         },
         rate: spring_rate(m),
+        base: 0,
     };
     let ForceScratch {
         spring_inputs,
@@ -201,7 +233,16 @@ where
         windows,
         ..
     } = scratch;
-    spring_sums(input, spring_inputs, springs, windows, inputs, sources, finish);
+    spring_sums(
+        input,
+        spring_inputs,
+        springs,
+        windows,
+        inputs,
+        sources,
+        ahead,
+        finish,
+    );
 }
 
 /// Computes the vertex normals at `x` into `scratch`.
@@ -222,7 +263,10 @@ fn compute_normals(x: &[Vec3], t: &crate::topology::Topology, scratch: &mut Forc
 /// Walks the particles tile by tile: sums each tile's spring forces and calls
 /// `finish(p0, sums, state)` with them (component arrays, which the finisher adds to) and the
 /// tile's state as component arrays (`sources`, from the tile walk's window on a tiled topology,
-/// gathered from the step's arrays otherwise).
+/// gathered from the step's arrays otherwise). With `ahead`, the velocities and
+/// half-derivatives of `sources` are those `ahead` writes: on a tiled topology it runs first
+/// on the particles around where the tasks meet, then each task runs it on its own particles
+/// a group ahead of its walk.
 #[allow(clippy::too_many_arguments)] // the pass's scratch buffers, borrowed apart from its normals
 fn spring_sums<T>(
     input: &ForceInput<'_>,
@@ -231,6 +275,7 @@ fn spring_sums<T>(
     windows: &mut crate::aligned::AlignedF64,
     inputs: SpringInputs,
     sources: Sources<'_>,
+    ahead: Option<&Ahead<'_>>,
     finish: T,
 ) where
     T: Fn(usize, [&mut [f64]; 3], &TileState<'_>) + Sync,
@@ -259,9 +304,31 @@ fn spring_sums<T>(
         };
         let w = tiles::scratch(layout);
         windows.resize(w * tasks);
+        let max_offset = t.tile_runs.max_offset;
+        // Task k's first particle, and the band around it that reads across two tasks.
+        let task_start = |k: usize| ((k * groups / tasks) * layout.group).min(n);
+        let band = max_offset.next_multiple_of(TILE);
+        // Where each task's own run of the first pass begins and ends: the bands are run
+        // first, before the tasks (tasks are at least a group, eight offsets, long).
+        let own = |k: usize| {
+            let lo = if k == 0 { 0 } else { (task_start(k) + band).min(n) };
+            let hi = if k + 1 == tasks {
+                n
+            } else {
+                task_start(k + 1) - band
+            };
+            lo..hi.max(lo)
+        };
+        if let Some(a) = ahead {
+            for k in 1..tasks {
+                let c = task_start(k);
+                (a.run)(c.saturating_sub(band)..(c + band).min(n));
+            }
+        }
         parallel::chunks(par, &mut windows[..w * tasks], w, |first, window| {
             let (sums, buf) = window.split_at_mut(tiles::sums_scratch(layout));
             let k = first / w;
+            let mut done = own(k).start;
             for g in k * groups / tasks..(k + 1) * groups / tasks {
                 let c0 = g * layout.group;
                 let len = layout.group.min(n - c0);
@@ -269,7 +336,30 @@ fn spring_sums<T>(
                     let len = sums[0].len();
                     finish(p0, sums, &w.tile(p0, p0 + len))
                 };
-                let start = c0.saturating_sub(t.tile_runs.max_offset);
+                let start = c0.saturating_sub(max_offset);
+                let end = (c0 + len + max_offset).min(n);
+                let sources = match ahead {
+                    None => sources,
+                    Some(a) => {
+                        // The first pass over this task's particles up to what the group's
+                        // springs read (beyond its own end: the band, already run).
+                        let upto = end.next_multiple_of(TILE).min(own(k).end);
+                        if upto > done {
+                            (a.run)(done..upto);
+                            done = upto;
+                        }
+                        // SAFETY: `start..end` has been run (by this task, or before the tasks
+                        // for the bands), and no task writes there while it is read.
+                        let (v, half) = unsafe { (a.v.shared(start..end), a.half.shared(start..end)) };
+                        Sources {
+                            x: &input.x[start..end],
+                            v: Some(v),
+                            half: sources.half.map(|_| half),
+                            base: start,
+                            ..sources
+                        }
+                    }
+                };
                 let mut window = InputWindow::new(sources, buf, start);
                 if layout.gather_runs > 0 {
                     tiles::spring_forces_gathered(&params, t, layout, c0, len, sums, &mut window, finish);
@@ -277,8 +367,10 @@ fn spring_sums<T>(
                     tiles::spring_forces(&params, t, c0, len, sums, &mut window, finish);
                 }
             }
+            debug_assert!(ahead.is_none() || done == own(k).end);
         });
     } else {
+        debug_assert!(ahead.is_none(), "the first pass runs inside tile walks only");
         springs::compute(&params, &t.spring_runs, par, spring_buffer);
         let spring_force = spring_buffer.slices();
         parallel::for_chunks(par, n, parallel::CHUNK, |first, len| {

@@ -41,4 +41,5 @@ pub(crate) use soe::LANES as SOE_BLOCK;
 pub use soe::{defers_folds, SumOfExponentials, DEFER_FROM_BYTES, DEFER_VARIABLE};
 pub use soe_kernel::SoeKernel;
 pub use state::History;
+pub(crate) use state::StepPast;
 pub use truncated::{eq6_weights, Truncated};
