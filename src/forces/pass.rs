@@ -315,7 +315,7 @@ fn spring_sums<T>(
             let hi = if k + 1 == tasks {
                 n
             } else {
-                task_start(k + 1) - band
+                task_start(k + 1).saturating_sub(band)
             };
             lo..hi.max(lo)
         };
