@@ -203,6 +203,30 @@ macro_rules! force_input {
     };
 }
 
+/// The step's first pass (`prepass::FirstPass`) of cloth `$c` with scratch `$s`, for `$plan`,
+/// its history `$past`, and the component arrays of positions and damping rates `$sx`, `$sq`
+/// (each three slices, empty when the spring pass does not read them).
+macro_rules! first_pass {
+    ($c:ident, $s:ident, $plan:expr, $past:expr, $sx:expr, $sq:expr) => {
+        prepass::FirstPass {
+            x: &$c.x,
+            v: &$c.v,
+            goal: &$s.pins.goal,
+            hard_pins: &$s.pins.hard,
+            h: $plan.h,
+            sampling: $plan.sampling,
+            current: $c.config.model.current,
+            rate: forces::spring_rate(&$c.config.model),
+            past: $past.as_ref(),
+            v_step: parallel::Disjoint::new(&mut $s.v_step),
+            v_rel: parallel::Disjoint::new(&mut $s.v_rel),
+            half: parallel::Disjoint::new(&mut $s.half),
+            sx: $sx.map(parallel::Disjoint::new),
+            sq: $sq.map(parallel::Disjoint::new),
+        }
+    };
+}
+
 impl Cloth {
     /// One step as `plan` says. Nothing is committed unless every pass succeeds.
     pub(super) fn advance(&mut self, plan: StepPlan) -> Result<(), Error> {
@@ -268,22 +292,7 @@ impl Cloth {
         // A tile walk transposes its own spring inputs; only other topologies need them here.
         let arrays = self.topology.tiled.is_none();
         let (sx, sq) = s.force_pass.spring_arrays(if arrays { n } else { 0 });
-        let first = prepass::FirstPass {
-            x: &self.x,
-            v: &self.v,
-            goal: &s.pins.goal,
-            hard_pins: &s.pins.hard,
-            h: plan.h,
-            sampling: plan.sampling,
-            current: self.config.model.current,
-            rate: forces::spring_rate(&self.config.model),
-            past: past.as_ref(),
-            v_step: parallel::Disjoint::new(&mut s.v_step),
-            v_rel: parallel::Disjoint::new(&mut s.v_rel),
-            half: parallel::Disjoint::new(&mut s.half),
-            sx: sx.slices_mut().map(parallel::Disjoint::new),
-            sq: sq.slices_mut().map(parallel::Disjoint::new),
-        };
+        let first = first_pass!(self, s, plan, past, sx.slices_mut(), sq.slices_mut());
         let w0 = first.w0();
         parallel::for_chunks(parallel::worth_it(n), n, parallel::CHUNK, |lo, len| {
             // SAFETY: every particle once, in chunks (which start on multiples of TILE).
@@ -330,22 +339,9 @@ impl Cloth {
         let history = self.histories.get_mut(Memory::Particles);
         let with_history = !history.is_off();
         let past = with_history.then(|| history.begin_step());
-        let first = prepass::FirstPass {
-            x: &self.x,
-            v: &self.v,
-            goal: &s.pins.goal,
-            hard_pins: &s.pins.hard,
-            h: plan.h,
-            sampling: plan.sampling,
-            current: self.config.model.current,
-            rate: forces::spring_rate(&self.config.model),
-            past: past.as_ref(),
-            v_step: parallel::Disjoint::new(&mut s.v_step),
-            v_rel: parallel::Disjoint::new(&mut s.v_rel),
-            half: parallel::Disjoint::new(&mut s.half),
-            sx: std::array::from_fn(|_| parallel::Disjoint::new(&mut [])),
-            sq: std::array::from_fn(|_| parallel::Disjoint::new(&mut [])),
-        };
+        // A tiled topology: the walk transposes its own spring inputs.
+        let none = || -> [&mut [f64]; 3] { [&mut [], &mut [], &mut []] };
+        let first = first_pass!(self, s, plan, past, none(), none());
         weights.0[Memory::Particles.index()] = first.w0();
         // SAFETY: the force pass runs every particle once, in ranges that start on multiples
         // of TILE, and reads none while it runs (`forces::Ahead`).
