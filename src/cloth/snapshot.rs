@@ -401,10 +401,10 @@ impl Cloth {
         // and lists keep their room: the steps after a load allocate nothing); a trial step on
         // a copy says whether it can step (`trial_step`), and the state it replaced comes back
         // when it cannot.
-        let (old_vt, old_ee) = {
-            let (vt, ee) = self.self_collision.pairs();
-            (vt.to_vec(), ee.to_vec())
-        };
+        // Self-collision's memory as it is (its pairs and where it last looked), to come back
+        // whole when the load is refused.
+        let mut old_memory = crate::collide::self_collision::SavedMemory::default();
+        self.self_collision.save_memory(&mut old_memory);
         let mut state = LoadedState {
             time,
             steps,
@@ -424,7 +424,7 @@ impl Cloth {
             .set_pairs(collisions.vertex_triangle, collisions.edge_edge);
         if let Err(e) = self.trial_step() {
             self.swap_state(&mut state);
-            self.self_collision.set_pairs(old_vt, old_ee);
+            self.self_collision.swap_memory(&mut old_memory);
             return Err(e);
         }
         Ok(())
