@@ -292,7 +292,20 @@ impl MeshCollider {
             ))),
             Some(v) => {
                 check_points("velocity", v)?;
-                self.given_velocity = v.to_vec();
+                // Into the room of the last call's (a host gives them every frame): no
+                // allocation once it holds a mesh's worth, and nothing changed when refused.
+                if self.given_velocity.capacity() < v.len() {
+                    let mut room = Vec::new();
+                    room.try_reserve_exact(v.len()).map_err(|_| {
+                        Error::out_of_memory(format!(
+                            "mesh collider: the velocities of {} vertices cannot be allocated",
+                            v.len()
+                        ))
+                    })?;
+                    self.given_velocity = room;
+                }
+                self.given_velocity.clear();
+                self.given_velocity.extend_from_slice(v);
                 Ok(())
             }
             None => {
