@@ -610,6 +610,10 @@ FcStatus fc_cloth_pin_group(FcCloth *cloth, const uint32_t *indices, size_t coun
  * `(xyz[3k], xyz[3k+1], xyz[3k+2])` (m). Every index must be pinned; the pin
  * travels in a straight line over the step, which is its velocity.
  *
+ * Like every call a host makes each frame (pin targets, colliders, the current, stepping,
+ * reading positions and normals), it allocates nothing once a call of its size has been
+ * made: the handle keeps the room it converts the floats in (`tests/no_alloc.rs`).
+ *
  * # Safety
  * `cloth` NULL or live; `indices` `count` readable values; `xyz` `3 * count` readable floats.
  */
@@ -966,7 +970,8 @@ FcStatus fc_cloth_get_triangles(const FcCloth *cloth, uint32_t *indices, size_t 
  * Writes the unit normal of every vertex at the current positions into `xyz` (float triples;
  * `float_count` = 3 * vertex_count): the area-weighted sum of its triangles' normals, pointing to
  * the side from which they wind counter-clockwise (+z for a fresh grid); (0, 0, 0) for a vertex
- * whose triangles have collapsed. For smooth shading of the cloth as it is now.
+ * whose triangles have collapsed. For smooth shading of the cloth as it is now; no allocation
+ * once it has been called (the handle keeps the room for them).
  *
  * # Safety
  * `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
@@ -1039,7 +1044,8 @@ FcStatus fc_cloth_add_mesh_collider(FcCloth *cloth,
  * Moves or deforms mesh collider `id`: `vertex_count` new positions (3 floats each, m) of
  * the same vertices in the same order, and their velocities (NULL: from the motion). The mesh
  * travels there in a straight line over the next `fc_cloth_step` call, as the pins do; call
- * it once a frame with the evaluated mesh (armature, shape keys, modifiers).
+ * it once a frame with the evaluated mesh (armature, shape keys, modifiers). No allocation
+ * once a call has been made with as many vertices (and velocities, when given).
  *
  * Errors: `FC_ERROR_OUT_OF_RANGE` for no mesh collider `id`; `FC_ERROR_INVALID_ARGUMENT` for
  * a vertex count other than the mesh's or a non-finite value. Nothing changes on an error.

@@ -327,13 +327,27 @@ impl Cloth {
                 out.len()
             )));
         }
+        self.vertex_normals_in(out, &mut Vec::new())
+    }
+
+    /// [`Self::vertex_normals`] with the triangles' normals summed in `faces` (its contents
+    /// replaced; in its room when it has enough): a host that shades every frame keeps one and
+    /// allocates nothing.
+    pub fn vertex_normals_in(&self, out: &mut [Vec3], faces: &mut Vec<Vec3>) -> Result<(), Error> {
+        if out.len() != self.vertex_count() {
+            return Err(Error::invalid(format!(
+                "expected {} normals, got room for {}",
+                self.vertex_count(),
+                out.len()
+            )));
+        }
         let t = &self.topology;
-        let mut faces = Vec::new();
+        faces.clear();
         faces
             .try_reserve_exact(t.triangles.len())
             .map_err(|_| Error::out_of_memory(format!("no memory for {} face normals", t.triangles.len())))?;
         faces.resize(t.triangles.len(), Vec3::zeros());
-        forces::vertex_normals_with(&self.x, &t.triangles, &t.vertex_triangles, false, &mut faces, out);
+        forces::vertex_normals_with(&self.x, &t.triangles, &t.vertex_triangles, false, faces, out);
         Ok(())
     }
 

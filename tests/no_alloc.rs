@@ -358,6 +358,131 @@ fn steps_do_not_allocate() {
         let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
         assert_eq!(during, 0, "steps after a load: {during} allocations in 40 steps");
     }
+    // An engine's frame through the C ABI: pin targets, a moving sphere, a skinned mesh
+    // collider with its velocities every other frame, the current, a step, then positions and
+    // normals read back. The handle converts the host's floats in its own room: no allocation
+    // once the first frames have sized it. (0.9.18 allocated in every input call, and the
+    // normals' room at every read.)
+    {
+        use fraccloth::collide::shapes::uv_sphere;
+        use fraccloth::ffi::FcStatus::FC_OK;
+        use fraccloth::ffi::*;
+        use fraccloth::Vec3;
+        let (w, h) = (15u32, 11u32);
+        // The underwater preset, at its automatic step.
+        let mut desc = fc_cloth_desc_default();
+        assert_eq!(
+            unsafe { fc_cloth_desc_preset(FcPreset::FC_PRESET_UNDERWATER as u32, &mut desc) },
+            FC_OK
+        );
+        desc.width = w;
+        desc.height = h;
+        desc.spacing = 0.02;
+        let mut c = std::ptr::null_mut();
+        let n = (w * h) as usize;
+        let dt = 1.0 / 240.0;
+        // Every motion repeats every 30 frames: the counted frames go where the first ones went.
+        let phase = |frame: usize| (frame as f64 * std::f64::consts::PI / 15.0).sin();
+        let ball = |frame: usize| {
+            let z = 0.1 - 0.05 * phase(frame).abs();
+            uv_sphere(Vec3::new(0.14, -0.1, z), 0.06, 16, 9)
+        };
+        let floats =
+            |p: &[Vec3]| -> Vec<f32> { p.iter().flat_map(|v| v.iter().map(|&x| x as f32)).collect() };
+        let (x0, tris) = ball(0);
+        let indices: Vec<u32> = tris.iter().flatten().copied().collect();
+        // Every frame's inputs made before counting.
+        type Frame = (Vec<f32>, Option<Vec<f32>>, Vec<f32>, [f32; 3], [f32; 3]);
+        let frames: Vec<Frame> = (1..=120)
+            .map(|f| {
+                let (now, before) = (ball(f).0, ball(f - 1).0);
+                let v: Vec<Vec3> = now.iter().zip(&before).map(|(a, b)| (a - b) / dt).collect();
+                let sway = 0.02 * phase(f);
+                let pins: Vec<f32> = (0..w)
+                    .flat_map(|i| [(0.02 * f64::from(i) + sway) as f32, 0.0, 0.0])
+                    .collect();
+                let sphere = [0.14, -0.1, (-0.2 + 0.05 * phase(f)) as f32];
+                let current = [0.0, 0.0, (0.1 + 0.05 * phase(f)) as f32];
+                (
+                    floats(&now),
+                    (f % 2 == 0).then(|| floats(&v)),
+                    pins,
+                    sphere,
+                    current,
+                )
+            })
+            .collect();
+        let top: Vec<u32> = (0..w).collect();
+        let (mut positions, mut normals) = (vec![0f32; 3 * n], vec![0f32; 3 * n]);
+        let (mut sphere_id, mut mesh_id) = (0, 0);
+        unsafe {
+            assert_eq!(fc_cloth_create_grid(&desc, &mut c), FC_OK);
+            assert_eq!(fc_cloth_set_pinned(c, top.as_ptr(), top.len()), FC_OK);
+            let centre = [0.14f32, -0.1, -0.2];
+            assert_eq!(
+                fc_cloth_add_sphere(c, centre.as_ptr(), 0.05, std::ptr::null(), &mut sphere_id),
+                FC_OK
+            );
+            let x0 = floats(&x0);
+            assert_eq!(
+                fc_cloth_add_mesh_collider(
+                    c,
+                    x0.as_ptr(),
+                    x0.len() / 3,
+                    indices.as_ptr(),
+                    indices.len(),
+                    std::ptr::null(),
+                    &mut mesh_id
+                ),
+                FC_OK
+            );
+        }
+        let frame = |f: &Frame| unsafe {
+            let (mesh, vel, pins, sphere, current) = f;
+            assert_eq!(
+                fc_cloth_set_pin_targets(c, top.as_ptr(), pins.as_ptr(), top.len()),
+                FC_OK
+            );
+            assert_eq!(
+                fc_cloth_set_sphere(c, sphere_id, sphere.as_ptr(), 0.05, std::ptr::null()),
+                FC_OK
+            );
+            let vel = vel.as_ref().map_or(std::ptr::null(), |v| v.as_ptr());
+            assert_eq!(
+                fc_cloth_set_mesh_collider(c, mesh_id, mesh.as_ptr(), mesh.len() / 3, vel),
+                FC_OK
+            );
+            assert_eq!(fc_cloth_set_current(c, current.as_ptr()), FC_OK);
+            assert_eq!(fc_cloth_step(c, dt), FC_OK);
+        };
+        let (warm, counted) = frames.split_at(90);
+        let read = |positions: &mut [f32], normals: &mut [f32]| unsafe {
+            assert_eq!(
+                fc_cloth_get_positions(c, positions.as_mut_ptr(), positions.len()),
+                FC_OK
+            );
+            assert_eq!(
+                fc_cloth_get_normals(c, normals.as_mut_ptr(), normals.len()),
+                FC_OK
+            );
+        };
+        for f in warm {
+            frame(f);
+            read(&mut positions, &mut normals);
+        }
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for f in counted {
+            frame(f);
+            read(&mut positions, &mut normals);
+        }
+        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        unsafe { fc_cloth_destroy(c) };
+        assert!(normals.iter().any(|&x| x != 0.0) && positions.iter().all(|x| x.is_finite()));
+        assert_eq!(
+            during, 0,
+            "an engine's frames through the C ABI: {during} allocations in 30 frames"
+        );
+    }
     // The counter does count: building a cloth allocates.
     let before = ALLOCATIONS.load(Ordering::Relaxed);
     let _ = SceneSpec::paper(SceneKind::Swing, Variant::Fractional)

@@ -9,6 +9,30 @@ use super::status::{guard, guard_value, FcStatus, FfiError};
 /// free with `fc_cloth_destroy`.
 pub struct FcCloth {
     pub(crate) cloth: Cloth,
+    /// Room for what the calls a host makes every frame convert: no allocation once a call has
+    /// been made with as many values.
+    pub(crate) scratch: Scratch,
+}
+
+/// The handle's room for the host's values on their way in and out.
+#[derive(Debug, Default)]
+pub(crate) struct Scratch {
+    /// The values of an input call (positions, pin targets, a mesh collider's positions).
+    pub(crate) input: Vec<Vec3>,
+    /// A second input of the same call (a mesh collider's velocities).
+    pub(crate) second: Vec<Vec3>,
+    /// The vertex and triangle normals of `fc_cloth_get_normals`, which takes a `const`
+    /// handle (locked for the call; a call that finds it locked uses room of its own).
+    pub(crate) normals: std::sync::Mutex<(Vec<Vec3>, Vec<Vec3>)>,
+}
+
+impl FcCloth {
+    pub(crate) fn new(cloth: Cloth) -> Self {
+        Self {
+            cloth,
+            scratch: Scratch::default(),
+        }
+    }
 }
 
 /// Borrows `len` elements at `ptr`; NULL is accepted only when `len` is 0.
@@ -47,6 +71,18 @@ pub(crate) unsafe fn handle_mut<'a>(cloth: *mut FcCloth) -> Result<&'a mut Cloth
 /// Converts xyz triples (float or double) to vectors, rejecting NaN and infinities.
 pub(crate) fn triples<T: Copy + Into<f64>>(xyz: &[T], what: &str) -> Result<Vec<Vec3>, FfiError> {
     let mut out = Vec::new();
+    triples_into(xyz, what, &mut out)?;
+    Ok(out)
+}
+
+/// [`triples`] into `out` (its contents replaced), in its room when it has enough: the calls a
+/// host makes every frame convert into the handle's [`Scratch`].
+pub(crate) fn triples_into<T: Copy + Into<f64>>(
+    xyz: &[T],
+    what: &str,
+    out: &mut Vec<Vec3>,
+) -> Result<(), FfiError> {
+    out.clear();
     out.try_reserve_exact(xyz.len() / 3).map_err(|_| {
         FfiError::from(crate::Error::out_of_memory(format!(
             "no memory for {} {what}s",
@@ -63,7 +99,30 @@ pub(crate) fn triples<T: Copy + Into<f64>>(xyz: &[T], what: &str) -> Result<Vec<
         }
         out.push(v);
     }
-    Ok(out)
+    Ok(())
+}
+
+/// One xyz triple (float or double) as a vector, rejecting NaN and infinities.
+pub(crate) fn triple<T: Copy + Into<f64>>(xyz: &[T], what: &str) -> Result<Vec3, FfiError> {
+    let v = Vec3::new(xyz[0].into(), xyz[1].into(), xyz[2].into());
+    if !v.iter().all(|x| x.is_finite()) {
+        return Err(FfiError::invalid(format!(
+            "{what} is not finite: ({}, {}, {})",
+            v.x, v.y, v.z
+        )));
+    }
+    Ok(v)
+}
+
+/// # Safety
+/// Non-NULL `cloth` must be a live handle not used elsewhere during the call.
+pub(crate) unsafe fn handle_and_scratch<'a>(
+    cloth: *mut FcCloth,
+) -> Result<(&'a mut Cloth, &'a mut Scratch), FfiError> {
+    // SAFETY: the caller promises a live, unaliased handle or NULL.
+    unsafe { cloth.as_mut() }
+        .map(|c| (&mut c.cloth, &mut c.scratch))
+        .ok_or_else(|| FfiError::null("cloth"))
 }
 
 pub(crate) fn check_float_count(cloth: &Cloth, float_count: usize) -> Result<(), FfiError> {
@@ -126,7 +185,7 @@ pub(crate) unsafe fn create(
         let desc = unsafe { super::desc_size::read_desc(desc, super::desc::fc_cloth_desc_default()) }?;
         let config = desc.config()?;
         let cloth = Cloth::new(topology(&desc)?, config)?;
-        let raw = Box::into_raw(Box::new(FcCloth { cloth }));
+        let raw = Box::into_raw(Box::new(FcCloth::new(cloth)));
         // SAFETY: checked non-NULL; the caller promises it is writable.
         unsafe { *out = raw };
         Ok(())
@@ -240,6 +299,10 @@ pub unsafe extern "C" fn fc_cloth_pin_group(
 /// `(xyz[3k], xyz[3k+1], xyz[3k+2])` (m). Every index must be pinned; the pin
 /// travels in a straight line over the step, which is its velocity.
 ///
+/// Like every call a host makes each frame (pin targets, colliders, the current, stepping,
+/// reading positions and normals), it allocates nothing once a call of its size has been
+/// made: the handle keeps the room it converts the floats in (`tests/no_alloc.rs`).
+///
 /// # Safety
 /// `cloth` NULL or live; `indices` `count` readable values; `xyz` `3 * count` readable floats.
 #[no_mangle]
@@ -251,14 +314,14 @@ pub unsafe extern "C" fn fc_cloth_set_pin_targets(
 ) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
-        let cloth = unsafe { handle_mut(cloth) }?;
+        let (cloth, scratch) = unsafe { handle_and_scratch(cloth) }?;
         let indices = unsafe { slice_in(indices, count, "indices") }?;
         let floats = count
             .checked_mul(3)
             .ok_or_else(|| FfiError::invalid("count too large"))?;
         let xyz = unsafe { slice_in(xyz, floats, "xyz") }?;
-        let targets = triples(xyz, "target")?;
-        Ok(cloth.set_pin_targets(indices, &targets)?)
+        triples_into(xyz, "target", &mut scratch.input)?;
+        Ok(cloth.set_pin_targets(indices, &scratch.input)?)
     })
 }
 
@@ -275,10 +338,11 @@ pub unsafe extern "C" fn fc_cloth_set_positions(
 ) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
-        let cloth = unsafe { handle_mut(cloth) }?;
+        let (cloth, scratch) = unsafe { handle_and_scratch(cloth) }?;
         check_float_count(cloth, float_count)?;
         let xyz = unsafe { slice_in(xyz, float_count, "xyz") }?;
-        Ok(cloth.set_positions(&triples(xyz, "position")?)?)
+        triples_into(xyz, "position", &mut scratch.input)?;
+        Ok(cloth.set_positions(&scratch.input)?)
     })
 }
 
@@ -380,8 +444,7 @@ pub(crate) unsafe fn set_current_from<T: Copy + Into<f64>>(cloth: *mut FcCloth, 
         // SAFETY: forwarded caller promises.
         let cloth = unsafe { handle_mut(cloth) }?;
         let xyz = unsafe { slice_in(xyz, 3, "xyz") }?;
-        let c = triples(xyz, "current")?;
-        Ok(cloth.set_current(c[0])?)
+        Ok(cloth.set_current(triple(xyz, "current")?)?)
     })
 }
 

@@ -3,7 +3,7 @@
 use crate::forces::{Capsule, Collider, Plane, Sphere};
 use crate::math::Vec3;
 
-use super::cloth::{handle, handle_mut, slice_in, triples};
+use super::cloth::{handle, handle_mut, slice_in, triple};
 use super::status::{guard, FcStatus, FfiError};
 
 /// Three floats at `p` as a vector (NULL is an error).
@@ -12,7 +12,7 @@ unsafe fn vec_in(p: *const f32, what: &str) -> Result<Vec3, FfiError> {
         return Err(FfiError::null(what));
     }
     // SAFETY: non-NULL; the caller promises 3 readable floats.
-    Ok(triples(unsafe { slice_in(p, 3, what) }?, what)?[0])
+    triple(unsafe { slice_in(p, 3, what) }?, what)
 }
 
 /// A velocity: three floats, or zero for NULL.

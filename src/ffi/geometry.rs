@@ -42,7 +42,8 @@ pub unsafe extern "C" fn fc_cloth_get_triangles(
 /// Writes the unit normal of every vertex at the current positions into `xyz` (float triples;
 /// `float_count` = 3 * vertex_count): the area-weighted sum of its triangles' normals, pointing to
 /// the side from which they wind counter-clockwise (+z for a fresh grid); (0, 0, 0) for a vertex
-/// whose triangles have collapsed. For smooth shading of the cloth as it is now.
+/// whose triangles have collapsed. For smooth shading of the cloth as it is now; no allocation
+/// once it has been called (the handle keeps the room for them).
 ///
 /// # Safety
 /// `cloth` NULL or live; `xyz` NULL or `float_count` writable floats.
@@ -53,21 +54,28 @@ pub unsafe extern "C" fn fc_cloth_get_normals(
     float_count: usize,
 ) -> FcStatus {
     guard(|| {
-        // SAFETY: forwarded caller promise.
-        let cloth = unsafe { handle(cloth) }?;
+        // SAFETY: the caller promises a live handle or NULL.
+        let handle = unsafe { cloth.as_ref() }.ok_or_else(|| FfiError::null("cloth"))?;
+        let cloth = &handle.cloth;
         check_float_count(cloth, float_count)?;
         if xyz.is_null() {
             return Err(FfiError::null("xyz"));
         }
-        let mut normals = Vec::new();
+        // The handle's room (a host reads the normals every frame), or room of this call's
+        // own when another call holds it.
+        let mut own = (Vec::new(), Vec::new());
+        let mut locked = handle.scratch.normals.try_lock().ok();
+        let (normals, faces) = locked.as_deref_mut().unwrap_or(&mut own);
+        let n = cloth.vertex_count();
+        normals.clear();
         normals
-            .try_reserve_exact(cloth.vertex_count())
+            .try_reserve_exact(n)
             .map_err(|_| FfiError::from(crate::Error::out_of_memory("no memory for the normals")))?;
-        normals.resize(cloth.vertex_count(), Vec3::zeros());
-        cloth.vertex_normals(&mut normals)?;
+        normals.resize(n, Vec3::zeros());
+        cloth.vertex_normals_in(normals, faces)?;
         // SAFETY: non-NULL and the caller promises `float_count` writable floats.
         let out = unsafe { std::slice::from_raw_parts_mut(xyz, float_count) };
-        write_triples(&normals, out, to_f32);
+        write_triples(normals, out, to_f32);
         Ok(())
     })
 }

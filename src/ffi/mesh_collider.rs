@@ -2,11 +2,27 @@
 
 use crate::math::Vec3;
 
-use super::cloth::{handle, handle_mut, put, slice_in, triples, FcCloth};
+use super::cloth::{handle, handle_and_scratch, handle_mut, put, slice_in, triples_into, FcCloth};
 use super::status::{guard, FcStatus, FfiError};
 
 /// `3 * count` floats at `xyz` as vectors.
 unsafe fn points_in(xyz: *const f32, count: usize, what: &str) -> Result<Vec<Vec3>, FfiError> {
+    let mut out = Vec::new();
+    // SAFETY: forwarded caller promises.
+    unsafe { points_into(xyz, count, what, &mut out) }?;
+    Ok(out)
+}
+
+/// [`points_in`] into `out` (its contents replaced, in its room when it has enough).
+///
+/// # Safety
+/// `xyz` NULL or `3 * count` readable floats.
+unsafe fn points_into(
+    xyz: *const f32,
+    count: usize,
+    what: &str,
+    out: &mut Vec<Vec3>,
+) -> Result<(), FfiError> {
     if xyz.is_null() {
         return Err(FfiError::null(what));
     }
@@ -14,7 +30,7 @@ unsafe fn points_in(xyz: *const f32, count: usize, what: &str) -> Result<Vec<Vec
         .checked_mul(3)
         .ok_or_else(|| FfiError::invalid(format!("{what}: count too large")))?;
     // SAFETY: non-NULL; the caller promises `3 * count` readable floats.
-    triples(unsafe { slice_in(xyz, floats, what) }?, what)
+    triples_into(unsafe { slice_in(xyz, floats, what) }?, what, out)
 }
 
 /// Velocities: NULL for none (then from the motion between calls).
@@ -96,7 +112,8 @@ pub unsafe extern "C" fn fc_cloth_add_mesh_collider(
 /// Moves or deforms mesh collider `id`: `vertex_count` new positions (3 floats each, m) of
 /// the same vertices in the same order, and their velocities (NULL: from the motion). The mesh
 /// travels there in a straight line over the next `fc_cloth_step` call, as the pins do; call
-/// it once a frame with the evaluated mesh (armature, shape keys, modifiers).
+/// it once a frame with the evaluated mesh (armature, shape keys, modifiers). No allocation
+/// once a call has been made with as many vertices (and velocities, when given).
 ///
 /// Errors: `FC_ERROR_OUT_OF_RANGE` for no mesh collider `id`; `FC_ERROR_INVALID_ARGUMENT` for
 /// a vertex count other than the mesh's or a non-finite value. Nothing changes on an error.
@@ -114,12 +131,18 @@ pub unsafe extern "C" fn fc_cloth_set_mesh_collider(
 ) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
-        let cloth = unsafe { handle_mut(cloth) }?;
+        let (cloth, scratch) = unsafe { handle_and_scratch(cloth) }?;
+        // Into the handle's room: a host sets a skinned mesh every frame.
         // SAFETY: forwarded caller promises.
-        let positions = unsafe { points_in(xyz, vertex_count, "xyz") }?;
-        // SAFETY: forwarded caller promise.
-        let v = unsafe { velocities_in(velocities, vertex_count) }?;
-        Ok(cloth.set_mesh_collider(id, &positions, v.as_deref())?)
+        unsafe { points_into(xyz, vertex_count, "xyz", &mut scratch.input) }?;
+        let v = if velocities.is_null() {
+            None
+        } else {
+            // SAFETY: forwarded caller promise.
+            unsafe { points_into(velocities, vertex_count, "velocities", &mut scratch.second) }?;
+            Some(&scratch.second[..])
+        };
+        Ok(cloth.set_mesh_collider(id, &scratch.input, v)?)
     })
 }
 

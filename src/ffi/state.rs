@@ -2,7 +2,7 @@
 //! keep their own state (an undo stack, a network replica) and for tests and references that
 //! need exact initial states. Positions and velocities in `float` are in `cloth.rs`.
 
-use super::cloth::{check_float_count, copy_out, handle_mut, slice_in, triples, FcCloth};
+use super::cloth::{check_float_count, copy_out, handle_and_scratch, slice_in, triples_into, FcCloth};
 use super::status::{guard, FcStatus};
 use crate::{Cloth, Vec3};
 
@@ -20,10 +20,11 @@ unsafe fn set_all<T: Copy + Into<f64>>(
 ) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
-        let cloth = unsafe { handle_mut(cloth) }?;
+        let (cloth, scratch) = unsafe { handle_and_scratch(cloth) }?;
         check_float_count(cloth, count)?;
         let xyz = unsafe { slice_in(xyz, count, "xyz") }?;
-        Ok(set(cloth, &triples(xyz, what)?)?)
+        triples_into(xyz, what, &mut scratch.input)?;
+        Ok(set(cloth, &scratch.input)?)
     })
 }
 

@@ -84,8 +84,14 @@ impl From<Error> for FfiError {
 }
 
 pub(crate) fn set_last_error(message: &str) {
-    let c = CString::new(message.replace('\0', " ")).unwrap_or_default();
-    LAST_ERROR.with(|e| *e.borrow_mut() = c);
+    LAST_ERROR.with(|e| {
+        // A successful call after a successful call changes nothing: no allocation in the
+        // calls a host makes every frame.
+        if message.is_empty() && e.borrow().as_bytes().is_empty() {
+            return;
+        }
+        *e.borrow_mut() = CString::new(message.replace('\0', " ")).unwrap_or_default();
+    });
 }
 
 /// Runs `f` inside the panic boundary and turns its result into a status.
