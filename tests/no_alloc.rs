@@ -335,14 +335,19 @@ fn steps_do_not_allocate() {
     }
     // Loading a snapshot keeps the cloth's own buffers: the steps after a load allocate
     // nothing (a host that rewinds to a saved state mid-bake keeps its frame budget). The
-    // brisk underwater swing with self-collision, whose looks keep lists between steps. (A
-    // mesh collider is loaded as a new one, whose lists grow again in the first steps.)
+    // brisk underwater swing with self-collision, whose looks keep lists between steps, and a
+    // mesh collider it swings into: the one made from the snapshot takes the room of the one
+    // it replaces (0.9.18 made it anew, and its lists grew again in its first steps).
     {
+        use fraccloth::collide::shapes::uv_sphere;
+        use fraccloth::Vec3;
         let mut model = fraccloth::Model::underwater();
         model.self_collision_relative = 0.4;
         let mut scene = SceneSpec::underwater_swing(15, 11, 2.0, 0.08, model)
             .build()
             .unwrap();
+        let (x, tris) = uv_sphere(Vec3::new(0.07, -0.05, 0.03), 0.04, 16, 9);
+        scene.cloth.add_mesh_collider(&x, &tris, None).unwrap();
         for _ in 0..40 {
             scene.step().unwrap();
         }
@@ -356,6 +361,8 @@ fn steps_do_not_allocate() {
             scene.step().unwrap();
         }
         let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        let touching = scene.cloth.contacts().iter().filter(|c| c.len < 4).count();
+        assert!(touching > 0, "the towel touches the ball");
         assert_eq!(during, 0, "steps after a load: {during} allocations in 40 steps");
     }
     // An engine's frame through the C ABI: pin targets, a moving sphere, a skinned mesh

@@ -427,6 +427,13 @@ impl Cloth {
             self.self_collision.swap_memory(&mut old_memory);
             return Err(e);
         }
+        // Accepted: a mesh collider made from the snapshot takes the room of the one it
+        // replaced at its slot, so its first steps grow no list.
+        for (new, old) in self.mesh_slots.iter_mut().zip(&mut state.meshes) {
+            if let (Some(new), Some(old)) = (new, old) {
+                new.take_room(old);
+            }
+        }
         Ok(())
     }
 

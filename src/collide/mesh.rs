@@ -136,6 +136,40 @@ struct Candidates {
     total: usize,
 }
 
+impl Candidates {
+    /// Holds nothing, as a new one, but keeps its lists' room: each list is emptied and every
+    /// one is looked up again at the next refresh (`stale`). The lists by cloth vertex,
+    /// triangle and edge keep their count (the cloth's), and the cloth's edges and incidences
+    /// are kept: they are the same cloth's.
+    fn empty_keeping_room(&mut self) {
+        for list in self
+            .vertex
+            .iter_mut()
+            .chain(&mut self.triangle)
+            .chain(&mut self.edge)
+        {
+            list.clear();
+        }
+        for list in [
+            &mut self.with_vertex,
+            &mut self.with_triangle,
+            &mut self.with_edge,
+            &mut self.looked,
+            &mut self.dirty_triangles,
+            &mut self.dirty_edges,
+            &mut self.nearest,
+            &mut self.touched,
+        ] {
+            list.clear();
+        }
+        self.touching.clear();
+        self.inside.clear();
+        self.distance.clear();
+        self.stale = true;
+        self.total = 0;
+    }
+}
+
 /// Room for a mesh collider's candidate lists: this many entries a cloth vertex (vertex,
 /// triangle and edge lists together) above [`CANDIDATES_FLOOR`]. A cloth near a mesh has a few
 /// a vertex (a towel on the 10k-triangle ball: under 10); a margin many times the mesh's
@@ -451,6 +485,48 @@ impl MeshCollider {
         self.fresh_at = reach;
         self.cache.stale = true;
         Ok(())
+    }
+
+    /// Takes the room of `old`'s lists (a collider this one replaces at the same slot of the
+    /// same cloth: a snapshot's, when a load is accepted), so this one's first refreshes and
+    /// lookups grow nothing. Only room moves: what the lists hold is made again as for a new
+    /// collider (this one is not fresh, its candidates all looked up again). The trees move
+    /// too when the two meshes have the same triangles (they are refitted to this one's
+    /// boxes, as a moving mesh's are from call to call); else this one builds its own.
+    pub(crate) fn take_room(&mut self, old: &mut MeshCollider) {
+        for (mine, theirs) in [
+            (&mut self.face_normal, &mut old.face_normal),
+            (&mut self.vertex_normal, &mut old.vertex_normal),
+        ] {
+            if mine.capacity() < theirs.capacity() {
+                std::mem::swap(mine, theirs);
+                mine.clear();
+            }
+        }
+        for (mine, theirs) in [
+            (&mut self.tri_boxes, &mut old.tri_boxes),
+            (&mut self.vert_boxes, &mut old.vert_boxes),
+            (&mut self.edge_boxes, &mut old.edge_boxes),
+        ] {
+            if mine.capacity() < theirs.capacity() {
+                std::mem::swap(mine, theirs);
+                mine.clear();
+            }
+        }
+        if self.edges.capacity() < old.edges.capacity() {
+            std::mem::swap(&mut self.edges, &mut old.edges);
+            self.edges.clear();
+        }
+        if self.triangles == old.triangles && self.tri_bvh.is_empty() {
+            std::mem::swap(&mut self.tri_bvh, &mut old.tri_bvh);
+            std::mem::swap(&mut self.vert_bvh, &mut old.vert_bvh);
+            std::mem::swap(&mut self.edge_bvh, &mut old.edge_bvh);
+        }
+        self.fresh_at = f64::NAN;
+        if self.cache.vertex.is_empty() {
+            std::mem::swap(&mut self.cache, &mut old.cache);
+            self.cache.empty_keeping_room();
+        }
     }
 
     /// The error when a refresh's lists cannot be allocated (the mesh is left to refresh
