@@ -320,13 +320,6 @@ impl Cloth {
     /// wind counter-clockwise; zero for a vertex whose triangles have no area. Fails with
     /// out-of-memory (nothing written) when the per-triangle buffer cannot be allocated.
     pub fn vertex_normals(&self, out: &mut [Vec3]) -> Result<(), Error> {
-        if out.len() != self.vertex_count() {
-            return Err(Error::invalid(format!(
-                "expected {} normals, got room for {}",
-                self.vertex_count(),
-                out.len()
-            )));
-        }
         self.vertex_normals_in(out, &mut Vec::new())
     }
 

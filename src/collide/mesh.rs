@@ -494,29 +494,19 @@ impl MeshCollider {
     /// too when the two meshes have the same triangles (they are refitted to this one's
     /// boxes, as a moving mesh's are from call to call); else this one builds its own.
     pub(crate) fn take_room(&mut self, old: &mut MeshCollider) {
-        for (mine, theirs) in [
-            (&mut self.face_normal, &mut old.face_normal),
-            (&mut self.vertex_normal, &mut old.vertex_normal),
-        ] {
+        /// `theirs`'s room for `mine` when larger, emptied (`refresh` fills it again).
+        fn larger<T>(mine: &mut Vec<T>, theirs: &mut Vec<T>) {
             if mine.capacity() < theirs.capacity() {
                 std::mem::swap(mine, theirs);
                 mine.clear();
             }
         }
-        for (mine, theirs) in [
-            (&mut self.tri_boxes, &mut old.tri_boxes),
-            (&mut self.vert_boxes, &mut old.vert_boxes),
-            (&mut self.edge_boxes, &mut old.edge_boxes),
-        ] {
-            if mine.capacity() < theirs.capacity() {
-                std::mem::swap(mine, theirs);
-                mine.clear();
-            }
-        }
-        if self.edges.capacity() < old.edges.capacity() {
-            std::mem::swap(&mut self.edges, &mut old.edges);
-            self.edges.clear();
-        }
+        larger(&mut self.face_normal, &mut old.face_normal);
+        larger(&mut self.vertex_normal, &mut old.vertex_normal);
+        larger(&mut self.tri_boxes, &mut old.tri_boxes);
+        larger(&mut self.vert_boxes, &mut old.vert_boxes);
+        larger(&mut self.edge_boxes, &mut old.edge_boxes);
+        larger(&mut self.edges, &mut old.edges);
         if self.triangles == old.triangles && self.tri_bvh.is_empty() {
             std::mem::swap(&mut self.tri_bvh, &mut old.tri_bvh);
             std::mem::swap(&mut self.vert_bvh, &mut old.vert_bvh);
