@@ -50,6 +50,11 @@ const SLOTS: usize = 18;
 /// Cells per block of the face passes: one AVX-512 vector of f64.
 const BLOCK: usize = 8;
 
+/// Vertices (whole rows, at least one) whose sums and rates the first pass keeps before taking
+/// their patch terms: 192 KB of sums and rates, in the second-level cache. A band of no more
+/// takes them in one range, as it did before the rows were chunked.
+const PATCH_ROWS_VERTICES: usize = 4096;
+
 /// The buffers [`turning_grid`] fills: each band's rows of vertices' vectors, of a row of
 /// cells' terms and of sums, in component arrays (a few rows, in cache); each vertex's sums of
 /// its faces' area vectors and rates, and its `w`.
@@ -164,33 +169,30 @@ pub(super) fn turning_grid(
         bands.clear();
         bands.resize(count, vec![0.0; len]);
     }
-    for a in [&mut *sums, &mut *rates, &mut *patches] {
-        a.resize(n, Vec3::zeros());
+    // A few rows of sums and rates a band: their patch terms are taken while they are in cache.
+    let chunk = PATCH_ROWS_VERTICES.div_ceil(w).clamp(1, band);
+    for a in [&mut *sums, &mut *rates] {
+        a.resize(count * chunk * w, Vec3::zeros());
     }
+    patches.resize(n, Vec3::zeros());
     let (x, v) = (&x[..n], &v[..n]);
     let rows = parallel::Disjoint::new(&mut bands[..]);
     {
-        let d = [
-            &mut sums[..],
-            &mut rates[..],
-            &mut patches[..],
-            &mut normals[..n],
-            &mut out[..n],
-        ]
-        .map(parallel::Disjoint::new);
+        let d = [&mut patches[..], &mut normals[..n], &mut out[..n]].map(parallel::Disjoint::new);
+        let row_sums = [&mut sums[..], &mut rates[..]].map(parallel::Disjoint::new);
         let projected = parallel::Disjoint::new(&mut projected[..n]);
         parallel::for_chunks(par, h, band, |first, len| {
             let r = first * w..(first + len) * w;
+            let b = first / band;
             // SAFETY: every task borrows only its own band's rows of each array, and its own
-            // row buffer.
-            let [sums, rates, patches, normals, out] = d.each_ref().map(|a| unsafe { a.range(r.clone()) });
+            // row buffer and row of sums.
+            let [patches, normals, out] = d.each_ref().map(|a| unsafe { a.range(r.clone()) });
             // SAFETY: as above.
-            let (projected, rows) = unsafe {
-                (
-                    projected.range(r.clone()),
-                    rows.range(first / band..first / band + 1),
-                )
-            };
+            let [sums, rates] = row_sums
+                .each_ref()
+                .map(|a| unsafe { a.range(b * chunk * w..(b + 1) * chunk * w) });
+            // SAFETY: as above.
+            let (projected, rows) = unsafe { (projected.range(r.clone()), rows.range(b..b + 1)) };
             let mine = Band {
                 rows: first..first + len,
                 buffer: &mut rows[0],
@@ -229,8 +231,9 @@ struct Band<'a> {
 
 crate::simd_dispatch! { fn areas_and_patches_widest(ma: f64, t: &Topology, w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: [&mut [Vec3]; 2], patch_out: PatchOut<'_>) => areas_and_patches }
 
-/// A band's sums and rates ([`areas`], into `into`) and then its patch terms ([`patch_range`],
-/// into `patch_out`: the band's rows).
+/// A band's sums and rates ([`areas`]) and their patch terms ([`patch_range`], into
+/// `patch_out`: the band's rows), a few rows at a time while they are in cache (`into`: room
+/// for the sums and rates of those rows, whole rows).
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 #[inline(always)]
 fn areas_and_patches(
@@ -244,18 +247,81 @@ fn areas_and_patches(
     into: [&mut [Vec3]; 2],
     patch_out: PatchOut<'_>,
 ) {
-    let r = band.rows.start * w..band.rows.end * w;
     let [sums, rates] = into;
-    areas(w, h, x, v, band, [&mut *sums, &mut *rates]);
-    patch_range(
+    let mut rows = PatchRows {
         ma,
-        &t.areas[r.clone()],
-        &t.patch_scale[r.clone()],
+        t,
+        top: band.rows.start,
+        end: band.rows.end,
+        from: band.rows.start,
+        w,
+        v,
         sums,
         rates,
-        &v[r],
-        patch_out,
-    );
+        out: patch_out,
+    };
+    areas(w, h, x, v, band, &mut rows);
+}
+
+/// What [`areas_and_patches`] does with each vertex row's sums and rates once complete: keeps
+/// them until its room is full or the band ends, then takes their patch terms.
+struct PatchRows<'a> {
+    ma: f64,
+    t: &'a Topology,
+    /// The band's rows.
+    top: usize,
+    end: usize,
+    /// The first row kept.
+    from: usize,
+    w: usize,
+    v: &'a [Vec3],
+    /// Room for the sums and rates of whole rows.
+    sums: &'a mut [Vec3],
+    rates: &'a mut [Vec3],
+    /// The band's rows.
+    out: PatchOut<'a>,
+}
+
+impl PatchRows<'_> {
+    /// Keeps vertex row `row`'s sums and rates (`cur`: their components); takes the patch terms
+    /// of the rows kept when there is no room for another or the band ends. A method, not a
+    /// closure: inlined into the caller, it runs at the caller's vector width.
+    #[inline(always)]
+    fn done(&mut self, row: usize, cur: &[&mut [f64]]) {
+        let w = self.w;
+        let at = (row - self.from) * w..(row - self.from + 1) * w;
+        untranspose(&cur[..3], &mut self.sums[at.clone()]);
+        untranspose(&cur[3..], &mut self.rates[at.clone()]);
+        if at.end + w <= self.sums.len() && row + 1 < self.end {
+            return;
+        }
+        let g = self.from * w..(row + 1) * w;
+        let r = g.start - self.top * w..g.end - self.top * w;
+        let PatchOut {
+            o,
+            projected,
+            normals,
+            w: patches,
+        } = &mut self.out;
+        let out = PatchOut {
+            o: &mut o[r.clone()],
+            projected: &mut projected[r.clone()],
+            normals: &mut normals[r.clone()],
+            w: &mut patches[r],
+        };
+        let t = self.t;
+        let (sums, rates) = (&self.sums[..at.end], &self.rates[..at.end]);
+        patch_range(
+            self.ma,
+            &t.areas[g.clone()],
+            &t.patch_scale[g.clone()],
+            sums,
+            rates,
+            &self.v[g],
+            out,
+        );
+        self.from = row + 1;
+    }
 }
 
 crate::simd_dispatch! { fn gradients_widest(w: usize, h: usize, x: &[Vec3], patches: &[Vec3], band: Band<'_>, out: &mut [Vec3]) => gradients }
@@ -266,11 +332,11 @@ fn cell_rows(rows: &std::ops::Range<usize>, h: usize) -> std::ops::Range<usize> 
     rows.start.saturating_sub(1)..rows.end.min(h - 1)
 }
 
-/// Each vertex of the band's sums of its faces' area vectors and rates (`into`: the band's
-/// rows), in ascending face order from zero, as a scatter adds them.
+/// Each vertex of the band's sums of its faces' area vectors and rates, in ascending face order
+/// from zero, as a scatter adds them, handed to `done` row by row (the row, then the sums' and
+/// the rates' components).
 #[inline(always)]
-fn areas(w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: [&mut [Vec3]; 2]) {
-    let [sums, rates] = into;
+fn areas(w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, done: &mut PatchRows<'_>) {
     let Band { rows, buffer } = band;
     let (mut vectors, mut terms, mut cur, mut next) = carve(buffer, w);
     let cells = cell_rows(&rows, h);
@@ -278,7 +344,6 @@ fn areas(w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: [&mut
         a.fill(0.0);
     }
     vectors.start(cells.start, [x, v], w);
-    let at = |row: usize| (row - rows.start) * w..(row - rows.start + 1) * w;
     for c in cells {
         vectors.cell_row(c, [x, v], w, area_terms, &mut terms[..12]);
         // Cell row c completes vertex row c's sums and begins row c + 1's.
@@ -290,14 +355,12 @@ fn areas(w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: [&mut
             above(next[k], t1, t0, t1);
         }
         if c >= rows.start {
-            untranspose(&cur[..3], &mut sums[at(c)]);
-            untranspose(&cur[3..], &mut rates[at(c)]);
+            done.done(c, &cur);
         }
         std::mem::swap(&mut cur, &mut next);
     }
     if rows.end == h {
-        untranspose(&cur[..3], &mut sums[at(h - 1)]);
-        untranspose(&cur[3..], &mut rates[at(h - 1)]);
+        done.done(h - 1, &cur);
     }
 }
 
