@@ -312,7 +312,8 @@ pub fn turning_forces(
             rates,
             patches,
         };
-        super::turning_grid::turning_grid(ma, t, size, x, v, buffers, (band, par), projected, normals, out);
+        let split = (band, par, super::turning_grid::PATCH_ROWS_VERTICES);
+        super::turning_grid::turning_grid(ma, t, size, x, v, buffers, split, projected, normals, out);
     } else if par && coarse.is_none() {
         // Four chunks a thread, so that the pool can even out uneven chunks.
         let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1);
@@ -868,91 +869,75 @@ pub(super) fn patch_range(
     let (areas, scale, sums, rates, v) = (&areas[..m], &scale[..m], &sums[..m], &rates[..m], &v[..m]);
     let (projected, normals, w) = (&mut projected[..m], &mut normals[..m], &mut w[..m]);
     let whole = m / B * B;
-    let (i, o) = ((areas, scale, sums, rates, v), (o, projected, normals, w));
     for q in (0..whole).step_by(B) {
-        patch_block::<true>(ma, q, B, i, (&mut *o.0, &mut *o.1, &mut *o.2, &mut *o.3));
-    }
-    if whole < m {
-        // The last few in a block of their own, its other lanes zero: the same operations on
-        // each vertex (a row of a grid, `turning_grid.rs`, often ends so).
-        patch_block::<false>(ma, whole, m - whole, i, o);
-    }
-}
-
-/// The inputs of [`patch_block`]: `areas`, `scale`, `sums`, `rates`, `v`.
-type PatchIn<'a> = (&'a [f64], &'a [f64], &'a [Vec3], &'a [Vec3], &'a [Vec3]);
-
-/// One block of [`patch_range`]: the vertices `q .. q + count`; `FULL`: `count` is
-/// [`PATCH_BLOCK`] (else the other lanes are zero and nothing is written for them).
-#[inline(always)]
-fn patch_block<const FULL: bool>(
-    ma: f64,
-    q: usize,
-    count: usize,
-    (areas, scale, sums, rates, v): PatchIn<'_>,
-    (o, projected, normals, w): (&mut [Vec3], &mut [f64], &mut [Vec3], &mut [Vec3]),
-) {
-    const B: usize = PATCH_BLOCK;
-    let lanes = if FULL { B } else { count };
-    let side = |a: &[Vec3], c: usize| -> [f64; B] {
-        std::array::from_fn(|l| if FULL || l < count { a[q + l][c] } else { 0.0 })
-    };
-    let each =
-        |a: &[f64]| -> [f64; B] { std::array::from_fn(|l| if FULL || l < count { a[q + l] } else { 0.0 }) };
-    let n: [[f64; B]; 3] = std::array::from_fn(|c| side(sums, c));
-    let nd: [[f64; B]; 3] = std::array::from_fn(|c| side(rates, c));
-    let vv: [[f64; B]; 3] = std::array::from_fn(|c| side(v, c));
-    let mut oo: [[f64; B]; 3] = std::array::from_fn(|c| side(o, c));
-    let sc: [f64; B] = each(scale);
-    let k: [f64; B] = each(areas).map(|a| ma * a);
-    let (mut nr, mut ww) = ([[0.0; B]; 3], [[0.0; B]; 3]);
-    let mut pr = [0.0; B];
-    // Patches stretched past the carried water's bound (rare: a patch that stretches a
-    // fifth of its area) take `patch_turning`'s path, with its extra terms.
-    let mut over = [false; B];
-    for l in 0..B {
-        let len = (n[0][l] * n[0][l] + n[1][l] * n[1][l] + n[2][l] * n[2][l]).sqrt();
-        for c in 0..3 {
-            nr[c][l] = if len > 0.0 { n[c][l] / len } else { n[c][l] };
+        let side = |a: &[Vec3], c: usize| -> [f64; B] { std::array::from_fn(|l| a[q + l][c]) };
+        let n: [[f64; B]; 3] = std::array::from_fn(|c| side(sums, c));
+        let nd: [[f64; B]; 3] = std::array::from_fn(|c| side(rates, c));
+        let vv: [[f64; B]; 3] = std::array::from_fn(|c| side(v, c));
+        let mut oo: [[f64; B]; 3] = std::array::from_fn(|c| side(o, c));
+        let sc: [f64; B] = std::array::from_fn(|l| scale[q + l]);
+        let k: [f64; B] = std::array::from_fn(|l| ma * areas[q + l]);
+        let (mut nr, mut ww) = ([[0.0; B]; 3], [[0.0; B]; 3]);
+        let mut pr = [0.0; B];
+        // Patches stretched past the carried water's bound (rare: a patch that stretches a
+        // fifth of its area) take `patch_turning`'s path, with its extra terms.
+        let mut over = [false; B];
+        for l in 0..B {
+            let len = (n[0][l] * n[0][l] + n[1][l] * n[1][l] + n[2][l] * n[2][l]).sqrt();
+            for c in 0..3 {
+                nr[c][l] = if len > 0.0 { n[c][l] / len } else { n[c][l] };
+            }
+            let a = [sc[l] * n[0][l], sc[l] * n[1][l], sc[l] * n[2][l]];
+            let ad = [sc[l] * nd[0][l], sc[l] * nd[1][l], sc[l] * nd[2][l]];
+            let q = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+            pr[l] = q.sqrt();
+            over[l] = q > CARRIED_FULL;
+            let av = a[0] * vv[0][l] + a[1] * vv[1][l] + a[2] * vv[2][l];
+            let adv = ad[0] * vv[0][l] + ad[1] * vv[1][l] + ad[2] * vv[2][l];
+            let kw = k[l] * av * sc[l];
+            for c in 0..3 {
+                oo[c][l] -= k[l] * (av * ad[c] + adv * a[c]);
+                ww[c][l] = kw * vv[c][l];
+            }
         }
-        let a = [sc[l] * n[0][l], sc[l] * n[1][l], sc[l] * n[2][l]];
-        let ad = [sc[l] * nd[0][l], sc[l] * nd[1][l], sc[l] * nd[2][l]];
-        let q = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-        pr[l] = q.sqrt();
-        over[l] = q > CARRIED_FULL;
-        let av = a[0] * vv[0][l] + a[1] * vv[1][l] + a[2] * vv[2][l];
-        let adv = ad[0] * vv[0][l] + ad[1] * vv[1][l] + ad[2] * vv[2][l];
-        let kw = k[l] * av * sc[l];
-        for c in 0..3 {
-            oo[c][l] -= k[l] * (av * ad[c] + adv * a[c]);
-            ww[c][l] = kw * vv[c][l];
-        }
-    }
-    let before = over[..lanes]
-        .contains(&true)
-        .then(|| std::array::from_fn::<Vec3, B, _>(|l| if l < lanes { o[q + l] } else { Vec3::zeros() }));
-    for l in 0..lanes {
-        let i = q + l;
-        o[i] = Vec3::new(oo[0][l], oo[1][l], oo[2][l]);
-        normals[i] = Vec3::new(nr[0][l], nr[1][l], nr[2][l]);
-        w[i] = Vec3::new(ww[0][l], ww[1][l], ww[2][l]);
-        projected[i] = pr[l];
-    }
-    if let Some(before) = before {
-        for l in (0..lanes).filter(|&l| over[l]) {
+        let before = over
+            .contains(&true)
+            .then(|| std::array::from_fn::<Vec3, B, _>(|l| o[q + l]));
+        for l in 0..B {
             let i = q + l;
-            o[i] = before[l];
-            w[i] = patch_turning(
-                sums[i],
-                rates[i],
-                scale[i],
-                k[l],
-                &v[i],
-                &mut o[i],
-                &mut projected[i],
-                &mut normals[i],
-            );
+            o[i] = Vec3::new(oo[0][l], oo[1][l], oo[2][l]);
+            normals[i] = Vec3::new(nr[0][l], nr[1][l], nr[2][l]);
+            w[i] = Vec3::new(ww[0][l], ww[1][l], ww[2][l]);
+            projected[i] = pr[l];
         }
+        if let Some(before) = before {
+            for l in (0..B).filter(|&l| over[l]) {
+                let i = q + l;
+                o[i] = before[l];
+                w[i] = patch_turning(
+                    sums[i],
+                    rates[i],
+                    scale[i],
+                    k[l],
+                    &v[i],
+                    &mut o[i],
+                    &mut projected[i],
+                    &mut normals[i],
+                );
+            }
+        }
+    }
+    for i in whole..m {
+        w[i] = patch_turning(
+            sums[i],
+            rates[i],
+            scale[i],
+            ma * areas[i],
+            &v[i],
+            &mut o[i],
+            &mut projected[i],
+            &mut normals[i],
+        );
     }
 }
 

@@ -53,7 +53,7 @@ const BLOCK: usize = 8;
 /// Vertices (whole rows, at least one) whose sums and rates the first pass keeps before taking
 /// their patch terms: 192 KB of sums and rates, in the second-level cache. A band of no more
 /// takes them in one range, as it did before the rows were chunked.
-const PATCH_ROWS_VERTICES: usize = 4096;
+pub(super) const PATCH_ROWS_VERTICES: usize = 4096;
 
 /// The buffers [`turning_grid`] fills: each band's rows of vertices' vectors, of a row of
 /// cells' terms and of sums, in component arrays (a few rows, in cache); each vertex's sums of
@@ -138,10 +138,11 @@ fn above(acc: &mut [f64], a: &[f64], b: &[f64], c: &[f64]) {
 
 /// [`super::inertia::turning_forces`] for a grid of `w` x `h` vertices whose triangles are
 /// [`Topology::grid_faces`]'s: the same terms in the same order, so the same bits. In bands of
-/// `band` vertex rows, on the pool when `par`: first every band's sums and patch terms, then
-/// every band's gradients (which read the `w` of the rows beside it). A band computes the
-/// cell row above it too, as the band above does: the same values, so the bits do not depend
-/// on the bands.
+/// `band` vertex rows, on the pool when `par`, keeping the sums of `kept` vertices (whole rows,
+/// [`PATCH_ROWS_VERTICES`] in the step): first each band walks its rows once, taking their
+/// sums, patch terms and the gradients of the cell rows inside it; then the rows where bands
+/// meet take the gradients that read another band's `w`. A cell row two bands need is
+/// computed by both, with the same values: the bits do not depend on the bands.
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 pub(super) fn turning_grid(
     ma: f64,
@@ -150,7 +151,7 @@ pub(super) fn turning_grid(
     x: &[Vec3],
     v: &[Vec3],
     buffers: GridBuffers<'_>,
-    (band, par): (usize, bool),
+    (band, par, kept): (usize, bool, usize),
     projected: &mut [f64],
     normals: &mut [Vec3],
     out: &mut [Vec3],
@@ -164,13 +165,14 @@ pub(super) fn turning_grid(
     let n = w * h;
     let band = band.clamp(1, h);
     let count = h.div_ceil(band);
-    let len = 24 * w + SLOTS * (w - 1);
+    // Two sets of rows: the first pass's (areas) and the gradients'.
+    let len = 2 * (24 * w + SLOTS * (w - 1));
     if bands.len() != count || bands.iter().any(|b| b.len() != len) {
         bands.clear();
         bands.resize(count, vec![0.0; len]);
     }
     // A few rows of sums and rates a band: their patch terms are taken while they are in cache.
-    let chunk = PATCH_ROWS_VERTICES.div_ceil(w).clamp(1, band);
+    let chunk = kept.div_ceil(w).clamp(1, band);
     for a in [&mut *sums, &mut *rates] {
         a.resize(count * chunk * w, Vec3::zeros());
     }
@@ -206,6 +208,12 @@ pub(super) fn turning_grid(
             areas_and_patches_widest(ma, t, w, h, x, v, mine, [sums, rates], patch_out);
         });
     }
+    if count == 1 {
+        // One band: it took every face's gradients itself.
+        return;
+    }
+    // The rows where bands meet: each band's gradients of the cell rows that read another
+    // band's `w` (the one above its first row and its own last one).
     let (patches, d) = (&patches[..], parallel::Disjoint::new(&mut out[..n]));
     parallel::for_chunks(par, h, band, |first, len| {
         // SAFETY: as above.
@@ -219,21 +227,23 @@ pub(super) fn turning_grid(
             rows: first..first + len,
             buffer: &mut rows[0],
         };
-        gradients_widest(w, h, x, patches, mine, out);
+        edges_widest(w, h, x, patches, mine, out);
     });
 }
 
 /// A band of vertex rows and its row buffer.
 struct Band<'a> {
     rows: std::ops::Range<usize>,
-    buffer: &'a mut Vec<f64>,
+    buffer: &'a mut [f64],
 }
 
 crate::simd_dispatch! { fn areas_and_patches_widest(ma: f64, t: &Topology, w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, into: [&mut [Vec3]; 2], patch_out: PatchOut<'_>) => areas_and_patches }
 
-/// A band's sums and rates ([`areas`]) and their patch terms ([`patch_range`], into
-/// `patch_out`: the band's rows), a few rows at a time while they are in cache (`into`: room
-/// for the sums and rates of those rows, whole rows).
+/// A band's sums and rates ([`areas`]), their patch terms ([`patch_range`], into `patch_out`:
+/// the band's rows), a few rows at a time while they are in cache (`into`: room for the sums
+/// and rates of those rows, whole rows), and the gradients of the cell rows whose `w` the band
+/// holds ([`Gradients`]), each as soon as its two rows' `w` are there. What is left (the cell
+/// rows that read another band's `w`) is [`edges`]'s.
 #[allow(clippy::too_many_arguments)] // the step's arrays the passes read and write
 #[inline(always)]
 fn areas_and_patches(
@@ -248,23 +258,36 @@ fn areas_and_patches(
     patch_out: PatchOut<'_>,
 ) {
     let [sums, rates] = into;
-    let mut rows = PatchRows {
+    let Band { rows, buffer } = band;
+    let (first, second) = buffer.split_at_mut(buffer.len() / 2);
+    let (vectors, terms, cur, next) = carve(second, w);
+    let mut rows_done = PatchRows {
         ma,
         t,
-        top: band.rows.start,
-        end: band.rows.end,
-        from: band.rows.start,
+        top: rows.start,
+        end: rows.end,
+        from: rows.start,
         w,
         v,
         sums,
         rates,
         out: patch_out,
+        gradients: Gradients {
+            x: &x[rows.start * w..rows.end * w],
+            vectors,
+            terms,
+            cur,
+            next,
+            cell: rows.start,
+        },
     };
-    areas(w, h, x, v, band, &mut rows);
+    let band = Band { rows, buffer: first };
+    areas(w, h, x, v, band, &mut rows_done);
 }
 
 /// What [`areas_and_patches`] does with each vertex row's sums and rates once complete: keeps
-/// them until its room is full or the band ends, then takes their patch terms.
+/// them until its room is full or the band ends, then takes their patch terms and the
+/// gradients they make ready.
 struct PatchRows<'a> {
     ma: f64,
     t: &'a Topology,
@@ -280,12 +303,14 @@ struct PatchRows<'a> {
     rates: &'a mut [Vec3],
     /// The band's rows.
     out: PatchOut<'a>,
+    gradients: Gradients<'a>,
 }
 
 impl PatchRows<'_> {
     /// Keeps vertex row `row`'s sums and rates (`cur`: their components); takes the patch terms
-    /// of the rows kept when there is no room for another or the band ends. A method, not a
-    /// closure: inlined into the caller, it runs at the caller's vector width.
+    /// of the rows kept when there is no room for another or the band ends, then the gradients
+    /// that were waiting for their `w`. A method, not a closure: inlined into the caller, it runs
+    /// at the caller's vector width.
     #[inline(always)]
     fn done(&mut self, row: usize, cur: &[&mut [f64]]) {
         let w = self.w;
@@ -321,10 +346,80 @@ impl PatchRows<'_> {
             out,
         );
         self.from = row + 1;
+        self.gradients.advance(self.top, self.end, row, w, patches, o);
     }
 }
 
-crate::simd_dispatch! { fn gradients_widest(w: usize, h: usize, x: &[Vec3], patches: &[Vec3], band: Band<'_>, out: &mut [Vec3]) => gradients }
+/// The gradients a band takes as its `w` comes ([`PatchRows`]): the cell rows from its first
+/// to its last but one, whose two vertex rows are the band's. Vertex row `r` adds its faces'
+/// terms in ascending face order, cell row `r - 1`'s then `r`'s, after its patch terms; so the
+/// band's first row (but the grid's first) waits for the cell row above it, and its last (but
+/// the grid's last) for its own cell row: [`edges`] adds those.
+struct Gradients<'a> {
+    /// The band's positions.
+    x: &'a [Vec3],
+    /// Two vertex rows of positions and `w` (the band's rows counted from its first).
+    vectors: VertexRows<'a>,
+    terms: [&'a mut [f64]; SLOTS],
+    /// The forces of the row being finished and of the one begun (three components, then
+    /// spare).
+    cur: [&'a mut [f64]; 6],
+    next: [&'a mut [f64]; 6],
+    /// The next cell row to take.
+    cell: usize,
+}
+
+impl Gradients<'_> {
+    /// Takes the cell rows whose `w` are there (vertex rows up to `ready`; `patches` and `out`
+    /// the band's rows, from `top` to `end`).
+    #[inline(always)]
+    fn advance(
+        &mut self,
+        top: usize,
+        end: usize,
+        ready: usize,
+        w: usize,
+        patches: &[Vec3],
+        out: &mut [Vec3],
+    ) {
+        let at = |row: usize| (row - top) * w..(row - top + 1) * w;
+        let local = [self.x, patches];
+        // Cell row c reads vertex rows c and c + 1: both the band's, and both ready.
+        while self.cell < ready.min(end - 1) {
+            let c = self.cell;
+            if c == top {
+                self.vectors.start(0, local, w);
+                if c == 0 {
+                    transpose(&out[at(0)], &mut self.cur[..3]);
+                }
+            }
+            self.vectors
+                .cell_row(c - top, local, w, gradient_terms, &mut self.terms[..]);
+            let terms = &self.terms;
+            // Cell row c completes vertex row c's forces (unless c is the band's first row and
+            // not the grid's: it waits for the cell row above) and begins row c + 1's.
+            if c > top || c == 0 {
+                for q in 0..3 {
+                    below(self.cur[q], terms[G0C + q], terms[G1A + q], terms[G0A + q]);
+                }
+                untranspose(&self.cur[..3], &mut out[at(c)]);
+            }
+            transpose(&out[at(c + 1)], &mut self.next[..3]);
+            for q in 0..3 {
+                above(self.next[q], terms[G1C + q], terms[G0B + q], terms[G1B + q]);
+            }
+            std::mem::swap(&mut self.cur, &mut self.next);
+            self.cell += 1;
+        }
+        if ready + 1 == end && self.cell > top {
+            // The band's last row, begun by the cell row above it: finished when it is the
+            // grid's last, else waiting for its own cell row ([`edges`]).
+            untranspose(&self.cur[..3], &mut out[at(end - 1)]);
+        }
+    }
+}
+
+crate::simd_dispatch! { fn edges_widest(w: usize, h: usize, x: &[Vec3], patches: &[Vec3], band: Band<'_>, out: &mut [Vec3]) => edges }
 
 /// The cell rows whose terms a band of vertex rows `rows` needs (the one above it too), of a
 /// grid `h` rows high.
@@ -364,37 +459,40 @@ fn areas(w: usize, h: usize, x: &[Vec3], v: &[Vec3], band: Band<'_>, done: &mut 
     }
 }
 
-/// Each face's gradients at its corners (`patches` every vertex's `w`), added to the band's
-/// vertices' forces (`out`: the band's rows) in ascending face order.
+/// The gradients [`Gradients`] leaves at a band's edges, once every band's `w` is there
+/// (`patches` every vertex's; `out` the band's rows): its first row's (but the grid's first),
+/// cell row above it then its own, and its last row's (but the grid's last), its own cell row.
 #[inline(always)]
-fn gradients(w: usize, h: usize, x: &[Vec3], patches: &[Vec3], band: Band<'_>, out: &mut [Vec3]) {
+fn edges(w: usize, h: usize, x: &[Vec3], patches: &[Vec3], band: Band<'_>, out: &mut [Vec3]) {
     let Band { rows, buffer } = band;
-    let (mut vectors, mut terms, mut cur, mut next) = carve(buffer, w);
-    let cells = cell_rows(&rows, h);
-    let at = |row: usize| (row - rows.start) * w..(row - rows.start + 1) * w;
-    if rows.start == 0 {
-        transpose(&out[at(0)], &mut cur[..3]);
-    }
-    vectors.start(cells.start, [x, patches], w);
-    for c in cells {
-        vectors.cell_row(c, [x, patches], w, gradient_terms, &mut terms[..]);
-        // Cell row c completes vertex row c's forces and begins row c + 1's.
-        if c >= rows.start {
+    let (mut vectors, mut terms, mut cur, _) = carve(buffer, w);
+    let (top, end) = (rows.start, rows.end);
+    let at = |row: usize| (row - top) * w..(row - top + 1) * w;
+    let from = [x, patches];
+    if top > 0 {
+        vectors.start(top - 1, from, w);
+        vectors.cell_row(top - 1, from, w, gradient_terms, &mut terms[..]);
+        transpose(&out[at(top)], &mut cur[..3]);
+        for q in 0..3 {
+            above(cur[q], terms[G1C + q], terms[G0B + q], terms[G1B + q]);
+        }
+        if top + 1 < h {
+            vectors.cell_row(top, from, w, gradient_terms, &mut terms[..]);
             for q in 0..3 {
                 below(cur[q], terms[G0C + q], terms[G1A + q], terms[G0A + q]);
             }
-            untranspose(&cur[..3], &mut out[at(c)]);
         }
-        if c + 1 < rows.end {
-            transpose(&out[at(c + 1)], &mut next[..3]);
-            for q in 0..3 {
-                above(next[q], terms[G1C + q], terms[G0B + q], terms[G1B + q]);
-            }
-        }
-        std::mem::swap(&mut cur, &mut next);
+        untranspose(&cur[..3], &mut out[at(top)]);
     }
-    if rows.end == h {
-        untranspose(&cur[..3], &mut out[at(h - 1)]);
+    // The last row, unless it is the grid's or the first row above took its cell row.
+    if end < h && !(end - 1 == top && top > 0) {
+        vectors.start(end - 1, from, w);
+        vectors.cell_row(end - 1, from, w, gradient_terms, &mut terms[..]);
+        transpose(&out[at(end - 1)], &mut cur[..3]);
+        for q in 0..3 {
+            below(cur[q], terms[G0C + q], terms[G1A + q], terms[G0A + q]);
+        }
+        untranspose(&cur[..3], &mut out[at(end - 1)]);
     }
 }
 
@@ -628,7 +726,7 @@ mod tests {
             let prior: Vec<Vec3> = (0..n)
                 .map(|i| Vec3::new(i as f64, -0.5, 0.25 * i as f64))
                 .collect();
-            let run = |how: Option<(usize, bool)>| {
+            let run = |how: Option<(usize, bool, usize)>| {
                 let mut s = TurningScratch::default();
                 let (mut p, mut nr, mut out) = (vec![0.0; n], vec![Vec3::zeros(); n], prior.clone());
                 // Twice: buffers sized by the first call are reused by the second.
@@ -662,13 +760,18 @@ mod tests {
                     .collect::<Vec<_>>()
             };
             let ratios = |a: &[f64]| a.iter().map(|p| p.to_bits()).collect::<Vec<_>>();
+            // Bands, and the vertices whose sums are kept before their patch terms are taken:
+            // a row, a few, and a whole band.
             for bands in [
-                (h as usize, false),
-                (1, false),
-                (2, true),
-                (3, true),
-                (7, false),
-                (1, true),
+                (h as usize, false, PATCH_ROWS_VERTICES),
+                (h as usize, false, 1),
+                (h as usize, true, 3 * w as usize - 1),
+                (1, false, PATCH_ROWS_VERTICES),
+                (2, true, 1),
+                (3, true, PATCH_ROWS_VERTICES),
+                (7, false, 2 * w as usize),
+                (7, true, 1),
+                (1, true, PATCH_ROWS_VERTICES),
             ] {
                 let got = run(Some(bands));
                 assert_eq!(bits(&got.0), bits(&want.0), "forces, {w}x{h}, bands {bands:?}");
