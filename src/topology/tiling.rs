@@ -30,22 +30,33 @@ pub struct TileLayout {
     /// Entries before a tile in each force window of the gather path: the largest offset,
     /// rounded up to whole cache lines so that a tile's entries start on one.
     pub lead: usize,
-    /// Numbers per component of each force window: `lead` and `GATHER_TILES` tiles or more.
+    /// Numbers per component of each force window: `lead`, then `SLIDE_OFFSETS` largest offsets
+    /// in whole tiles and `GATHER_TILES` tiles or more.
     pub force_window: usize,
     /// Particles in the window of inputs (`forces::inputs::InputWindow`): what the springs from before a
     /// group read (twice the largest offset) or what a tile's springs read (a tile and the
-    /// largest offset), and `INPUT_TILES` tiles more, so that it slides once every few tiles.
+    /// largest offset), and `SLIDE_OFFSETS` largest offsets or `INPUT_TILES` tiles more, so that
+    /// it slides once every few tiles.
     pub inputs: usize,
 }
 
-/// Tiles a force window of the gather path holds after its lead: it slides (copies each run's
-/// last `offset` forces to its front) once every so many tiles.
+/// Tiles a force window of the gather path holds after its lead, at least: it slides (copies
+/// each run's last `offset` forces to its front) once every so many tiles.
 const GATHER_TILES: usize = 4;
 
-/// Tiles the window of inputs holds beyond what one tile reads: it slides once every so many
-/// tiles. 1, 2 and 4 measured the same at 61 x 41 (`step_cycles`, 28.3-28.9 ns); 2 keeps the
-/// window (nine component arrays) smaller than 4 and slides half as often as 1.
+/// Tiles the window of inputs holds beyond what one tile reads, at least: it slides once every
+/// so many tiles. 1, 2 and 4 measured the same at 61 x 41 (`step_cycles`, 28.3-28.9 ns); 2 keeps
+/// the window (nine component arrays) smaller than 4 and slides half as often as 1.
 const INPUT_TILES: usize = 2;
+
+/// Largest offsets both windows hold beyond what a tile reads, at least. A slide copies about
+/// one largest offset of every component, so the windows slide once every eight offsets'
+/// particles: an eighth of a copy of each array a particle. A grid 1001 wide (bend springs two
+/// rows long, 2 002 particles) slid every 2 048 particles before and spent 3 ns of its 49 a
+/// particle-step of the fractional model in the copies (`perf`, stop 56); holding 8 offsets
+/// instead of 1 or 4, 45-47 ns against 48-51 (`docs/benchmarks.md`). Only the windows' parts
+/// near the tile are read, so the longer windows do not crowd the cache.
+const SLIDE_OFFSETS: usize = 8;
 
 /// Most entries (runs, and two a choice run) the gathered tile walk sums per particle.
 pub const GATHER_RUNS: usize = 12;
@@ -77,8 +88,13 @@ impl TileLayout {
                 0
             },
             lead: tr.max_offset.next_multiple_of(8),
-            force_window: tr.max_offset.next_multiple_of(8) + tiles.max(GATHER_TILES) * TILE,
-            inputs: ((2 * tr.max_offset).max(tr.max_offset + TILE) + INPUT_TILES * TILE).next_multiple_of(8),
+            force_window: tr.max_offset.next_multiple_of(8)
+                + (SLIDE_OFFSETS * tr.max_offset)
+                    .next_multiple_of(TILE)
+                    .max(GATHER_TILES * TILE),
+            inputs: ((2 * tr.max_offset).max(tr.max_offset + TILE)
+                + (INPUT_TILES * TILE).max(SLIDE_OFFSETS * tr.max_offset))
+            .next_multiple_of(8),
         })
     }
 }
