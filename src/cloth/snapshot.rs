@@ -463,21 +463,26 @@ impl Cloth {
     /// where they are, an implicit solve accepted whatever its residual (only an unsound
     /// result refuses). When it fails, the same trial without the half-derivative histories
     /// says whether they are what the cloth cannot step from.
-    fn trial_step(&self) -> Result<(), Error> {
+    fn trial_step(&mut self) -> Result<(), Error> {
         let h = if self.steps > 0 && self.time > 0.0 {
             self.time / self.steps as f64
         } else {
             1e-4
         };
+        let Err(e) = self.trial_in_place(h) else {
+            return Ok(());
+        };
+        if e.kind == crate::ErrorKind::OutOfMemory {
+            // No room for the rollback's copy: nothing was stepped, and copies would not fit.
+            return Err(e);
+        }
+        // Refused (rare): which part of the state is at fault, from trials on copies.
         let trial = |c: &Cloth| -> Result<(), Error> {
             let mut t = c.clone();
             t.pin_target.clear();
             t.pin_target.extend_from_slice(&t.x);
             t.config.accept_unconverged = true;
             t.advance(StepPlan::new(t.config.integrator, h, None, Stage::Whole))
-        };
-        let Err(e) = trial(self) else {
-            return Ok(());
         };
         let mut without = self.clone();
         without.histories = Histories::new(&self.config.model, self.config.scheme, &self.topology)?;
@@ -490,6 +495,39 @@ impl Cloth {
             "snapshot: {what} (a trial step of {h:.3e} s on a copy: {}); the cloth is unchanged",
             e.message
         )))
+    }
+
+    /// The trial step of [`Self::trial_step`] on this cloth itself, then everything it moved
+    /// put back as it was (the rollback a refused call uses, the mesh colliders as loaded, and
+    /// the pins' targets, the solve's acceptance, the statistics and the count of vertices
+    /// carried through meshes),
+    /// so that a large cloth is not copied whole: at a million particles the copy was most of
+    /// a load's time (fresh pages to zero; `docs/benchmarks.md`, stop 56).
+    fn trial_in_place(&mut self, h: f64) -> Result<(), Error> {
+        let mut snap = std::mem::take(&mut self.rollback);
+        if let Err(e) = snap.save(self) {
+            self.rollback = snap;
+            return Err(e);
+        }
+        // Pins held where they are.
+        let mut targets = std::mem::take(&mut snap.targets);
+        targets.clear();
+        targets.extend_from_slice(&self.x);
+        std::mem::swap(&mut self.pin_target, &mut targets);
+        let unconverged = std::mem::replace(&mut self.config.accept_unconverged, true);
+        let (solver, stats, carried) = (self.solver_stats, self.step_stats, self.mesh_carried);
+        // The mesh colliders as loaded (their lists and trees empty: small to copy), so that
+        // the step's refresh of them is not kept.
+        let meshes = self.mesh_slots.clone();
+        let done = self.advance(StepPlan::new(self.config.integrator, h, None, Stage::Whole));
+        self.mesh_slots = meshes;
+        snap.restore(self);
+        std::mem::swap(&mut self.pin_target, &mut targets);
+        snap.targets = targets;
+        self.config.accept_unconverged = unconverged;
+        (self.solver_stats, self.step_stats, self.mesh_carried) = (solver, stats, carried);
+        self.rollback = snap;
+        done
     }
 
     /// Size in bytes of [`Cloth::save_snapshot`]'s result now, counted without building it.

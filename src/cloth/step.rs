@@ -146,6 +146,8 @@ pub(super) struct Rollback {
     mesh_from: f64,
     time: f64,
     steps: u64,
+    /// Room for the pins' targets a snapshot's trial step sets aside (not saved or restored).
+    pub(super) targets: Vec<Vec3>,
 }
 
 impl Rollback {
