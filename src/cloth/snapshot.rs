@@ -458,11 +458,12 @@ impl Cloth {
         self.rebuild_colliders();
     }
 
-    /// Refuses a loaded state that cannot take one step: one step on a copy, at the mean step
-    /// size the state was reached with (`time / steps`; 0.1 ms before any step), pins held
-    /// where they are, an implicit solve accepted whatever its residual (only an unsound
-    /// result refuses). When it fails, the same trial without the half-derivative histories
-    /// says whether they are what the cloth cannot step from.
+    /// Refuses a loaded state that cannot take one step: one step on the cloth itself, rolled
+    /// back ([`Self::trial_in_place`]), at the mean step size the state was reached with
+    /// (`time / steps`; 0.1 ms before any step), pins held where they are, an implicit solve
+    /// accepted whatever its residual (only an unsound result refuses). When it fails, the same
+    /// trial without the half-derivative histories says whether they are what the cloth cannot
+    /// step from.
     fn trial_step(&mut self) -> Result<(), Error> {
         let h = if self.steps > 0 && self.time > 0.0 {
             self.time / self.steps as f64
@@ -473,26 +474,21 @@ impl Cloth {
             return Ok(());
         };
         if e.kind == crate::ErrorKind::OutOfMemory {
-            // No room for the rollback's copy: nothing was stepped, and copies would not fit.
+            // No room for the rollback's copy: nothing was stepped.
             return Err(e);
         }
-        // Refused (rare): which part of the state is at fault, from trials on copies.
-        let trial = |c: &Cloth| -> Result<(), Error> {
-            let mut t = c.clone();
-            t.pin_target.clear();
-            t.pin_target.extend_from_slice(&t.x);
-            t.config.accept_unconverged = true;
-            t.advance(StepPlan::new(t.config.integrator, h, None, Stage::Whole))
-        };
-        let mut without = self.clone();
-        without.histories = Histories::new(&self.config.model, self.config.scheme, &self.topology)?;
-        let what = if trial(&without).is_ok() {
+        // Refused (rare): the same trial with empty histories says whether they are at fault.
+        let mut histories = Histories::new(&self.config.model, self.config.scheme, &self.topology)?;
+        std::mem::swap(&mut self.histories, &mut histories);
+        let without = self.trial_in_place(h);
+        std::mem::swap(&mut self.histories, &mut histories);
+        let what = if without.is_ok() {
             "its half-derivative history holds values the cloth cannot step from"
         } else {
             "its positions, velocities, pins or colliders are a state the cloth cannot step from"
         };
         Err(Error::invalid(format!(
-            "snapshot: {what} (a trial step of {h:.3e} s on a copy: {}); the cloth is unchanged",
+            "snapshot: {what} (a trial step of {h:.3e} s, rolled back: {}); the cloth is unchanged",
             e.message
         )))
     }
@@ -500,9 +496,9 @@ impl Cloth {
     /// The trial step of [`Self::trial_step`] on this cloth itself, then everything it moved
     /// put back as it was (the rollback a refused call uses, the mesh colliders as loaded, and
     /// the pins' targets, the solve's acceptance, the statistics and the count of vertices
-    /// carried through meshes),
-    /// so that a large cloth is not copied whole: at a million particles the copy was most of
-    /// a load's time (fresh pages to zero; `docs/benchmarks.md`, stop 56).
+    /// carried through meshes), so that a large cloth is not copied whole: at a million
+    /// particles the copy was most of a load's time (fresh pages to zero; `docs/benchmarks.md`,
+    /// stop 56).
     fn trial_in_place(&mut self, h: f64) -> Result<(), Error> {
         let mut snap = std::mem::take(&mut self.rollback);
         if let Err(e) = snap.save(self) {
