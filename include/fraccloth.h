@@ -99,6 +99,9 @@ typedef enum {
   FC_INTEGRATOR_SYMPLECTIC_EULER = 1,
   /**
    * Backward Euler (Baraff & Witkin), CG solve. Stable at frame-rate steps with stiff cloth.
+   * First order: it damps fast motion. With the underwater preset at its automatic step, a
+   * 1-2 Hz swing's free edge moves 15-70 % less than with symplectic Euler
+   * (docs/underwater.md); for brisk scenes take symplectic Euler or the second-order implicit.
    */
   FC_INTEGRATOR_IMPLICIT_EULER = 2,
   /**

@@ -135,9 +135,11 @@ struct Args {
     /// the explicit integrators; 1/30 s implicit).
     #[arg(long)]
     dt: Option<f64>,
-    /// Integrator: explicit (the paper's Eq. 7), symplectic, implicit (stable at frame rate);
-    /// second order: symplectic2, implicit2 (each step extrapolated from a whole and two half
-    /// steps). Default: symplectic for the underwater preset, explicit for the paper's models.
+    /// Integrator: explicit (the paper's Eq. 7), symplectic, implicit (stable at frame rate; first
+    /// order, it damps fast motion: a 1-2 Hz swing's free edge moves 15-70 % less than with
+    /// symplectic); second order: symplectic2, implicit2 (each step extrapolated from a whole
+    /// and two half steps). Default: symplectic for the underwater preset, explicit for the
+    /// paper's models.
     #[arg(long)]
     integrator: Option<String>,
     /// How D^{1/2} is evaluated: soe (accurate, constant cost; the default), paper (Eq. 6 with

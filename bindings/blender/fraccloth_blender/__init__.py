@@ -57,7 +57,7 @@ HISTORY_ITEMS = [
 INTEGRATOR_ITEMS = [
     ("SYMPLECTIC", "Symplectic Euler", "Fast; small time steps (about 1 ms)"),
     ("EXPLICIT", "Explicit Euler", "The paper's integrator; small time steps"),
-    ("IMPLICIT", "Implicit Euler", "Stable at large steps (a frame)"),
+    ("IMPLICIT", "Implicit Euler", "Stable at large steps (a frame); first order, so it damps fast motion: a 1-2 Hz swing's free edge moves 15-70 % less than with symplectic Euler. For slow scenes"),
     ("SYMPLECTIC2", "Symplectic, 2nd order", "Extrapolated symplectic Euler: error shrinks with the square of the step; 3x the work per step"),
     ("IMPLICIT2", "Implicit, 2nd order", "Extrapolated implicit Euler: second order and stable at a frame; 3x the work per step"),
 ]
