@@ -48,17 +48,43 @@ impl<'a> FirstPass<'a> {
     /// overlap, and start on multiples of `TILE` and end on one or at the last particle (the
     /// history's blocks of 16, [`StepPast::past_range`]); nothing reads a range while it runs.
     pub unsafe fn run(&self, r: std::ops::Range<usize>) {
+        // SAFETY: this range only (the caller's contract).
+        let (v_step, half) = unsafe { (self.v_step.range(r.clone()), self.half.range(r.clone())) };
+        // SAFETY: the caller's contract.
+        unsafe { self.run_with(r, v_step, half, false) };
+    }
+
+    /// [`Self::run`], writing the step's velocities and D^{1/2}x of particles `r` into
+    /// `v_step` and `half` (as long as `r`) instead of this pass's arrays: for a force pass
+    /// that keeps them only while it reads them (`forces::Ahead`). The same operations, so
+    /// the same bits. The fully pinned particles' step velocities also go to this pass's
+    /// `v_step` (the pins' pass after the step reads them there).
+    ///
+    /// # Safety
+    /// As [`Self::run`].
+    pub unsafe fn run_into(&self, r: std::ops::Range<usize>, v_step: &mut [Vec3], half: &mut [Vec3]) {
+        // SAFETY: the caller's contract.
+        unsafe { self.run_with(r, v_step, half, true) };
+    }
+
+    /// The pass over `r` into `v_step` and `half`; `keep_pins`: the fully pinned particles'
+    /// step velocities also into this pass's `v_step` (which `v_step` is not part of).
+    ///
+    /// # Safety
+    /// As [`Self::run`].
+    unsafe fn run_with(
+        &self,
+        r: std::ops::Range<usize>,
+        v_step: &mut [Vec3],
+        half: &mut [Vec3],
+        keep_pins: bool,
+    ) {
         let first = r.start;
         let len = r.len();
+        debug_assert!(v_step.len() == len && half.len() == len);
         let with_history = self.past.is_some();
         // SAFETY: this range only (the caller's contract).
-        let (v_step, v_rel, half) = unsafe {
-            (
-                self.v_step.range(r.clone()),
-                self.v_rel.range(r.clone()),
-                self.half.range(r.clone()),
-            )
-        };
+        let v_rel = unsafe { self.v_rel.range(r.clone()) };
         let arrays = !self.sx[0].is_empty();
         // This range's part of a component array, or nothing when the arrays are not kept.
         let part = |a: &Disjoint<'a, f64>| -> &'a mut [f64] {
@@ -90,6 +116,12 @@ impl<'a> FirstPass<'a> {
                 let (p, k) = (i as usize, i as usize - first);
                 v_step[k] = (goal[p] - x[k]) / self.h;
                 v_rel[k] = self.sampling.rate(v[k], v_step[k]) - self.current;
+                if keep_pins {
+                    // SAFETY: particle `p` is in `r`, which this run alone writes (the
+                    // caller's contract), and `v_step` is not this pass's array here.
+                    let kept = unsafe { self.v_step.range(p..p + 1) };
+                    kept[0] = v_step[k];
+                }
             }
             if let Some(past) = self.past {
                 // SAFETY: every particle once; tiles start on multiples of TILE and end on

@@ -347,12 +347,10 @@ impl Cloth {
         weights.0[Memory::Particles.index()] = first.w0();
         // SAFETY: the force pass runs every particle once, in ranges that start on multiples
         // of TILE, and reads none while it runs (`forces::Ahead`).
-        let run = |r: std::ops::Range<usize>| unsafe { first.run(r) };
-        let ahead = forces::Ahead {
-            run: &run,
-            v: &first.v_step,
-            half: &first.half,
+        let run = |r: std::ops::Range<usize>, v: &mut [Vec3], half: &mut [Vec3]| unsafe {
+            first.run_into(r, v, half)
         };
+        let ahead = forces::Ahead { run: &run };
         let input = ForceInput {
             model: &self.config.model,
             topology: &self.topology,

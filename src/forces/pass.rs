@@ -52,6 +52,9 @@ pub struct ForceScratch {
     springs: Soa3,
     spring_inputs: springs::SpringScratch,
     windows: crate::aligned::AlignedF64,
+    /// What an [`Ahead`] first pass wrote, while the walk reads it: each task's window, then
+    /// the bands where tasks meet (velocities, then D^{1/2}x, in each).
+    ahead: Vec<Vec3>,
 }
 
 impl ForceScratch {
@@ -105,17 +108,24 @@ pub enum SpringInputs {
 /// the first pass wrote from cache instead of memory. For a step whose passes between the two
 /// read none of it (no water carried, no pair elements, no contacts), on a tiled topology
 /// ([`Topology::tiled`]; the caller runs the first pass itself on others).
+///
+/// What it writes that the force pass reads, the step's velocities and the half-derivatives
+/// D^{1/2}x (in place of [`ForceInput::v`] and [`ForceInput::half_derivative`], which are then
+/// empty), the force pass keeps only while its walk reads them: in a window of each task's
+/// particles that slides with the walk, and a band where two tasks meet. Written to arrays
+/// of the whole cloth, they would be written back to memory and read from it again (as a
+/// line's write begins with reading it) only to be dropped after the step.
 pub struct Ahead<'a> {
-    /// The first pass over a range of particles: every particle once, in ranges that start on
+    /// The first pass over a range of particles, writing their velocities and D^{1/2}x into
+    /// the two slices (as long as the range): every particle once, in ranges that start on
     /// multiples of [`TILE`] and end on one or at the last particle, never two overlapping
     /// ones at a time (what the force pass asks of it).
-    pub run: &'a (dyn Fn(std::ops::Range<usize>) + Sync),
-    /// What it writes that the force pass reads: the step's velocities and the
-    /// half-derivatives D^{1/2}x (in place of [`ForceInput::v`] and
-    /// [`ForceInput::half_derivative`], which are then empty).
-    pub v: &'a parallel::Disjoint<'a, Vec3>,
-    pub half: &'a parallel::Disjoint<'a, Vec3>,
+    pub run: &'a FirstPassInto<'a>,
 }
+
+/// The first pass over a range of particles, writing their velocities and D^{1/2}x into the
+/// two slices ([`Ahead::run`]).
+pub type FirstPassInto<'f> = dyn Fn(std::ops::Range<usize>, &mut [Vec3], &mut [Vec3]) + Sync + 'f;
 
 /// A tile's total forces and state as component arrays, each `[x, y, z]` of one length.
 pub struct TileTotals<'a> {
@@ -231,13 +241,14 @@ pub fn for_each_tile_ahead<S>(
         spring_inputs,
         springs,
         windows,
+        ahead: ahead_room,
         ..
     } = scratch;
     spring_sums(
         input,
         spring_inputs,
         springs,
-        windows,
+        (windows, ahead_room),
         inputs,
         sources,
         ahead,
@@ -272,7 +283,7 @@ fn spring_sums<T>(
     input: &ForceInput<'_>,
     spring_inputs: &mut springs::SpringScratch,
     spring_buffer: &mut Soa3,
-    windows: &mut crate::aligned::AlignedF64,
+    (windows, ahead_room): (&mut crate::aligned::AlignedF64, &mut Vec<Vec3>),
     inputs: SpringInputs,
     sources: Sources<'_>,
     ahead: Option<&Ahead<'_>>,
@@ -319,16 +330,41 @@ fn spring_sums<T>(
             };
             lo..hi.max(lo)
         };
+        // The first pass's velocities and D^{1/2}x: a window of `room` particles a task (the
+        // group it walks, the springs' reach either side, a tile of rounding), and the bands.
+        let room = (layout.group + 2 * max_offset + 2 * TILE).min(n);
+        let (task_room, band_room) = if ahead.is_some() {
+            (2 * room, 4 * band)
+        } else {
+            (0, 0)
+        };
+        ahead_room.resize(tasks * task_room + (tasks - 1) * band_room, Vec3::zeros());
+        let (task_rooms, band_rooms) = ahead_room.split_at_mut(tasks * task_room);
         if let Some(a) = ahead {
-            for k in 1..tasks {
+            for (k, b) in (1..tasks).zip(band_rooms.chunks_mut(band_room)) {
                 let c = task_start(k);
-                (a.run)(c.saturating_sub(band)..(c + band).min(n));
+                let r = c.saturating_sub(band)..(c + band).min(n);
+                let (bv, bh) = b.split_at_mut(2 * band);
+                (a.run)(r.clone(), &mut bv[..r.len()], &mut bh[..r.len()]);
             }
         }
+        let band_rooms = &*band_rooms;
+        // The band where tasks k - 1 and k meet: its first particle and its two parts.
+        let band_of = |k: usize| {
+            let b = &band_rooms[(k - 1) * band_room..k * band_room];
+            let (bv, bh) = b.split_at(2 * band);
+            (task_start(k).saturating_sub(band), bv, bh)
+        };
+        let task_rooms = parallel::Disjoint::new(task_rooms);
         parallel::chunks(par, &mut windows[..w * tasks], w, |first, window| {
             let (sums, buf) = window.split_at_mut(tiles::sums_scratch(layout));
             let k = first / w;
             let mut done = own(k).start;
+            // SAFETY: each task takes its own part.
+            let mine = unsafe { task_rooms.range(k * task_room..(k + 1) * task_room) };
+            let (wv, wh) = mine.split_at_mut(task_room / 2);
+            // The window holds particles `lo .. hi` at `wv[0..]`, `wh[0..]`.
+            let (mut lo, mut hi) = (0, 0);
             for g in k * groups / tasks..(k + 1) * groups / tasks {
                 let c0 = g * layout.group;
                 let len = layout.group.min(n - c0);
@@ -342,19 +378,49 @@ fn spring_sums<T>(
                     None => sources,
                     Some(a) => {
                         // The first pass over this task's particles up to what the group's
-                        // springs read (beyond its own end: the band, already run).
-                        let upto = end.next_multiple_of(TILE).min(own(k).end);
-                        if upto > done {
-                            (a.run)(done..upto);
-                            done = upto;
+                        // springs read, a tile at a time; the bands' particles (run before
+                        // the tasks) copied in.
+                        let own = own(k);
+                        let target = end.max(end.next_multiple_of(TILE).min(own.end));
+                        // The window slides to what the group's springs read when it would
+                        // not hold them (never on a cloth it holds whole).
+                        if hi <= start {
+                            (lo, hi) = (start, start);
+                        } else if target - lo > room {
+                            wv.copy_within(start - lo..hi - lo, 0);
+                            wh.copy_within(start - lo..hi - lo, 0);
+                            lo = start;
                         }
-                        // SAFETY: `start..end` has been run (by this task, or before the tasks
-                        // for the bands), and no task writes there while it is read.
-                        let (v, half) = unsafe { (a.v.shared(start..end), a.half.shared(start..end)) };
+                        while hi < target {
+                            let next = if hi < own.start {
+                                let (b0, bv, bh) = band_of(k);
+                                let e = target.min(own.start);
+                                wv[hi - lo..e - lo].copy_from_slice(&bv[hi - b0..e - b0]);
+                                wh[hi - lo..e - lo].copy_from_slice(&bh[hi - b0..e - b0]);
+                                e
+                            } else if hi < own.end {
+                                debug_assert_eq!(hi, done);
+                                let e = target.next_multiple_of(TILE).min(own.end);
+                                (a.run)(hi..e, &mut wv[hi - lo..e - lo], &mut wh[hi - lo..e - lo]);
+                                done = e;
+                                e
+                            } else {
+                                let (b0, bv, bh) = band_of(k + 1);
+                                let e = target.min((task_start(k + 1) + band).min(n));
+                                wv[hi - lo..e - lo].copy_from_slice(&bv[hi - b0..e - b0]);
+                                wh[hi - lo..e - lo].copy_from_slice(&bh[hi - b0..e - b0]);
+                                e
+                            };
+                            debug_assert!(next > hi, "the window did not grow");
+                            if next <= hi {
+                                break;
+                            }
+                            hi = next;
+                        }
                         Sources {
                             x: &input.x[start..end],
-                            v: Some(v),
-                            half: sources.half.map(|_| half),
+                            v: Some(&wv[start - lo..end - lo]),
+                            half: sources.half.map(|_| &wh[start - lo..end - lo]),
                             base: start,
                             ..sources
                         }

@@ -276,18 +276,6 @@ impl<'a, T> Disjoint<'a, T> {
         // borrow (the caller's contract).
         unsafe { std::slice::from_raw_parts_mut(self.ptr.add(r.start), r.end - r.start) }
     }
-
-    /// The elements `r`, to read. Panics when `r` is out of bounds.
-    ///
-    /// # Safety
-    /// No range borrowed with [`Self::range`] while this one lives may overlap it (parts
-    /// written earlier are read back once their writers are done with them).
-    pub unsafe fn shared(&self, r: std::ops::Range<usize>) -> &'a [T] {
-        assert!(r.start <= r.end && r.end <= self.len, "range out of bounds");
-        // SAFETY: in bounds (checked above) of a live `&'a mut [T]`; not written through any
-        // other borrow while this one lives (the caller's contract).
-        unsafe { std::slice::from_raw_parts(self.ptr.add(r.start), r.end - r.start) }
-    }
 }
 
 /// The smallest index in `0..n` for which `bad` holds, searched in parallel chunks when
