@@ -54,7 +54,7 @@ pub struct ForceScratch {
     windows: crate::aligned::AlignedF64,
     /// What an [`Ahead`] first pass wrote, while the walk reads it: each task's window, then
     /// the bands where tasks meet (velocities, then D^{1/2}x, in each).
-    ahead: Vec<Vec3>,
+    ahead: crate::aligned::AlignedVec3,
 }
 
 impl ForceScratch {
@@ -283,7 +283,7 @@ fn spring_sums<T>(
     input: &ForceInput<'_>,
     spring_inputs: &mut springs::SpringScratch,
     spring_buffer: &mut Soa3,
-    (windows, ahead_room): (&mut crate::aligned::AlignedF64, &mut Vec<Vec3>),
+    (windows, ahead_room): (&mut crate::aligned::AlignedF64, &mut crate::aligned::AlignedVec3),
     inputs: SpringInputs,
     sources: Sources<'_>,
     ahead: Option<&Ahead<'_>>,
@@ -332,13 +332,19 @@ fn spring_sums<T>(
         };
         // The first pass's velocities and D^{1/2}x: a window of `room` particles a task (the
         // group it walks, the springs' reach either side, a tile of rounding), and the bands.
-        let room = (layout.group + 2 * max_offset + 2 * TILE).min(n);
+        // Windows start on a particle a multiple of `LINED` from the first, so each particle
+        // sits at the same place in its cache line as in an array of the whole cloth (the
+        // walk's loads split no more lines than they did there).
+        const LINED: usize = 8;
+        let room = (layout.group + 2 * max_offset + 2 * TILE + LINED)
+            .min(n)
+            .next_multiple_of(LINED);
         let (task_room, band_room) = if ahead.is_some() {
             (2 * room, 4 * band)
         } else {
             (0, 0)
         };
-        ahead_room.resize(tasks * task_room + (tasks - 1) * band_room, Vec3::zeros());
+        ahead_room.resize(tasks * task_room + (tasks - 1) * band_room);
         let (task_rooms, band_rooms) = ahead_room.split_at_mut(tasks * task_room);
         if let Some(a) = ahead {
             for (k, b) in (1..tasks).zip(band_rooms.chunks_mut(band_room)) {
@@ -385,11 +391,12 @@ fn spring_sums<T>(
                         // The window slides to what the group's springs read when it would
                         // not hold them (never on a cloth it holds whole).
                         if hi <= start {
-                            (lo, hi) = (start, start);
+                            (lo, hi) = (start - start % LINED, start - start % LINED);
                         } else if target - lo > room {
-                            wv.copy_within(start - lo..hi - lo, 0);
-                            wh.copy_within(start - lo..hi - lo, 0);
-                            lo = start;
+                            let from = start - start % LINED;
+                            wv.copy_within(from - lo..hi - lo, 0);
+                            wh.copy_within(from - lo..hi - lo, 0);
+                            lo = from;
                         }
                         while hi < target {
                             let next = if hi < own.start {
