@@ -344,7 +344,7 @@ fn spring_sums<T>(
         } else {
             (0, 0)
         };
-        ahead_room.resize(tasks * task_room + (tasks - 1) * band_room);
+        ahead_room.resize(tasks * task_room + tasks.saturating_sub(1) * band_room);
         let (task_rooms, band_rooms) = ahead_room.split_at_mut(tasks * task_room);
         if let Some(a) = ahead {
             for (k, b) in (1..tasks).zip(band_rooms.chunks_mut(band_room)) {
