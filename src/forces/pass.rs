@@ -348,6 +348,7 @@ fn spring_sums<T>(
         let (task_rooms, band_rooms) = ahead_room.split_at_mut(tasks * task_room);
         if let Some(a) = ahead {
             for (k, b) in (1..tasks).zip(band_rooms.chunks_mut(band_room)) {
+                // The particles `band_of(k)` says.
                 let c = task_start(k);
                 let r = c.saturating_sub(band)..(c + band).min(n);
                 let (bv, bh) = b.split_at_mut(2 * band);
@@ -355,11 +356,12 @@ fn spring_sums<T>(
             }
         }
         let band_rooms = &*band_rooms;
-        // The band where tasks k - 1 and k meet: its first particle and its two parts.
+        // The band where tasks k - 1 and k meet: its particles and its two parts.
         let band_of = |k: usize| {
             let b = &band_rooms[(k - 1) * band_room..k * band_room];
             let (bv, bh) = b.split_at(2 * band);
-            (task_start(k).saturating_sub(band), bv, bh)
+            let c = task_start(k);
+            (c.saturating_sub(band)..(c + band).min(n), bv, bh)
         };
         let task_rooms = parallel::Disjoint::new(task_rooms);
         parallel::chunks(par, &mut windows[..w * tasks], w, |first, window| {
@@ -399,23 +401,18 @@ fn spring_sums<T>(
                             lo = from;
                         }
                         while hi < target {
-                            let next = if hi < own.start {
-                                let (b0, bv, bh) = band_of(k);
-                                let e = target.min(own.start);
-                                wv[hi - lo..e - lo].copy_from_slice(&bv[hi - b0..e - b0]);
-                                wh[hi - lo..e - lo].copy_from_slice(&bh[hi - b0..e - b0]);
-                                e
-                            } else if hi < own.end {
+                            let next = if own.contains(&hi) {
                                 debug_assert_eq!(hi, done);
                                 let e = target.next_multiple_of(TILE).min(own.end);
                                 (a.run)(hi..e, &mut wv[hi - lo..e - lo], &mut wh[hi - lo..e - lo]);
                                 done = e;
                                 e
                             } else {
-                                let (b0, bv, bh) = band_of(k + 1);
-                                let e = target.min((task_start(k + 1) + band).min(n));
-                                wv[hi - lo..e - lo].copy_from_slice(&bv[hi - b0..e - b0]);
-                                wh[hi - lo..e - lo].copy_from_slice(&bh[hi - b0..e - b0]);
+                                // A band's particles: the one the task starts in, or ends in.
+                                let (b, bv, bh) = band_of(if hi < own.start { k } else { k + 1 });
+                                let e = target.min(b.end);
+                                wv[hi - lo..e - lo].copy_from_slice(&bv[hi - b.start..e - b.start]);
+                                wh[hi - lo..e - lo].copy_from_slice(&bh[hi - b.start..e - b.start]);
                                 e
                             };
                             debug_assert!(next > hi, "the window did not grow");
