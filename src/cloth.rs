@@ -10,6 +10,7 @@ mod auto_step;
 mod collisions;
 mod extrapolate;
 mod histories;
+mod motion;
 mod pins;
 mod prepass;
 mod snapshot;
@@ -187,6 +188,9 @@ pub struct Cloth {
     solver_stats: SolverStats,
     /// What the last call to `step` did.
     step_stats: StepStats,
+    /// The motion's frequency, averaged over calls: implicit Euler's accuracy bound on the
+    /// automatic step (`cloth/motion.rs`).
+    motion: motion::MotionRate,
     /// Where the step runs (`plumbing/parallel.rs`).
     threads: Threads,
 }
@@ -257,6 +261,7 @@ impl Cloth {
             probe: Rollback::default(),
             solver_stats: SolverStats::default(),
             step_stats: StepStats::default(),
+            motion: motion::MotionRate::default(),
             threads: Threads::default(),
             topology,
             config,

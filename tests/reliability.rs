@@ -97,9 +97,14 @@ fn snapshots_with_a_valid_checksum_but_impossible_contents_are_refused() {
         refused(&mut c, &bytes, l.velocity0, f64::NAN, "velocity");
         refused(&mut c, &bytes, l.velocity0, 1e6, "max_speed");
         refused(&mut c, &bytes, l.velocity0 - 24 * N - 8 + 8, 1e300, "float range");
-        // The end of the history state: before the collision state (three empty counts) and
-        // the checksum.
-        let tail = bytes.len() - 4 - 24;
+        // The motion averages (two f64 before the checksum; `src/cloth/motion.rs`).
+        let motion = bytes.len() - 4 - 16;
+        refused(&mut c, &bytes, motion, f64::NAN, "motion averages");
+        refused(&mut c, &bytes, motion + 8, -1.0, "motion averages");
+        refused(&mut c, &bytes, motion, f64::INFINITY, "motion averages");
+        // The end of the history state: before the collision state (three empty counts), the
+        // motion averages and the checksum.
+        let tail = motion - 24;
         match scheme {
             Scheme::SumOfExponentials { .. } => {
                 // The first mode of the first particle, then the step sizes at the end.

@@ -16,6 +16,11 @@
 //!   any undamped oscillator, and only the springs' own damping holds it;
 //! - the extrapolated (second-order) steps as the step they extrapolate;
 //! - implicit Euler: no bound from springs, drags or contacts; the turning forces' `2 / rho`.
+//!   And an accuracy bound (implicit Euler only, not its extrapolated form): its own damping
+//!   takes about `pi omega h` of a motion's amplitude a period, so the substep is kept to
+//!   `h <= `[`ACCURACY`]` / omega`, `omega` the cloth's motion frequency as it moves
+//!   (`motion.rs`), but never below the step symplectic Euler would take on the same cloth
+//!   (implicit Euler then costs more a call than symplectic Euler, never more substeps).
 //!
 //! And pins: no pin travels more than one spring rest length in a substep.
 //!
@@ -56,6 +61,14 @@ pub fn safety(integrator: Integrator) -> f64 {
         _ => SAFETY,
     }
 }
+
+/// Implicit Euler's accuracy bound: `omega h` at most this, `omega` the motion's frequency as
+/// `motion.rs` reads it (frame-rate accelerations against velocities: on the 4 cm swing of
+/// 61 x 41 it reads 2-3.5 times the drive's frequency, the cloth's ripples included). Measured
+/// there (docs/underwater.md): at 1 Hz implicit Euler's half-waves were 2.75 at its stable step
+/// against 4.76 converged; with this bound 5.22 (17 substeps a frame), and within 10 % of the
+/// converged shot from 0.25 to 2 Hz. 0.016 took 1.5 times the substeps for no better shot.
+pub const ACCURACY: f64 = 0.016;
 
 /// Times a refused frame is retried with twice the substeps (so up to 16 times the estimate's).
 pub const MAX_RETRIES: u32 = 4;
@@ -110,6 +123,12 @@ impl Cloth {
         use crate::error::ErrorKind;
         self.measure_contact_weights()?;
         let h = self.auto_substep(dt);
+        let tracks = self.tracks_motion();
+        if tracks {
+            let start = &mut self.scratch.motion_v;
+            start.clear();
+            start.extend_from_slice(&self.v);
+        }
         let limit = f64::from(super::MAX_SUBSTEPS);
         let mut n = if h > 0.0 {
             (dt / h).ceil().clamp(1.0, limit)
@@ -121,6 +140,11 @@ impl Cloth {
             let substeps = n as u32;
             match self.step_substeps(dt, substeps) {
                 Ok(()) => {
+                    if tracks {
+                        let t = &self.topology;
+                        let (start, end) = (&self.scratch.motion_v, &self.v);
+                        self.motion.update(&t.masses, &self.pinned, start, end, dt);
+                    }
                     self.step_stats = StepStats {
                         substeps,
                         retries,
@@ -153,13 +177,29 @@ impl Cloth {
     pub fn auto_substep(&self, dt: f64) -> f64 {
         let weight = &self.scratch.contact_weight;
         // Fractional damping's current-rate weight grows as h^{1/2}: the bound at the bound.
-        let mut h = self.substep_bound(dt, 0.0, weight);
+        let (mut h, mut floor) = self.substep_bound(dt, 0.0, weight);
         if self.fractional_damping() {
             for _ in 0..3 {
-                h = self.substep_bound(dt, h, weight);
+                (h, floor) = self.substep_bound(dt, h, weight);
             }
         }
-        (safety(self.config.integrator) * h).min(dt)
+        let mut h = safety(self.config.integrator) * h;
+        let omega = self.motion.omega();
+        if self.tracks_motion() && omega > 0.0 {
+            h = h.min((ACCURACY / omega).max(SAFETY_SYMPLECTIC * floor));
+        }
+        h.min(dt)
+    }
+
+    /// Whether the automatic step bounds implicit Euler's damping of the motion (module docs).
+    fn tracks_motion(&self) -> bool {
+        self.config.integrator == Integrator::ImplicitEuler && self.config.max_substep < 0.0
+    }
+
+    /// The motion's averaged frequency the automatic step reads, rad/s (0: none yet, or not
+    /// tracked: implicit Euler at the automatic step only).
+    pub fn motion_frequency(&self) -> f64 {
+        self.motion.omega()
     }
 
     /// Whether the springs or drags damp on D^{1/2} (their damping depends on the step).
@@ -171,7 +211,8 @@ impl Cloth {
     /// The smallest bound over the particles and pins (module docs); `h` the step at which the
     /// half-derivative's current-rate weight `h^{1/2} / Gamma(3/2)` is taken (0: none);
     /// `weight` each vertex's contact weight (`Cloth::measure_contact_weights`; empty: none).
-    fn substep_bound(&self, dt: f64, h: f64, weight: &[f64]) -> f64 {
+    /// Also symplectic Euler's bound on the same oscillators (implicit Euler's accuracy floor).
+    fn substep_bound(&self, dt: f64, h: f64, weight: &[f64]) -> (f64, f64) {
         let w0 = h.sqrt() / GAMMA_3_2;
         let m = &self.config.model;
         let t = &self.topology;
@@ -188,6 +229,7 @@ impl Cloth {
         let oscillator = if explicit { 0.5 } else { 1.0 };
         let (ma, rho_w, cd) = (m.water.added_mass, m.water_density, m.water.form_drag);
         let rate = damping_rate(m);
+        let mut floor = f64::INFINITY;
         for i in 0..self.x.len() {
             if self.pinned[i] {
                 continue;
@@ -226,8 +268,10 @@ impl Cloth {
                 omega2 += touch * m.collision_stiffness / mass;
                 gamma += touch * m.collision_damping / mass;
             }
+            let oscillator_bound = symplectic_bound(omega2, gamma);
+            floor = floor.min(oscillator_bound);
             if !implicit {
-                bound = bound.min(oscillator * symplectic_bound(omega2, gamma));
+                bound = bound.min(oscillator * oscillator_bound);
             }
             // The carried water's turning forces, explicit in every integrator.
             if ma > 0.0 && shortest.is_finite() && shortest > 0.0 {
@@ -251,7 +295,7 @@ impl Cloth {
                 bound = bound.min(dt * shortest / travel / safety(integrator));
             }
         }
-        bound
+        (bound, floor)
     }
 }
 

@@ -1,7 +1,9 @@
 //! Snapshots: the complete state of a cloth as bytes, to save a bake and resume it later
 //! (or undo in a host), continuing bitwise identically.
 //!
-//! Format version 6, little-endian; version 5 (no colliders' own margins) is read with every
+//! Format version 7, little-endian; version 6 (no motion averages) is read with the motion
+//! unseen (implicit Euler's automatic step then bounds nothing by accuracy until the averages
+//! fill, `cloth/motion.rs`), version 5 (no colliders' own margins) is read with every
 //! collider at the model's margin, version 4 (no collision state) as a cloth with no mesh
 //! collider and no remembered self-collision pair. Older versions are refused: version 1
 //! stored the SOE modes in their in-memory block layout, version 2 unshifted modes, version 3
@@ -9,7 +11,7 @@
 //! sum instead of the sample that waits to be folded (`history/soe.rs`).
 //!
 //! ```text
-//! header   b"FCSNAP\0\0"  u32 version = 6  u32 flags = 0  u64 payload_len
+//! header   b"FCSNAP\0\0"  u32 version = 7  u32 flags = 0  u64 payload_len
 //! payload  u64 vertex_count  u64 spring_count  u64 triangle_count  u64 topology_fingerprint
 //!          u8 history_tag  u64 history_config_fingerprint
 //!          f64 time  u64 steps  vec3 current  f64 solver_tolerance  u32 solver_max_iterations
@@ -23,6 +25,7 @@
 //!            f64 margin (-1: the model's)]
 //!          u64 n + n (u32 vertex, u32 triangle, i8 side)  self-collision pairs
 //!          u64 n + n (u32 edge, u32 edge, i8 side)
+//!          f64 motion accel2  f64 motion vel2  (`cloth/motion.rs`; version 7)
 //! trailer  u32 CRC-32 (IEEE) of header and payload
 //! ```
 //!
@@ -45,7 +48,7 @@ use crate::math::Vec3;
 
 const MAGIC: &[u8; 8] = b"FCSNAP\0\0";
 /// Current format version.
-pub const SNAPSHOT_VERSION: u32 = 6;
+pub const SNAPSHOT_VERSION: u32 = 7;
 const HEADER: usize = 8 + 4 + 4 + 8;
 
 /// FNV-1a over a stream of u64 words: cheap identity checks, not security.
@@ -176,6 +179,7 @@ struct LoadedState {
     collider_slots: Vec<Option<super::ColliderSlot>>,
     histories: Histories,
     meshes: Vec<Option<MeshCollider>>,
+    motion: super::motion::MotionRate,
 }
 
 impl Cloth {
@@ -232,6 +236,8 @@ impl Cloth {
         }
         self.histories.write_state(w)?;
         self.write_collision_state(w);
+        w.f64(self.motion.accel2);
+        w.f64(self.motion.vel2);
         Ok(())
     }
 
@@ -355,6 +361,17 @@ impl Cloth {
                 "snapshot: collider id {id} is both a mesh and a shape"
             )));
         }
+        let motion = if version >= 7 {
+            super::motion::MotionRate {
+                accel2: r.f64()?,
+                vel2: r.f64()?,
+            }
+        } else {
+            super::motion::MotionRate::default()
+        };
+        if !motion.is_sound() {
+            return Err(Error::invalid("snapshot: bad motion averages"));
+        }
         if r.remaining() != 4 {
             return Err(Error::invalid("snapshot has trailing data"));
         }
@@ -418,6 +435,7 @@ impl Cloth {
             collider_slots,
             histories,
             meshes: collisions.meshes,
+            motion,
         };
         self.swap_state(&mut state);
         self.self_collision
@@ -452,6 +470,7 @@ impl Cloth {
         std::mem::swap(&mut self.collider_slots, &mut s.collider_slots);
         std::mem::swap(&mut self.histories, &mut s.histories);
         std::mem::swap(&mut self.mesh_slots, &mut s.meshes);
+        std::mem::swap(&mut self.motion, &mut s.motion);
         for (p, &w) in self.pinned.iter_mut().zip(&self.pin_weight) {
             *p = w == 1.0;
         }
@@ -592,5 +611,53 @@ mod tests {
             assert_eq!(a.velocities(), b.velocities(), "{}", scheme.name());
             assert_eq!(a.time(), b.time());
         }
+    }
+
+    /// Implicit Euler's automatic step reads the motion's averages (`cloth/motion.rs`): a
+    /// snapshot carries them, so a cloth made from it takes the same substeps and bits.
+    /// Without them in the snapshot, the loaded cloth's first call steps differently.
+    #[test]
+    fn implicit_eulers_automatic_step_continues_bitwise_from_a_snapshot() {
+        let make = || {
+            let mut c = cloth(Scheme::DEFAULT);
+            c.config.integrator = crate::Integrator::ImplicitEuler;
+            c.config.max_substep = crate::cloth::AUTO;
+            c
+        };
+        let mut a = make();
+        let rest: Vec<Vec3> = a.positions()[..3].to_vec();
+        let drive = |c: &mut Cloth, k: u32| {
+            let s = Vec3::new(0.01 * (f64::from(k) * 0.4).sin(), 0.0, 0.0);
+            let targets: Vec<Vec3> = rest.iter().map(|&r| r + s).collect();
+            c.set_pin_targets(&[0, 1, 2], &targets).unwrap();
+        };
+        for k in 0..20 {
+            drive(&mut a, k);
+            a.step(1.0 / 30.0).unwrap();
+        }
+        assert!(a.motion_frequency() > 0.0);
+        let snap = a.save_snapshot().unwrap();
+        let mut b = make();
+        b.load_snapshot(&snap).unwrap();
+        assert_eq!(a.motion_frequency(), b.motion_frequency());
+        for k in 20..30 {
+            drive(&mut a, k);
+            drive(&mut b, k);
+            a.step(1.0 / 30.0).unwrap();
+            b.step(1.0 / 30.0).unwrap();
+            assert_eq!(a.step_stats(), b.step_stats());
+        }
+        assert_eq!(a.positions(), b.positions());
+
+        // A version-6 snapshot (no averages) loads with the motion unseen.
+        let mut old = snap[..snap.len() - 4 - 16].to_vec();
+        old[8..12].copy_from_slice(&6u32.to_le_bytes());
+        let payload = (old.len() - HEADER) as u64;
+        old[16..24].copy_from_slice(&payload.to_le_bytes());
+        let crc = crc32fast::hash(&old);
+        old.extend_from_slice(&crc.to_le_bytes());
+        let mut c = make();
+        c.load_snapshot(&old).unwrap();
+        assert_eq!(c.motion_frequency(), 0.0);
     }
 }

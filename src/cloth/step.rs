@@ -94,6 +94,8 @@ pub(super) struct StepScratch {
     pub half: crate::aligned::AlignedVec3,
     /// Total forces as one array (the implicit route only), N.
     pub force_array: Vec<Vec3>,
+    /// The velocities where an automatic call with implicit Euler began (`motion.rs`).
+    pub motion_v: Vec<Vec3>,
     /// The state the step proposes; committed only if sound.
     pub x_new: crate::aligned::AlignedVec3,
     pub v_new: crate::aligned::AlignedVec3,
