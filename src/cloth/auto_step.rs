@@ -65,9 +65,11 @@ pub fn safety(integrator: Integrator) -> f64 {
 /// Implicit Euler's accuracy bound: `omega h` at most this, `omega` the motion's frequency as
 /// `motion.rs` reads it (frame-rate accelerations against velocities: on the 4 cm swing of
 /// 61 x 41 it reads 2-3.5 times the drive's frequency, the cloth's ripples included). Measured
-/// there (docs/underwater.md): at 1 Hz implicit Euler's half-waves were 2.75 at its stable step
-/// against 4.76 converged; with this bound 5.22 (17 substeps a frame), and within 10 % of the
-/// converged shot from 0.25 to 2 Hz. 0.016 took 1.5 times the substeps for no better shot.
+/// there in 12 s bakes (docs/underwater.md, stop 58): at 1 Hz implicit Euler gave 2.73
+/// half-waves and a free edge of 0.090 of the drive at its stable step, against symplectic
+/// Euler's 4.72 and 0.217; with this bound 5.30 and 0.171 (25 substeps a frame), and the depth
+/// of the motion within 12 % of symplectic Euler's from 0.25 to 2 Hz. A bound of 0.025 took
+/// 17 substeps a frame at 1 Hz and gave 3.67 and 0.149.
 pub const ACCURACY: f64 = 0.016;
 
 /// Times a refused frame is retried with twice the substeps (so up to 16 times the estimate's).
