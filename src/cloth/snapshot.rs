@@ -615,7 +615,7 @@ mod tests {
 
     /// Implicit Euler's automatic step reads the motion's averages (`cloth/motion.rs`): a
     /// snapshot carries them, so a cloth made from it takes the same substeps and bits.
-    /// Without them in the snapshot, the loaded cloth's first call steps differently.
+    /// With them left out of the load, the loaded cloth reads no motion and the test fails.
     #[test]
     fn implicit_eulers_automatic_step_continues_bitwise_from_a_snapshot() {
         let make = || {
