@@ -127,6 +127,48 @@ fn travelling_waves_decaying_over_20_and_10_cm() {
     }
 }
 
+/// The half-wave count a hard cut at 10 % of the top's amplitude would give: the lag of the
+/// first row under it (interpolated), over pi.
+fn hard_cut_half_waves(rows: &[fraccloth_tools::look::RowHarmonic]) -> f64 {
+    let limit = 0.1 * rows[0].amplitude;
+    match rows.iter().position(|r| r.amplitude < limit) {
+        None => rows[rows.len() - 1].lag / PI,
+        Some(j) => {
+            let (a, b) = (&rows[j - 1], &rows[j]);
+            let f = (a.amplitude - limit) / (a.amplitude - b.amplitude);
+            (a.lag + f * (b.lag - a.lag)) / PI
+        }
+    }
+}
+
+#[test]
+fn a_column_hovering_about_the_visible_limit_is_counted_steadily() {
+    // A wave at 0.1 m/s (4 half-waves down the column) whose amplitude decays over 5 cm to a
+    // plateau at 10.2 % or 9.8 % of the top's: the rows of the two agree within 0.4 % of the
+    // top. A hard cut at 10 % reads the whole column in one and stops at 11.6 cm in the other;
+    // the count weighs each row's lag by its visibility and moves by about 0.14.
+    let c = 0.1;
+    let column =
+        |plateau: f64| move |y: f64, t: f64| 0.04 * (-y / 0.05).exp().max(plateau) * (W * (t - y / c)).sin();
+    let (above, below) = (bake(column(0.102)), bake(column(0.098)));
+    let (hard_above, hard_below) = (
+        hard_cut_half_waves(&above.descriptors.rows),
+        hard_cut_half_waves(&below.descriptors.rows),
+    );
+    assert!(
+        hard_above - hard_below > 2.0,
+        "the columns hover about the limit: a hard cut reads {hard_above} and {hard_below}"
+    );
+    let (a, b) = (above.descriptors.half_waves, below.descriptors.half_waves);
+    assert!(
+        a > b && a - b < 0.2,
+        "half-waves {a} and {b} for two columns within 0.4 % of the top's amplitude"
+    );
+    // Between the lag of the 10 % depth (1.16) and the whole column's (4): the rows below it
+    // count for about half.
+    assert!((2.2..=2.9).contains(&a), "half-waves {a}");
+}
+
 #[test]
 fn a_whole_period_lag_is_read_as_the_slow_wave_it_is() {
     // At 0.1 m/s the row three quarters down lags the one a quarter down by exactly one
