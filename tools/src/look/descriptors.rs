@@ -349,6 +349,23 @@ mod tests {
     }
 
     #[test]
+    fn visibility_ramps_in_the_logarithm_from_a_fifteenth_to_fifteen_hundredths() {
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(close(visibility(VISIBLE_FRACTION), 0.5));
+        assert!(close(visibility(VISIBLE_FRACTION * VISIBLE_RAMP), 1.0));
+        assert!(close(visibility(VISIBLE_FRACTION / VISIBLE_RAMP), 0.0));
+        assert_eq!(visibility(1.0), 1.0);
+        assert_eq!(visibility(0.01), 0.0);
+        for bad in [0.0, -0.2, f64::NAN] {
+            assert_eq!(visibility(bad), 0.0);
+        }
+        // Symmetric in the logarithm about 10 %: r and 0.01 / r weigh 1 together.
+        for r in [0.07, 0.08, 0.09, 0.1, 0.12, 0.14] {
+            assert!(close(visibility(r) + visibility(0.01 / r), 1.0), "{r}");
+        }
+    }
+
+    #[test]
     fn a_rigid_line_is_straight_and_an_arc_is_not() {
         let y: Vec<f64> = (0..20).map(|j| 0.01 * j as f64).collect();
         let line: Vec<Complex<f64>> = y.iter().map(|&y| Complex::new(0.05, -0.3 * y)).collect();
