@@ -19,8 +19,8 @@
 //!   And an accuracy bound (implicit Euler only, not its extrapolated form): its own damping
 //!   takes about `pi omega h` of a motion's amplitude a period, so the substep is kept to
 //!   `h <= `[`ACCURACY`]` / omega`, `omega` the cloth's motion frequency as it moves
-//!   (`motion.rs`), but never below the step symplectic Euler would take on the same cloth
-//!   (implicit Euler then costs more a call than symplectic Euler, never more substeps).
+//!   (`motion.rs`), but never below [`ACCURACY_FLOOR`] (0.7) of the step symplectic Euler would
+//!   take on the same cloth.
 //!
 //! And pins: no pin travels more than one spring rest length in a substep.
 //!
@@ -65,13 +65,19 @@ pub fn safety(integrator: Integrator) -> f64 {
 /// Implicit Euler's accuracy bound: `omega h` at most this, `omega` the motion's frequency as
 /// `motion.rs` reads it (frame-rate accelerations against velocities: on the 4 cm swing of
 /// 61 x 41 it reads 2-3.5 times the drive's frequency, the cloth's ripples included). Measured
-/// there in 12 s bakes (docs/underwater.md, stop 58): at 1 Hz implicit Euler gave 2.73
-/// half-waves and a free edge of 0.090 of the drive at its stable step, against symplectic
-/// Euler's 4.72 and 0.217; with this bound 5.30 and 0.171 (25 substeps a frame), and the depth
-/// of the motion within 12 % of symplectic Euler's from 0.25 to 1.5 Hz (at 2 Hz, where the
-/// step is already symplectic Euler's, 26 % less). A bound of 0.025 took
-/// 17 substeps a frame at 1 Hz and gave 3.67 and 0.149.
+/// there in 12 s bakes (docs/underwater.md, stop 58): at 1 Hz implicit Euler's free edge swung
+/// 0.090 of the drive at its stable step against symplectic Euler's 0.217, and 0.171 with this
+/// bound (25 substeps a frame), the depth of the motion within 12 % of symplectic Euler's from
+/// 0.25 to 1.5 Hz; a bound of 0.025 took 17 substeps a frame at 1 Hz and gave 0.149.
 pub const ACCURACY: f64 = 0.016;
+
+/// The shortest substep the accuracy bound may ask of implicit Euler, as a fraction of the step
+/// symplectic Euler takes on the same cloth. Measured on the 61 x 41 swing, 12 s bakes
+/// (docs/underwater.md, stop 59): at 2 Hz the bound asks for less than symplectic Euler's step,
+/// and at 1 (symplectic Euler's step) implicit Euler read 5.61 half-waves against symplectic
+/// Euler's 6.89 (-19 %), at 0.7 6.02 (-13 %) for 42 substeps a frame instead of 30, at 0.5 6.06
+/// for 52.
+pub const ACCURACY_FLOOR: f64 = 0.7;
 
 /// Times a refused frame is retried with twice the substeps (so up to 16 times the estimate's).
 pub const MAX_RETRIES: u32 = 4;
@@ -189,7 +195,7 @@ impl Cloth {
         let mut h = safety(self.config.integrator) * h;
         let omega = self.motion.omega();
         if self.tracks_motion() && omega > 0.0 {
-            h = h.min((ACCURACY / omega).max(SAFETY_SYMPLECTIC * floor));
+            h = h.min((ACCURACY / omega).max(ACCURACY_FLOOR * SAFETY_SYMPLECTIC * floor));
         }
         h.min(dt)
     }
