@@ -73,10 +73,10 @@ pub const ACCURACY: f64 = 0.016;
 
 /// The shortest substep the accuracy bound may ask of implicit Euler, as a fraction of the step
 /// symplectic Euler takes on the same cloth. Measured on the 61 x 41 swing, 12 s bakes
-/// (docs/underwater.md, stop 59): at 2 Hz the bound asks for less than symplectic Euler's step,
-/// and at 1 (symplectic Euler's step) implicit Euler read 5.61 half-waves against symplectic
-/// Euler's 6.89 (-19 %), at 0.7 6.02 (-13 %) for 42 substeps a frame instead of 30, at 0.5 6.06
-/// for 52.
+/// (docs/underwater.md, stop 59): at 2 Hz the bound asks for less than symplectic Euler's step.
+/// With the floor at 1 (symplectic Euler's step) implicit Euler read 5.61 half-waves against
+/// symplectic Euler's 6.89 (-19 %); at 0.7, 6.02 (-13 %) for 42 substeps a frame instead of 30;
+/// at 0.5, 6.06 for 52.
 pub const ACCURACY_FLOOR: f64 = 0.7;
 
 /// Times a refused frame is retried with twice the substeps (so up to 16 times the estimate's).

@@ -17,7 +17,7 @@ pub const VISIBLE_FRACTION: f64 = 0.1;
 /// below `VISIBLE_FRACTION / VISIBLE_RAMP`, linearly in the logarithm of the amplitude between.
 /// A hard cut at 10 % made the count jump by one or two half-waves with a 1 % change of one
 /// row's amplitude wherever the column hovers about 10 % (a 1.5 Hz swing: 3.82 or 4.81 for two
-/// bakes whose rows agree within 0.03 of the top in amplitude and 0.15 pi in lag).
+/// bakes whose rows agree within 0.035 of the top in amplitude and 0.15 pi in lag to 0.3 m).
 pub const VISIBLE_RAMP: f64 = 1.5;
 /// Side-view extrema are counted with this hysteresis, m.
 pub const BULGE_HYSTERESIS: f64 = 0.005;
