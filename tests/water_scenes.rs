@@ -72,8 +72,8 @@ fn the_towel_hangs_and_its_bumps_shorten_from_a_quarter_to_two_hertz() {
             d.mid_ratio,
             d.hang_depth
         );
-        // Nothing rolls up under the pins: the towel hangs (at 2 Hz its six half-waves of
-        // ripple shorten it to 0.89 of its length: docs/underwater.md).
+        // Nothing rolls up under the pins: the towel hangs (at 2 Hz the tilt of its ripples,
+        // most of it in the top 5 cm, shortens it to 0.89 of its length: docs/underwater.md).
         let hang = if f < 2.0 { 0.9 } else { 0.88 };
         assert!(
             d.hang_depth >= hang * rest_length,
