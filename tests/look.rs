@@ -7,7 +7,7 @@
 use std::f64::consts::PI;
 
 use fraccloth::{GridSpec, Vec3};
-use fraccloth_tools::look::{measure, Look};
+use fraccloth_tools::look::{half_waves_cut_at, measure, Look};
 
 const L: f64 = 0.4; // column length, m
 const FPS: f64 = 30.0;
@@ -127,20 +127,6 @@ fn travelling_waves_decaying_over_20_and_10_cm() {
     }
 }
 
-/// The half-wave count a hard cut at 10 % of the top's amplitude would give: the lag of the
-/// first row under it (interpolated), over pi.
-fn hard_cut_half_waves(rows: &[fraccloth_tools::look::RowHarmonic]) -> f64 {
-    let limit = 0.1 * rows[0].amplitude;
-    match rows.iter().position(|r| r.amplitude < limit) {
-        None => rows[rows.len() - 1].lag / PI,
-        Some(j) => {
-            let (a, b) = (&rows[j - 1], &rows[j]);
-            let f = (a.amplitude - limit) / (a.amplitude - b.amplitude);
-            (a.lag + f * (b.lag - a.lag)) / PI
-        }
-    }
-}
-
 #[test]
 fn a_column_hovering_about_the_visible_limit_is_counted_steadily() {
     // A wave at 0.1 m/s (4 half-waves down the column) whose amplitude decays over 5 cm to a
@@ -152,8 +138,8 @@ fn a_column_hovering_about_the_visible_limit_is_counted_steadily() {
         |plateau: f64| move |y: f64, t: f64| 0.04 * (-y / 0.05).exp().max(plateau) * (W * (t - y / c)).sin();
     let (above, below) = (bake(column(0.102)), bake(column(0.098)));
     let (hard_above, hard_below) = (
-        hard_cut_half_waves(&above.descriptors.rows),
-        hard_cut_half_waves(&below.descriptors.rows),
+        half_waves_cut_at(&above.descriptors.rows, 0.1),
+        half_waves_cut_at(&below.descriptors.rows, 0.1),
     );
     assert!(
         hard_above - hard_below > 2.0,

@@ -113,6 +113,24 @@ pub fn visibility(ratio: f64) -> f64 {
     (0.5 + (ratio / VISIBLE_FRACTION).ln() / (2.0 * VISIBLE_RAMP.ln())).clamp(0.0, 1.0)
 }
 
+/// The half-wave count as the meter read it before 0.9.23: the lag at the first row whose
+/// amplitude falls under `fraction` of the top's (interpolated to the crossing), or the bottom
+/// row's, over pi. Kept to show where that cut jumps ([`VISIBLE_RAMP`]); 0 for no rows.
+pub fn half_waves_cut_at(rows: &[RowHarmonic], fraction: f64) -> f64 {
+    let Some(top) = rows.first() else { return 0.0 };
+    let limit = fraction * top.amplitude;
+    let lag = match rows.iter().position(|r| r.amplitude < limit) {
+        None => rows[rows.len() - 1].lag,
+        Some(0) => 0.0,
+        Some(j) => {
+            let (a, b) = (&rows[j - 1], &rows[j]);
+            let f = crossing(0.0, 1.0, a.amplitude, b.amplitude, limit);
+            a.lag + f * (b.lag - a.lag)
+        }
+    };
+    lag / std::f64::consts::PI
+}
+
 /// Phase lags behind the first entry, unwrapped entry to entry.
 pub fn unwrapped_lags(z: &[Complex<f64>]) -> Vec<f64> {
     let mut lags = Vec::with_capacity(z.len());
@@ -363,6 +381,27 @@ mod tests {
         for r in [0.07, 0.08, 0.09, 0.1, 0.12, 0.14] {
             assert!(close(visibility(r) + visibility(0.01 / r), 1.0), "{r}");
         }
+    }
+
+    #[test]
+    fn the_old_cut_reads_the_lag_at_the_first_crossing() {
+        let row = |depth, amplitude, lag| RowHarmonic {
+            depth,
+            amplitude,
+            lag,
+        };
+        let pi = std::f64::consts::PI;
+        let rows = [
+            row(0.0, 1.0, 0.0),
+            row(0.01, 0.5, 1.0),
+            row(0.02, 0.05, 2.0),
+            row(0.03, 0.5, 3.0),
+        ];
+        // Under 10 % between the second and third rows, 8/9 of the way.
+        assert!((half_waves_cut_at(&rows, 0.1) - (1.0 + 8.0 / 9.0) / pi).abs() < 1e-12);
+        // Never under 1 %: the bottom row's lag.
+        assert!((half_waves_cut_at(&rows, 0.01) - 3.0 / pi).abs() < 1e-12);
+        assert_eq!(half_waves_cut_at(&[], 0.1), 0.0);
     }
 
     #[test]

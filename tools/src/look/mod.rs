@@ -10,8 +10,8 @@ mod meter;
 mod stream;
 
 pub use descriptors::{
-    describe, extrema_with_hysteresis, straight_line_residual, unwrapped_lags, visibility, zigzag,
-    ColumnMotion, Descriptors, RowHarmonic, BULGE_HYSTERESIS, MAX_STRAIGHT_RESIDUAL, MIN_TRAVEL_LAG,
+    describe, extrema_with_hysteresis, half_waves_cut_at, straight_line_residual, unwrapped_lags, visibility,
+    zigzag, ColumnMotion, Descriptors, RowHarmonic, BULGE_HYSTERESIS, MAX_STRAIGHT_RESIDUAL, MIN_TRAVEL_LAG,
     VISIBLE_FRACTION, VISIBLE_RAMP,
 };
 pub use harmonic::{complex_amplitude, dominant_frequency};
