@@ -3,7 +3,8 @@
 //! without self-collision, at 61 x 41 and 201 x 201, and with a 10k-triangle sphere mesh
 //! collider the towel swings against. Each configuration is baked alternately with its
 //! baseline, best of `rounds`, so both see the same machine. Prints seconds of bake per
-//! simulated second, the ratio, substeps a frame, self-collision looks a frame and the most
+//! simulated second, the ratio, substeps a frame, self-collision looks a frame (and how many of
+//! them the proof of `collide/unfolded.rs` settled whole, testing no pair) and the most
 //! crossing triangle pairs at any frame.
 //!
 //! `cargo run --release --example collision_cost -- [rounds] [case]` (default 3 rounds, every
@@ -29,8 +30,9 @@ struct Case {
     seconds: f64,
 }
 
-/// (wall seconds, substeps a frame, looks a frame, most crossing pairs, contacts at the end).
-fn bake(c: Case) -> (f64, f64, f64, usize, usize) {
+/// (wall seconds, substeps a frame, looks a frame, most crossing pairs, contacts at the end,
+/// looks a frame the proof of `collide/unfolded.rs` settled whole).
+fn bake(c: Case) -> (f64, f64, f64, usize, usize, f64) {
     let model = Model {
         self_collision_thickness: c.thickness,
         ..Model::underwater()
@@ -47,6 +49,7 @@ fn bake(c: Case) -> (f64, f64, f64, usize, usize) {
     let frames = (c.seconds * FPS) as usize;
     let (mut wall, mut substeps, mut worst) = (0.0, 0u64, 0);
     let looks0 = scene.cloth.self_collision_looks();
+    let proved0 = scene.cloth.self_collision_proved_looks();
     for f in 1..=frames {
         let t0 = Instant::now();
         scene.run_until(f as f64 / FPS).expect("frame");
@@ -57,20 +60,22 @@ fn bake(c: Case) -> (f64, f64, f64, usize, usize) {
         }
     }
     let looks = (scene.cloth.self_collision_looks() - looks0) as f64 / frames as f64;
+    let proved = (scene.cloth.self_collision_proved_looks() - proved0) as f64 / frames as f64;
     (
         wall,
         substeps as f64 / frames as f64,
         looks,
         worst,
         scene.cloth.contacts().len(),
+        proved,
     )
 }
 
 fn main() {
     let rounds: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(3);
     println!(
-        "{:<34} {:>9} {:>9} {:>6} {:>13} {:>7} {:>9} {:>9}",
-        "case", "base s/s", "with s/s", "ratio", "substeps b/w", "looks", "crossing", "contacts"
+        "{:<34} {:>9} {:>9} {:>6} {:>13} {:>7} {:>7} {:>9} {:>9}",
+        "case", "base s/s", "with s/s", "ratio", "substeps b/w", "looks", "proved", "crossing", "contacts"
     );
     let towel = |frequency, amplitude| Case {
         width: 61,
@@ -109,7 +114,7 @@ fn main() {
             ..base
         };
         let (mut b, mut w) = (f64::INFINITY, f64::INFINITY);
-        let mut stats = (0.0, 0.0, 0, 0);
+        let mut stats = (0.0, 0.0, 0, 0, 0.0);
         let mut base_substeps = 0.0;
         for _ in 0..rounds {
             let r = bake(base);
@@ -117,16 +122,17 @@ fn main() {
             base_substeps = r.1;
             let r = bake(with);
             w = w.min(r.0);
-            stats = (r.1, r.2, r.3, r.4);
+            stats = (r.1, r.2, r.3, r.4, r.5);
         }
         let s = base.seconds;
         println!(
-            "{name:<34} {:>9.3} {:>9.3} {:>6.2} {:>13} {:>7.2} {:>9} {:>9}",
+            "{name:<34} {:>9.3} {:>9.3} {:>6.2} {:>13} {:>7.2} {:>7.2} {:>9} {:>9}",
             b / s,
             w / s,
             w / b,
             format!("{base_substeps:.1}/{:.1}", stats.0),
             stats.1,
+            stats.4,
             stats.2,
             stats.3
         );

@@ -93,6 +93,12 @@ impl Cloth {
         self.self_collision.looks
     }
 
+    /// How many of those looks tested no pair: the proof that the unfolded sheet keeps its
+    /// distances covered every pair (`collide/unfolded.rs`).
+    pub fn self_collision_proved_looks(&self) -> u64 {
+        self.self_collision.certified_looks
+    }
+
     /// The error of mesh collider `id` whose candidate lists were refused (`why`) at margin
     /// `margin` against a cloth of `vertices`.
     fn too_many_candidates(id: usize, mesh: &MeshCollider, margin: f64, vertices: usize, why: Full) -> Error {

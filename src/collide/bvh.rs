@@ -118,6 +118,16 @@ impl Aabb {
             & (p.z <= self.max.z)
     }
 
+    /// The squared distance of the two furthest points of this box and `o`.
+    pub fn farthest2(&self, o: &Aabb) -> f64 {
+        (0..3)
+            .map(|k| {
+                let d = (self.max[k] - o.min[k]).max(o.max[k] - self.min[k]);
+                d * d
+            })
+            .sum()
+    }
+
     /// Squared distance from `p` to the box (0 inside).
     pub fn distance2(&self, p: &Vec3) -> f64 {
         let d = (self.min - p).sup(&Vec3::zeros()).sup(&(p - self.max));
@@ -381,6 +391,50 @@ impl Bvh {
         );
     }
 
+    /// Each node's box of the items' `boxes` (in the tree's order, [`Bvh::in_order`]), into
+    /// `out` (which the caller may have reserved fallibly): boxes of another shape of the same
+    /// items, for [`Bvh::self_overlapping_apart_within`].
+    pub fn node_boxes_into(&self, boxes: &[Aabb], out: &mut Vec<Aabb>) {
+        debug_assert_eq!(boxes.len(), self.boxes.len());
+        out.clear();
+        out.resize(self.nodes.len(), Aabb::empty());
+        for k in (0..self.nodes.len()).rev() {
+            let Node { first, count, .. } = self.nodes[k];
+            let (first, count) = (first as usize, count as usize);
+            out[k] = if count > 0 {
+                boxes[first..first + count]
+                    .iter()
+                    .fold(Aabb::empty(), |b, o| b.join(o))
+            } else {
+                out[first].join(&out[first + 1])
+            };
+        }
+    }
+
+    /// As [`Bvh::self_overlapping_apart`], leaving out whole the node pairs whose `nodes`
+    /// boxes (one per node: [`Bvh::node_boxes_into`]) hold no two points `within` or further
+    /// apart: self-collision's walk where a proof covers the pairs nearer than that at rest.
+    pub fn self_overlapping_apart_within(
+        &self,
+        task: (u32, u32),
+        other: &[Aabb],
+        nodes: &[Aabb],
+        within: f64,
+        stack: &mut Vec<(u32, u32)>,
+        f: impl FnMut(u32, u32),
+    ) {
+        debug_assert_eq!(other.len(), self.boxes.len());
+        debug_assert_eq!(nodes.len(), self.nodes.len());
+        let within2 = within * within;
+        self.walk_self_skipping(
+            task,
+            stack,
+            |a, b| nodes[a as usize].farthest2(&nodes[b as usize]) < within2,
+            |k, l| self.boxes[k].overlaps(&self.boxes[l]) & !other[k].overlaps(&other[l]),
+            f,
+        );
+    }
+
     /// The tree against itself from the node pair `task`: `f(i, j)` for the items of the
     /// slots `k`, `l` (places in `order`) of every leaf pair whose bounds overlap where
     /// `pair(k, l)`.
@@ -390,11 +444,27 @@ impl Bvh {
         task: (u32, u32),
         stack: &mut Vec<(u32, u32)>,
         pair: impl Fn(usize, usize) -> bool,
+        f: impl FnMut(u32, u32),
+    ) {
+        self.walk_self_skipping(task, stack, |_, _| false, pair, f);
+    }
+
+    /// [`Bvh::walk_self`], leaving out the node pairs where `skip(a, b)`.
+    #[inline(always)]
+    fn walk_self_skipping(
+        &self,
+        task: (u32, u32),
+        stack: &mut Vec<(u32, u32)>,
+        skip: impl Fn(u32, u32) -> bool,
+        pair: impl Fn(usize, usize) -> bool,
         mut f: impl FnMut(u32, u32),
     ) {
         stack.clear();
         stack.push(task);
         while let Some((a, b)) = stack.pop() {
+            if skip(a, b) {
+                continue;
+            }
             let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
             let leaves = na.count > 0 && nb.count > 0;
             if !leaves {

@@ -16,6 +16,7 @@
 //! | `room.rs` | bounded, fallibly grown lists (entries a caller's input sets) |
 //! | `self_collision.rs` | the cloth against itself |
 //! | `shapes.rs` | closed meshes of simple solids (scenes and tests) |
+//! | `unfolded.rs` | a proof that an unfolded sheet keeps its distances: pairs a look need not test |
 
 pub mod bvh;
 pub mod ccd;
@@ -30,6 +31,7 @@ pub mod ownership;
 pub(crate) mod room;
 pub mod self_collision;
 pub mod shapes;
+mod unfolded;
 
 pub use contact::Contact;
 pub use mesh::MeshCollider;

@@ -138,6 +138,8 @@ pub(super) struct NearPairs {
     pub(super) vertex_triangle: Vec<(u32, u32)>,
     /// `(e, f)`, e < f, owned by two rest-near triangles.
     pub(super) edge_edge: Vec<(u32, u32)>,
+    /// The furthest apart at rest any two points of a listed pair are (0 with none).
+    pub(super) max_span: f64,
 }
 
 impl NearPairs {
@@ -188,10 +190,29 @@ impl NearPairs {
         // In order, so that a vertex's (an edge's) pairs come together.
         vt.sort_unstable();
         ee.sort_unstable();
+        // The furthest points of a vertex and a triangle are corners, of two edges ends.
+        let far = |p: u32, q: u32| (rest[p as usize] - rest[q as usize]).norm();
+        let max_span = vt
+            .iter()
+            .map(|&(p, t)| {
+                triangles[t as usize]
+                    .iter()
+                    .map(|&q| far(p, q))
+                    .fold(0.0, f64::max)
+            })
+            .chain(ee.iter().map(|&(e, f)| {
+                let (a, b) = (edges[e as usize], edges[f as usize]);
+                a.iter()
+                    .flat_map(|&p| b.iter().map(move |&q| (p, q)))
+                    .map(|(p, q)| far(p, q))
+                    .fold(0.0, f64::max)
+            }))
+            .fold(0.0, f64::max);
         Some(NearPairs {
             rest_boxes,
             vertex_triangle: vt,
             edge_edge: ee,
+            max_span,
         })
     }
 

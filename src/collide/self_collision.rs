@@ -38,6 +38,7 @@ use super::impact_zones::{PairRef, Passage};
 use super::neighbours::{Exclusions, NearPairs};
 use super::ownership::Ownership;
 use super::room::{Full, Room};
+use super::unfolded::Unfolded;
 use crate::error::Error;
 use crate::math::Vec3;
 
@@ -105,6 +106,16 @@ pub struct SelfCollision {
     /// The neighbour pairs the proximity search leaves out, whose passage through each other
     /// the impact zones' continuous check watches ([`Guard`]).
     guard: Guard,
+    /// The proof that an unfolded sheet keeps its distances ([`Unfolded`]): the pairs nearer
+    /// at rest than what it proves are not tested.
+    unfolded: Unfolded,
+    /// Looks without it (tests compare looks with and without).
+    pub(crate) full_looks: bool,
+    /// The triangles' plain rest boxes gathered by the tree's nodes; empty when the tree or
+    /// the rest shape is new.
+    rest_nodes: Vec<Aabb>,
+    /// Looks the proof settled whole, testing nothing (for benchmarks).
+    pub certified_looks: u64,
     /// A look's working lists, kept for the next look: the parts' finds, the walk's tasks,
     /// and a copy of the remembered pairs (their sides, read while the new lists are made).
     found: Vec<Found>,
@@ -434,6 +445,7 @@ impl SelfCollision {
                 self.near = near;
                 self.rest_in_order.clear();
                 self.guard = guard;
+                self.unfolded = Unfolded::new(rest, triangles);
                 Ok(())
             }
             (None, Some(Full::Memory)) => Err(Error::out_of_memory(format!(
@@ -638,6 +650,34 @@ impl SelfCollision {
         self.looks += 1;
         // Looked at afresh by the next step unless this look completes.
         self.looked_at.clear();
+        self.looked_at
+            .try_reserve(x.len())
+            .map_err(|_| oom("the positions of a look"))?;
+        if !self.prepared(x.len(), triangles.len(), excluded_within) {
+            // Unreachable through a cloth (it prepares at create and on a new model); a
+            // direct caller that did not prepare gets the default room and, past it, no pairs.
+            if self.prepare_within(rest, triangles, excluded_within).is_err() {
+                self.vertex_triangle.clear();
+                self.edge_edge.clear();
+                self.looked_at.extend_from_slice(x);
+                return Ok(());
+            }
+        }
+        // Pairs nearer than this at rest are surely out of reach (`unfolded.rs`).
+        let below = if self.full_looks {
+            excluded_within
+        } else {
+            self.unfolded
+                .certified_below(x, triangles, reach, excluded_within)
+        };
+        if below == f64::INFINITY && self.owners.orphans().is_empty() {
+            // Every pair: nothing in reach, nothing to remember.
+            self.certified_looks += 1;
+            self.vertex_triangle.clear();
+            self.edge_edge.clear();
+            self.looked_at.extend_from_slice(x);
+            return Ok(());
+        }
         // A vertex is a candidate for a triangle within `reach` of the triangle's box, two
         // edges for each other when their boxes grown by half the reach overlap. The
         // triangles' tree holds their boxes grown by half the reach: a vertex (an edge) of one
@@ -650,7 +690,6 @@ impl SelfCollision {
             .try_reserve(triangles.len())
             .and_then(|()| self.tree_boxes.try_reserve(triangles.len()))
             .and_then(|()| self.edge_boxes.try_reserve(self.edges.len()))
-            .and_then(|()| self.looked_at.try_reserve(x.len()))
             .map_err(|_| oom("the boxes of a look"))?;
         for t in triangles {
             let b = Aabb::of(t.iter().map(|&i| &x[i as usize]));
@@ -668,23 +707,31 @@ impl SelfCollision {
             self.tri_bvh = Bvh::try_build(&self.tree_boxes).map_err(|_| oom("the triangles' tree"))?;
             self.rest_in_order.clear();
         }
-        if !self.prepared(x.len(), triangles.len(), excluded_within) {
-            // Unreachable through a cloth (it prepares at create and on a new model); a
-            // direct caller that did not prepare gets the default room and, past it, no pairs.
-            if self.prepare_within(rest, triangles, excluded_within).is_err() {
-                self.vertex_triangle.clear();
-                self.edge_edge.clear();
-                self.looked_at.extend_from_slice(x);
-                return Ok(());
-            }
-        }
         if self.rest_in_order.len() != triangles.len() {
             let rest_boxes = self.near.rest_boxes();
             self.rest_in_order.clear();
+            self.rest_nodes.clear();
             self.rest_in_order
                 .try_reserve(rest_boxes.len())
                 .map_err(|_| oom("the rest boxes in the tree's order"))?;
             self.tri_bvh.in_order_into(rest_boxes, &mut self.rest_in_order);
+        }
+        if below > excluded_within && self.rest_nodes.is_empty() {
+            // The plain rest boxes, in the tree's order, gathered by its nodes (the tree's
+            // boxes at most twice its items' count).
+            let (mut boxes, mut plain) = (Vec::new(), Vec::new());
+            boxes
+                .try_reserve_exact(triangles.len())
+                .and_then(|()| plain.try_reserve_exact(triangles.len()))
+                .and_then(|()| self.rest_nodes.try_reserve_exact(2 * triangles.len()))
+                .map_err(|_| oom("the rest boxes of the tree's nodes"))?;
+            boxes.extend(
+                triangles
+                    .iter()
+                    .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize]))),
+            );
+            self.tri_bvh.in_order_into(&boxes, &mut plain);
+            self.tri_bvh.node_boxes_into(&plain, &mut self.rest_nodes);
         }
         // The remembered pairs copied aside (the new lists are made where they are), each
         // list keeping its room from look to look.
@@ -716,12 +763,18 @@ impl SelfCollision {
         // thread to the pool cost more than the second thread saved at 61 x 41 (Intel Xeon,
         // `collision_cost -- 5 0`: 1.34-1.40x the bake without on one thread, 1.46-1.73x on two).
         let par = crate::parallel::worth_it(x.len());
-        let (tri_bvh, near, rest_in_order) = (&self.tri_bvh, &self.near, &self.rest_in_order);
-        let near_chunks = near
-            .vertex_triangle
-            .len()
-            .max(near.edge_edge.len())
-            .div_ceil(NEAR_CHUNK);
+        let (tri_bvh, near, rest_in_order, rest_nodes) =
+            (&self.tri_bvh, &self.near, &self.rest_in_order, &self.rest_nodes);
+        // The near pairs all proved out of reach, or tested.
+        let near_chunks = if near.max_span < below {
+            0
+        } else {
+            near.vertex_triangle
+                .len()
+                .max(near.edge_edge.len())
+                .div_ceil(NEAR_CHUNK)
+        };
+        let proved = below > excluded_within;
         tri_bvh.self_tasks_into(if par { 64 } else { 1 }, &mut self.tasks, &mut self.tasks_spare);
         let tasks = &self.tasks;
         // One part a task and a chunk, and at least one (the orphans' queries below).
@@ -737,9 +790,22 @@ impl SelfCollision {
             if let Some(&task) = tasks.get(k) {
                 let Found { stack, .. } = found;
                 let mut stack = std::mem::take(stack);
-                tri_bvh.self_overlapping_apart(task, rest_in_order, &mut stack, |i, j| {
-                    search.far_triangles(i, j, found);
-                });
+                if proved {
+                    tri_bvh.self_overlapping_apart_within(
+                        task,
+                        rest_in_order,
+                        rest_nodes,
+                        below,
+                        &mut stack,
+                        |i, j| {
+                            search.far_triangles(i, j, found);
+                        },
+                    );
+                } else {
+                    tri_bvh.self_overlapping_apart(task, rest_in_order, &mut stack, |i, j| {
+                        search.far_triangles(i, j, found);
+                    });
+                }
                 found.stack = stack;
             } else if k - tasks.len() < near_chunks {
                 search.near_chunk(near, k - tasks.len(), found);
@@ -997,6 +1063,96 @@ mod tests {
         );
         assert_eq!(sc.vertex_triangle, vt);
         assert_eq!(sc.edge_edge, ee);
+    }
+
+    /// The proof that an unfolded sheet keeps its distances (`unfolded.rs`) changes no look:
+    /// the pairs, sides included, are those of a look without it and of a test of every pair,
+    /// on a sheet waved gently (the proof covers every pair: nothing tested), rolled into a
+    /// spiral whose turns lie 6 mm apart (the proof covers the short distances; the pairs a
+    /// turn apart are found), creased by a radian along a diagonal, and the folded sheet with
+    /// its lone vertex (never proved whole).
+    #[test]
+    fn the_proof_leaves_every_look_as_it_was() {
+        let (cols, rows, h) = (41u32, 11u32, 0.01);
+        let rest: Vec<Vec3> = (0..rows)
+            .flat_map(|j| (0..cols).map(move |i| Vec3::new(f64::from(i) * h, f64::from(j) * h, 0.0)))
+            .collect();
+        let at = |i: u32, j: u32| j * cols + i;
+        let mut triangles = Vec::new();
+        for j in 0..rows - 1 {
+            for i in 0..cols - 1 {
+                triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        let waved: Vec<Vec3> = rest
+            .iter()
+            .map(|p| p + Vec3::new(0.0, 0.0, 0.01 * (p.x * 20.0).sin() + 0.004 * (p.y * 30.0).cos()))
+            .collect();
+        let rolled: Vec<Vec3> = rest
+            .iter()
+            .map(|p| {
+                let (mut angle, mut s) = (0.0_f64, 0.0);
+                let r = |angle: f64| 0.05 + 0.006 * angle / std::f64::consts::TAU;
+                while s < p.x {
+                    let step = 1e-4 / r(angle);
+                    s += r(angle) * step;
+                    angle += step;
+                }
+                Vec3::new(r(angle) * angle.sin(), p.y, r(angle) * angle.cos())
+            })
+            .collect();
+        let creased: Vec<Vec3> = rest
+            .iter()
+            .map(|p| {
+                let off = (p.x - p.y - 0.15) / 2f64.sqrt();
+                if off <= 0.0 {
+                    *p
+                } else {
+                    let across = Vec3::new(1.0, -1.0, 0.0) / 2f64.sqrt();
+                    p - off * across + off * (1f64.cos() * across + 1f64.sin() * Vec3::z())
+                }
+            })
+            .collect();
+        let (thickness, reach) = (0.004, 0.008);
+        let excluded = EXCLUDED * thickness;
+        for (name, x, whole) in [
+            ("waved", &waved, true),
+            ("rolled", &rolled, false),
+            ("creased", &creased, false),
+        ] {
+            let mut proved = SelfCollision::new(&triangles);
+            proved.prepare(&rest, &triangles, thickness).expect("prepared");
+            let below = proved.unfolded.certified_below(x, &triangles, reach, excluded);
+            if name == "rolled" {
+                assert!(
+                    below > 2.0 * excluded && below < 0.3,
+                    "{name}: proved below {below} m"
+                );
+            }
+            proved.look(x, &rest, &triangles, reach, excluded).expect("room");
+            assert_eq!(proved.certified_looks, u64::from(whole), "{name}");
+            let mut full = SelfCollision::new(&triangles);
+            full.full_looks = true;
+            full.look(x, &rest, &triangles, reach, excluded).expect("room");
+            assert_eq!(full.certified_looks, 0);
+            assert_eq!(proved.vertex_triangle, full.vertex_triangle, "{name}");
+            assert_eq!(proved.edge_edge, full.edge_edge, "{name}");
+            let (vt, ee) = every_pair(x, &rest, &triangles, &proved.edges, reach, excluded);
+            assert_eq!(proved.vertex_triangle, vt, "{name}");
+            assert_eq!(proved.edge_edge, ee, "{name}");
+            if name == "rolled" {
+                assert!(vt.len() > 100 && ee.len() > 100, "the turns find each other");
+            }
+        }
+        let (x, rest, triangles) = folded_sheet(12, 9);
+        let mut sc = SelfCollision::new(&triangles);
+        sc.look(&x, &rest, &triangles, reach, excluded).expect("room");
+        let mut full = SelfCollision::new(&triangles);
+        full.full_looks = true;
+        full.look(&x, &rest, &triangles, reach, excluded).expect("room");
+        assert_eq!(sc.vertex_triangle, full.vertex_triangle);
+        assert_eq!(sc.edge_edge, full.edge_edge);
     }
 
     /// The guard's watch leaves out of a step's check only neighbour pairs (edge pairs and

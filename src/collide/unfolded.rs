@@ -1,0 +1,865 @@
+//! A proof that an unfolded sheet keeps its distances: up to which rest distance every pair of
+//! the cloth's points is surely further apart now than self-collision's reach, so that a look
+//! need not test such pairs (`self_collision.rs`).
+//!
+//! **When it applies.** The rest shape must be a flat convex sheet: every vertex on one plane,
+//! every triangle turning the same way in it, each edge shared by at most two triangles (in
+//! opposite directions), every border edge on the border of the vertices' convex hull, and the
+//! triangles' areas adding up to the hull's. Then the triangles cover the hull once, so the
+//! rest segment between any two points of the cloth runs through triangles of the cloth and
+//! the cloth's map from rest to now is continuous along it. (A grid is always such a sheet; a
+//! mesh with a hole, a slit, a notch or a curved rest shape is not, and is looked at in full.)
+//!
+//! **The bound.** In rest-plane coordinates each triangle `T` maps rest vectors to space by its
+//! deformation gradient `F_T` (3 x 2, columns `a_T`, `b_T`). For points `p`, `q` at rest
+//! distance `d` along the unit direction `u`, `x(q) - x(p)` is the integral of `F_T u` along
+//! the rest segment. Take any window of the rest plane that holds the segment, the box of the
+//! `a_T` and the box of the `b_T` of the triangles in it (centres `a_0`, `b_0`, half diagonals
+//! `da`, `db`) and the least singular value `s` of their `F_T`. Then
+//! `|F_T u - F_0 u| <= sqrt(da^2 + db^2) = e` (Cauchy-Schwarz), and by the law of cosines the
+//! component of `F_T u` along `F_0 u` is `(|F_T u|^2 + |F_0 u|^2 - |F_T u - F_0 u|^2) / (2 |F_0 u|)`,
+//! at least `sqrt(|F_T u|^2 - e^2)` (the arithmetic-geometric mean), so
+//!
+//! `|x(q) - x(p)| >= d g`, `g = sqrt(s^2 - e^2)`.
+//!
+//! Bending costs little here: the `b_T` of a sheet bent by an angle `phi` across the window
+//! spread over an arc whose box has a half diagonal of about `phi / 2`, so `g` falls only as
+//! `1 - phi^2 / 8`, where a rigid fit of the window is off by its whole sag.
+//!
+//! **Windows.** The rest plane is cut into square cells no smaller than any triangle's box,
+//! each cell summarising the triangles whose boxes meet it, and the cells are merged two by
+//! two into coarser levels. A segment of rest length `d` meets at most `floor(d / c) + 2` cells
+//! of side `c` along each axis, so it lies in some window of `k x k` cells whenever
+//! `d < (k - 1) c`. For windows of 2 (the finest level only), 3 and 4 cells of each level in
+//! turn, the least `g` over every window bounds every pair in its band of distances: the
+//! pairs from the exclusion radius up (nearer pairs are neighbours, never tested) are certain
+//! as long as each band's nearest distance times its `g` reaches the reach. The first band
+//! that does not stops the proof there; a level whose windows hold the whole sheet proves it
+//! for every distance.
+//!
+//! Nothing is kept from one look to the next but the rest shape's numbers and the working
+//! lists (made when the cloth is set up, so a look allocates nothing).
+
+use crate::math::Vec3;
+
+/// A summary of triangles' deformation gradients: the boxes of their columns `a` (0-2) and
+/// `b` (3-5), lows then highs, and the least squared singular value (12). Stored in f32,
+/// rounded outwards (lows and the singular value down, highs up), so a summary only ever
+/// widens: the bound read from it holds for the f64 numbers.
+type Span = [f32; 13];
+
+const EMPTY: Span = [
+    f32::INFINITY,
+    f32::INFINITY,
+    f32::INFINITY,
+    f32::INFINITY,
+    f32::INFINITY,
+    f32::INFINITY,
+    f32::NEG_INFINITY,
+    f32::NEG_INFINITY,
+    f32::NEG_INFINITY,
+    f32::NEG_INFINITY,
+    f32::NEG_INFINITY,
+    f32::NEG_INFINITY,
+    f32::INFINITY,
+];
+
+#[inline(always)]
+fn merge(into: &mut Span, o: &Span) {
+    for k in 0..6 {
+        into[k] = into[k].min(o[k]);
+        into[6 + k] = into[6 + k].max(o[6 + k]);
+    }
+    into[12] = into[12].min(o[12]);
+}
+
+/// `g^2` of a window (see the module docs), in f64; infinite for a window with no triangle.
+#[inline(always)]
+fn spread_left(s: &Span) -> f64 {
+    if s[12] == f32::INFINITY {
+        return f64::INFINITY;
+    }
+    let e2: f64 = (0..6)
+        .map(|k| {
+            let d = f64::from(s[6 + k]) - f64::from(s[k]);
+            d * d
+        })
+        .sum();
+    f64::from(s[12]) - 0.25 * e2
+}
+
+/// An f32 not above `v` (finite): `v` lowered by more than half an f32 step before the
+/// rounding cast, which moves it by at most that (a relative 2^-24; the 1e-30 covers
+/// numbers near zero).
+#[inline(always)]
+fn down(v: f64) -> f32 {
+    (v - v.abs() * (1.0 / 8_388_608.0) - 1e-30) as f32
+}
+
+/// An f32 not below `v` (finite).
+#[inline(always)]
+fn up(v: f64) -> f32 {
+    (v + v.abs() * (1.0 / 8_388_608.0) + 1e-30) as f32
+}
+
+/// Relative tolerance of the rest shape's flatness, convexity and areas.
+const TOLERANCE: f64 = 1e-9;
+/// The margin a band's bound must clear the reach by (relative, squared distances).
+const MARGIN: f64 = 1e-9;
+
+/// One level's grid of cells: `real` cells a side hold triangles, padded with empty ones to at
+/// least 4 (a window of 4 always fits).
+#[derive(Clone, Debug, Default)]
+struct Level {
+    real: [usize; 2],
+    padded: [usize; 2],
+    cells: Vec<Span>,
+}
+
+impl Level {
+    fn sized(real: [usize; 2]) -> Level {
+        let padded = [real[0].max(4), real[1].max(4)];
+        Level {
+            real,
+            padded,
+            cells: Vec::new(),
+        }
+    }
+}
+
+/// The flat convex rest sheet's numbers, worked out once.
+#[derive(Clone, Debug, Default)]
+struct Sheet {
+    /// Each triangle's inverse rest edge matrix in the rest plane, row-major.
+    inverse: Vec<[f64; 4]>,
+    /// Each triangle's cells at the finest level: first and last column, first and last row.
+    cells: Vec<[u32; 4]>,
+    /// The finest cells' side, m.
+    side: f64,
+    levels: Vec<Level>,
+}
+
+/// The certificate's rest numbers and working lists; `None` inside when the rest shape is not
+/// a flat convex sheet (see the module docs).
+#[derive(Clone, Debug, Default)]
+pub(super) struct Unfolded {
+    sheet: Option<Sheet>,
+    /// Windows of the level being worked on: the last size's and the next's.
+    windows: [Vec<Span>; 2],
+}
+
+impl Unfolded {
+    /// The certificate for rest positions `rest` and `triangles`: none (every look in full)
+    /// when the rest shape is not a flat convex sheet, or when its lists cannot be allocated.
+    pub(super) fn new(rest: &[Vec3], triangles: &[[u32; 3]]) -> Unfolded {
+        let sheet = Sheet::of(rest, triangles);
+        let mut windows = [Vec::new(), Vec::new()];
+        if let Some(s) = &sheet {
+            let most = s.levels.first().map_or(0, |l| l.padded[0] * l.padded[1]);
+            if windows.iter_mut().any(|w| w.try_reserve_exact(most).is_err()) {
+                return Unfolded::default();
+            }
+        }
+        Unfolded { sheet, windows }
+    }
+
+    /// Whether the rest shape qualified.
+    #[cfg(test)]
+    pub(super) fn applies(&self) -> bool {
+        self.sheet.is_some()
+    }
+
+    /// The rest distance below which every pair of points at least `excluded` apart at rest
+    /// is surely at least `reach` apart at positions `x`: `excluded` when nothing is proved,
+    /// infinite when every such pair is.
+    pub(super) fn certified_below(
+        &mut self,
+        x: &[Vec3],
+        triangles: &[[u32; 3]],
+        reach: f64,
+        excluded: f64,
+    ) -> f64 {
+        let Some(sheet) = &mut self.sheet else {
+            return excluded;
+        };
+        if sheet.inverse.len() != triangles.len() || reach.is_nan() || reach <= 0.0 {
+            return excluded;
+        }
+        // The finest cells.
+        let level0 = &mut sheet.levels[0];
+        level0.cells.clear();
+        level0.cells.resize(level0.padded[0] * level0.padded[1], EMPTY);
+        let stride = level0.padded[0];
+        for ((t, m), c) in triangles.iter().zip(&sheet.inverse).zip(&sheet.cells) {
+            let Some(span) = gradient(x, t, m) else {
+                return excluded;
+            };
+            for row in c[2]..=c[3] {
+                for col in c[0]..=c[1] {
+                    merge(&mut level0.cells[row as usize * stride + col as usize], &span);
+                }
+            }
+        }
+        let reach2 = reach * reach * (1.0 + MARGIN);
+        // The whole sheet's summary bounds every window's: from the distance where it proves
+        // a band, it proves every band after.
+        let whole = spread_left(&level0.cells.iter().fold(EMPTY, |mut s, c| {
+            merge(&mut s, c);
+            s
+        }));
+        let all_from = if whole > 0.0 {
+            (reach2 / whole).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        let mut below = excluded;
+        let mut side = sheet.side;
+        for l in 0..sheet.levels.len() {
+            if below >= all_from {
+                return f64::INFINITY;
+            }
+            if l > 0 {
+                let (finer, coarser) = sheet.levels.split_at_mut(l);
+                coarsen(&finer[l - 1], &mut coarser[0]);
+            }
+            let level = &sheet.levels[l];
+            let [w0, w1] = &mut self.windows;
+            // Windows of 2 (the finest level's band only), 3 and 4 cells, each from the last
+            // (2 from the cells).
+            for k in 2..=4usize {
+                let upto = band_end(k, side);
+                let band = !(k == 2 && l > 0) && upto > below;
+                if band && below >= all_from {
+                    return f64::INFINITY;
+                }
+                let (dims, out) = if k == 2 {
+                    windows_of(&level.cells, level.padded, &level.cells, level.padded, 2, w0)
+                } else if k == 3 {
+                    windows_of(&level.cells, level.padded, w0, dims_of(level.padded, 2), 3, w1)
+                } else {
+                    windows_of(&level.cells, level.padded, w1, dims_of(level.padded, 3), 4, w0)
+                };
+                debug_assert_eq!(dims, dims_of(level.padded, k));
+                if !band {
+                    continue;
+                }
+                let g2 = out.iter().map(spread_left).fold(f64::INFINITY, f64::min);
+                if !(g2 > 0.0 && below * below * g2 >= reach2) {
+                    return below;
+                }
+                below = upto;
+            }
+            if level.real[0] <= 4 && level.real[1] <= 4 {
+                // The windows of 4 held the whole sheet.
+                return f64::INFINITY;
+            }
+            side *= 2.0;
+        }
+        below
+    }
+}
+
+/// The rest distance below which every segment lies in some window of `k` cells of side
+/// `side`: a segment of length `d` meets at most `floor(d / side) + 2` cells along an axis.
+fn band_end(k: usize, side: f64) -> f64 {
+    (k - 1) as f64 * side
+}
+
+/// Dimensions of the windows of `k` cells over a grid of `padded` cells.
+fn dims_of(padded: [usize; 2], k: usize) -> [usize; 2] {
+    [padded[0] + 1 - k, padded[1] + 1 - k]
+}
+
+/// The windows of `k` cells of `cells` (a grid of `padded`), from those of `k - 1` (`prev`, of
+/// `prev_dims`: the cells themselves for `k = 2`), into `out`: each is the last size's window
+/// at its corner and the one diagonally next to it, with the two corner cells neither covers.
+fn windows_of<'a>(
+    cells: &[Span],
+    padded: [usize; 2],
+    prev: &[Span],
+    prev_dims: [usize; 2],
+    k: usize,
+    out: &'a mut Vec<Span>,
+) -> ([usize; 2], &'a [Span]) {
+    let dims = dims_of(padded, k);
+    out.clear();
+    for j in 0..dims[1] {
+        for i in 0..dims[0] {
+            let mut s = prev[j * prev_dims[0] + i];
+            merge(&mut s, &prev[(j + 1) * prev_dims[0] + i + 1]);
+            merge(&mut s, &cells[j * padded[0] + i + k - 1]);
+            merge(&mut s, &cells[(j + k - 1) * padded[0] + i]);
+            out.push(s);
+        }
+    }
+    (dims, out)
+}
+
+/// The next level's cells, each the merge of the four below it.
+fn coarsen(finer: &Level, coarser: &mut Level) {
+    coarser.cells.clear();
+    coarser.cells.resize(coarser.padded[0] * coarser.padded[1], EMPTY);
+    for j in 0..coarser.real[1] {
+        for i in 0..coarser.real[0] {
+            let out = &mut coarser.cells[j * coarser.padded[0] + i];
+            for (dj, di) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+                let (fi, fj) = (2 * i + di, 2 * j + dj);
+                if fi < finer.real[0] && fj < finer.real[1] {
+                    merge(out, &finer.cells[fj * finer.padded[0] + fi]);
+                }
+            }
+        }
+    }
+}
+
+/// Triangle `t`'s deformation gradient at `x` as a one-triangle summary; `None` when it is
+/// not finite.
+#[inline]
+fn gradient(x: &[Vec3], t: &[u32; 3], m: &[f64; 4]) -> Option<Span> {
+    let x0 = x.get(t[0] as usize)?;
+    let d1 = x.get(t[1] as usize)? - x0;
+    let d2 = x.get(t[2] as usize)? - x0;
+    let a = d1 * m[0] + d2 * m[2];
+    let b = d1 * m[1] + d2 * m[3];
+    let (aa, bb, ab) = (a.dot(&a), b.dot(&b), a.dot(&b));
+    let s2 = 0.5 * ((aa + bb) - ((aa - bb) * (aa - bb) + 4.0 * ab * ab).sqrt());
+    // Rounding of the root's argument: a relative 1e-12 of the trace taken off.
+    let s2 = s2 - 1e-12 * (aa + bb);
+    let all = [a.x, a.y, a.z, b.x, b.y, b.z, s2];
+    if !all.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let mut span = EMPTY;
+    for k in 0..6 {
+        span[k] = down(all[k]);
+        span[6 + k] = up(all[k]);
+    }
+    span[12] = down(s2);
+    Some(span)
+}
+
+impl Sheet {
+    /// The sheet's numbers, or `None` when the rest shape is not a flat convex sheet or its
+    /// lists cannot be allocated.
+    fn of(rest: &[Vec3], triangles: &[[u32; 3]]) -> Option<Sheet> {
+        if triangles.is_empty() || triangles.iter().flatten().any(|&v| v as usize >= rest.len()) {
+            return None;
+        }
+        // The plane: the triangles' summed area vector (Newell's normal).
+        let corner = |t: &[u32; 3], k: usize| rest[t[k] as usize];
+        let normal: Vec3 = triangles
+            .iter()
+            .map(|t| (corner(t, 1) - corner(t, 0)).cross(&(corner(t, 2) - corner(t, 0))))
+            .sum();
+        let n = normal.try_normalize(0.0)?;
+        let first = corner(&triangles[0], 0);
+        let extent = triangles
+            .iter()
+            .flatten()
+            .map(|&v| (rest[v as usize] - first).norm())
+            .fold(0.0, f64::max);
+        if !(extent > 0.0 && extent.is_finite()) {
+            return None;
+        }
+        let tol = TOLERANCE * extent;
+        if triangles
+            .iter()
+            .flatten()
+            .any(|&v| (rest[v as usize] - first).dot(&n).abs() > tol)
+        {
+            return None;
+        }
+        let e1 = (corner(&triangles[0], 1) - first - n * (corner(&triangles[0], 1) - first).dot(&n))
+            .try_normalize(0.0)?;
+        let e2 = n.cross(&e1);
+        let flat = |v: u32| {
+            let r = rest[v as usize] - first;
+            [r.dot(&e1), r.dot(&e2)]
+        };
+        // Every triangle turning the same way, its inverse edge matrix, its area.
+        let mut inverse = Vec::new();
+        inverse.try_reserve_exact(triangles.len()).ok()?;
+        let mut area = 0.0;
+        for t in triangles {
+            let [p, q, r] = t.map(flat);
+            let (m00, m01, m10, m11) = (q[0] - p[0], r[0] - p[0], q[1] - p[1], r[1] - p[1]);
+            let det = m00 * m11 - m01 * m10;
+            if det.is_nan() || det <= tol * tol {
+                return None;
+            }
+            area += 0.5 * det;
+            inverse.push([m11 / det, -m01 / det, -m10 / det, m00 / det]);
+        }
+        // Each edge in at most two triangles, in opposite directions; the border edges.
+        let mut directed: Vec<(u32, u32, bool)> = Vec::new();
+        directed.try_reserve_exact(3 * triangles.len()).ok()?;
+        for t in triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                directed.push((a.min(b), a.max(b), a < b));
+            }
+        }
+        directed.sort_unstable();
+        let mut border = Vec::new();
+        let mut k = 0;
+        while k < directed.len() {
+            let mut end = k + 1;
+            while end < directed.len() && directed[end].0 == directed[k].0 && directed[end].1 == directed[k].1
+            {
+                end += 1;
+            }
+            match end - k {
+                1 => border.push((directed[k].0, directed[k].1)),
+                2 if directed[k].2 != directed[k + 1].2 => {}
+                _ => return None,
+            }
+            k = end;
+        }
+        // The hull: its area is the triangles', and every border edge lies on its border.
+        let mut used = Vec::new();
+        used.try_reserve_exact(rest.len()).ok()?;
+        used.resize(rest.len(), false);
+        triangles.iter().flatten().for_each(|&v| used[v as usize] = true);
+        let mut points: Vec<[f64; 2]> = Vec::new();
+        points
+            .try_reserve_exact(used.iter().filter(|&&u| u).count())
+            .ok()?;
+        points.extend((0..rest.len() as u32).filter(|&v| used[v as usize]).map(flat));
+        let hull = convex_hull(&mut points);
+        let hull_area = polygon_area(&hull);
+        if hull.len() < 3 || (hull_area - area).abs() > TOLERANCE * hull_area {
+            return None;
+        }
+        let on_border = |p: [f64; 2]| {
+            (0..hull.len()).any(|i| segment_distance(p, hull[i], hull[(i + 1) % hull.len()]) <= tol)
+        };
+        for &(a, b) in &border {
+            let (p, q) = (flat(a), flat(b));
+            let mid = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
+            if !(on_border(p) && on_border(q) && on_border(mid)) {
+                return None;
+            }
+        }
+        // Cells no smaller than any triangle's box, over the hull's box.
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let mut side: f64 = 0.0;
+        for t in triangles {
+            let c = t.map(flat);
+            for axis in 0..2 {
+                let (a, b) = (
+                    c.iter().map(|p| p[axis]).fold(f64::INFINITY, f64::min),
+                    c.iter().map(|p| p[axis]).fold(f64::NEG_INFINITY, f64::max),
+                );
+                side = side.max(b - a);
+                lo[axis] = lo[axis].min(a);
+                hi[axis] = hi[axis].max(b);
+            }
+        }
+        let side = side * (1.0 + 1e-6);
+        let real = [0, 1].map(|axis| ((hi[axis] - lo[axis]) / side).floor() as usize + 1);
+        // A sheet whose box is mostly empty (a thin diagonal strip) is not worth the cells.
+        if real[0].saturating_mul(real[1]) > 2 * triangles.len() + 64 {
+            return None;
+        }
+        let cell_of = |u: f64, axis: usize| {
+            let f = (u - lo[axis]) / side;
+            f.floor().clamp(0.0, (real[axis] - 1) as f64) as u32
+        };
+        let mut cells = Vec::new();
+        cells.try_reserve_exact(triangles.len()).ok()?;
+        let pad = 1e-7 * side;
+        for t in triangles {
+            let c = t.map(flat);
+            let range = |axis: usize| {
+                let a = c.iter().map(|p| p[axis]).fold(f64::INFINITY, f64::min);
+                let b = c.iter().map(|p| p[axis]).fold(f64::NEG_INFINITY, f64::max);
+                (cell_of(a - pad, axis), cell_of(b + pad, axis))
+            };
+            let ((c0, c1), (r0, r1)) = (range(0), range(1));
+            cells.push([c0, c1, r0, r1]);
+        }
+        // The levels, each half the last a side, down to one whose windows of 4 hold it all.
+        let mut levels = vec![Level::sized(real)];
+        while levels.last().is_some_and(|l| l.real[0] > 4 || l.real[1] > 4) {
+            let r = levels.last().map_or([1, 1], |l| l.real);
+            levels.push(Level::sized([r[0].div_ceil(2), r[1].div_ceil(2)]));
+        }
+        for l in &mut levels {
+            l.cells.try_reserve_exact(l.padded[0] * l.padded[1]).ok()?;
+        }
+        Some(Sheet {
+            inverse,
+            cells,
+            side,
+            levels,
+        })
+    }
+}
+
+/// The convex hull of `points` (reordered), counter-clockwise, without points on its edges
+/// (Andrew's monotone chain).
+fn convex_hull(points: &mut [[f64; 2]]) -> Vec<[f64; 2]> {
+    points.sort_unstable_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    let cross =
+        |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    let chain = |ordered: &mut dyn Iterator<Item = &[f64; 2]>| {
+        let mut out: Vec<[f64; 2]> = Vec::new();
+        for &p in ordered {
+            while out.len() >= 2 && cross(out[out.len() - 2], out[out.len() - 1], p) <= 0.0 {
+                out.pop();
+            }
+            out.push(p);
+        }
+        // Its last point is the other chain's first.
+        out.pop();
+        out
+    };
+    let mut hull = chain(&mut points.iter());
+    hull.extend(chain(&mut points.iter().rev()));
+    hull
+}
+
+/// The area of a counter-clockwise polygon.
+fn polygon_area(p: &[[f64; 2]]) -> f64 {
+    0.5 * (0..p.len())
+        .map(|i| {
+            let (a, b) = (p[i], p[(i + 1) % p.len()]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum::<f64>()
+}
+
+/// The distance from `p` to the segment from `a` to `b`.
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = dx * dx + dy * dy;
+    let s = if len2 > 0.0 {
+        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    ((p[0] - a[0] - s * dx).powi(2) + (p[1] - a[1] - s * dy).powi(2)).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collide::geometry::closest_on_triangle;
+
+    /// A `cols` x `rows` grid of `h` spacing in the xy plane: (rest positions, triangles).
+    pub(crate) fn grid(cols: u32, rows: u32, h: f64) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let rest = (0..rows)
+            .flat_map(|j| (0..cols).map(move |i| Vec3::new(f64::from(i) * h, f64::from(j) * h, 0.0)))
+            .collect();
+        let at = |i: u32, j: u32| j * cols + i;
+        let mut triangles = Vec::new();
+        for j in 0..rows - 1 {
+            for i in 0..cols - 1 {
+                triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        (rest, triangles)
+    }
+
+    /// A point of triangle `t` at weights `w`.
+    fn point(x: &[Vec3], t: &[u32; 3], w: [f64; 3]) -> Vec3 {
+        w[0] * x[t[0] as usize] + w[1] * x[t[1] as usize] + w[2] * x[t[2] as usize]
+    }
+
+    #[test]
+    fn a_grid_qualifies_and_a_holed_notched_slit_or_curved_sheet_does_not() {
+        let (rest, triangles) = grid(9, 7, 0.01);
+        assert!(Unfolded::new(&rest, &triangles).applies());
+        // Turned the other way, and moved off the origin and tilted: still a flat convex sheet.
+        let flipped: Vec<[u32; 3]> = triangles.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        assert!(Unfolded::new(&rest, &flipped).applies());
+        let tilted: Vec<Vec3> = rest
+            .iter()
+            .map(|p| Vec3::new(p.x, 0.6 * p.y, 0.8 * p.y + 1.0))
+            .collect();
+        assert!(Unfolded::new(&tilted, &triangles).applies());
+        // A hole: the two triangles of one inner quad left out.
+        let holed: Vec<[u32; 3]> = triangles
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| *k / 2 != 3 * 8 + 4)
+            .map(|(_, t)| *t)
+            .collect();
+        assert!(!Unfolded::new(&rest, &holed).applies());
+        // A notch: a corner quad left out (the border no longer on the hull).
+        assert!(!Unfolded::new(&rest, &triangles[2..]).applies());
+        // A slit: the lower half's top row of vertices duplicated, so the two halves meet
+        // along a seam without sharing vertices.
+        let mut slit_rest = rest.clone();
+        let copies: Vec<u32> = (0..9)
+            .map(|i| {
+                slit_rest.push(rest[(3 * 9 + i) as usize]);
+                (slit_rest.len() - 1) as u32
+            })
+            .collect();
+        let slit: Vec<[u32; 3]> = triangles
+            .iter()
+            .map(|t| {
+                if t.iter().all(|&v| v / 9 <= 3) {
+                    t.map(|v| if v / 9 == 3 { copies[(v % 9) as usize] } else { v })
+                } else {
+                    *t
+                }
+            })
+            .collect();
+        assert!(!Unfolded::new(&slit_rest, &slit).applies());
+        // Curved at rest.
+        let curved: Vec<Vec3> = rest
+            .iter()
+            .map(|p| Vec3::new(p.x, p.y, 2.0 * p.x * p.x))
+            .collect();
+        assert!(!Unfolded::new(&curved, &triangles).applies());
+        // A triangle turned over.
+        let mut over = triangles.clone();
+        over[10] = [over[10][0], over[10][2], over[10][1]];
+        assert!(!Unfolded::new(&rest, &over).applies());
+    }
+
+    /// The bands' ends: every segment shorter than `band_end(k, side)`, anywhere and in any
+    /// direction, meets at most `k` cells along each axis (cells counted as the triangles'
+    /// cells are, by the floor of the coordinate over the side).
+    #[test]
+    fn a_window_of_k_cells_holds_every_segment_shorter_than_its_band() {
+        let mut r = crate::testing::numbers(3);
+        let side = 0.0123;
+        let cell = |u: f64| (u / side).floor() as i64;
+        for k in 2..=4 {
+            let end = band_end(k, side);
+            for n in 0..200_000 {
+                // Lengths up to the end, many of them at it (the worst case), and starts on
+                // cell borders now and then.
+                let d = if n % 3 == 0 {
+                    end * (1.0 - 1e-12)
+                } else {
+                    end * (r() + 0.5)
+                };
+                let a = r() * std::f64::consts::TAU;
+                let p = if n % 7 == 0 {
+                    [side * (r() * 100.0).round(), side * (r() * 100.0).round()]
+                } else {
+                    [r() * 1.0, r() * 1.0]
+                };
+                let q = [p[0] + d * a.cos(), p[1] + d * a.sin()];
+                for axis in 0..2 {
+                    let spanned = (cell(p[axis]) - cell(q[axis])).unsigned_abs() + 1;
+                    assert!(
+                        spanned <= k as u64,
+                        "a segment of {d} m meets {spanned} cells of {side} m"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Known answers: a sheet moved rigidly keeps every distance (proved at every distance); a
+    /// sheet shrunk to 0.85 of its size brings points 2.2 thicknesses apart at rest to 1.87,
+    /// inside the reach of 2, so nothing is proved; at 0.95 (2.09) everything is.
+    #[test]
+    fn a_sheet_moved_rigidly_is_proved_everywhere_and_one_shrunk_past_the_reach_nowhere() {
+        let (rest, triangles) = grid(31, 21, 0.01);
+        let (t, e) = (0.004, 0.0088);
+        let mut u = Unfolded::new(&rest, &triangles);
+        let turn = nalgebra::Rotation3::from_euler_angles(0.3, -1.1, 2.0);
+        let moved: Vec<Vec3> = rest
+            .iter()
+            .map(|p| turn * p + Vec3::new(1.0, -2.0, 0.5))
+            .collect();
+        assert_eq!(u.certified_below(&moved, &triangles, 2.0 * t, e), f64::INFINITY);
+        let shrunk: Vec<Vec3> = moved.iter().map(|p| 0.85 * p).collect();
+        assert_eq!(u.certified_below(&shrunk, &triangles, 2.0 * t, e), e);
+        let shrunk: Vec<Vec3> = moved.iter().map(|p| 0.95 * p).collect();
+        assert_eq!(u.certified_below(&shrunk, &triangles, 2.0 * t, e), f64::INFINITY);
+        // A position that is not a number proves nothing.
+        let mut bad = moved.clone();
+        bad[40].y = f64::NAN;
+        assert_eq!(u.certified_below(&bad, &triangles, 2.0 * t, e), e);
+    }
+
+    /// A sheet 40 cm long rolled into a spiral (radius 5 cm growing 6 mm a turn): points a
+    /// turn apart along the sheet (about 31 cm at rest) lie 6 mm apart, inside a reach of
+    /// 8 mm, so the proof must stop before that distance, yet its bending (0.4 radians over
+    /// 2 cm) leaves the short distances proved; a roll of 2 cm (a radian over 2 cm) proves
+    /// nothing; a gentle bend (radius 30 cm) is proved everywhere.
+    #[test]
+    fn a_rolled_sheet_is_proved_only_below_one_turn() {
+        let (rest, triangles) = grid(41, 11, 0.01);
+        let (t, e) = (0.004, 0.0088);
+        let mut u = Unfolded::new(&rest, &triangles);
+        let roll = |radius: f64, pitch: f64| -> Vec<Vec3> {
+            rest.iter()
+                .map(|p| {
+                    // Arc length p.x along a spiral r = radius + pitch * angle / (2 pi).
+                    let (mut angle, mut s) = (0.0_f64, 0.0);
+                    while s < p.x {
+                        let r = radius + pitch * angle / std::f64::consts::TAU;
+                        let step = 1e-4 / r;
+                        angle += step;
+                        s += r * step;
+                    }
+                    let r = radius + pitch * angle / std::f64::consts::TAU;
+                    Vec3::new(r * angle.sin(), p.y, r * angle.cos())
+                })
+                .collect()
+        };
+        let rolled = roll(0.05, 0.006);
+        let below = u.certified_below(&rolled, &triangles, 2.0 * t, e);
+        let turn = std::f64::consts::TAU * 0.05;
+        assert!(
+            below <= turn,
+            "proved up to {below} m in a roll whose turn is {turn} m"
+        );
+        assert!(below > 2.0 * e, "proved only up to {below} m");
+        let tight = roll(0.02, 0.006);
+        assert_eq!(u.certified_below(&tight, &triangles, 2.0 * t, e), e);
+        let gentle = roll(0.3, 0.0);
+        assert_eq!(u.certified_below(&gentle, &triangles, 2.0 * t, e), f64::INFINITY);
+    }
+
+    /// The bound itself: on sheets waved, bent and crumpled at random, every pair of points
+    /// the proof covers (at least the exclusion apart at rest, nearer than what it proves) is
+    /// at least the reach apart. Random points of random triangles, and the closest point of
+    /// a triangle to each vertex, are tried; some deformations bring covered-looking pairs
+    /// within the reach (so the proof has something to refuse), and some are proved whole.
+    #[test]
+    fn every_pair_the_proof_covers_is_out_of_reach() {
+        let (rest, triangles) = grid(25, 17, 0.01);
+        let (t, e) = (0.004, 0.0088);
+        let reach = 2.0 * t;
+        let mut u = Unfolded::new(&rest, &triangles);
+        let mut r = crate::testing::numbers(5);
+        let (mut whole, mut partial, mut refused) = (0, 0, 0);
+        for case in 0..90 {
+            // Waves of random wavelength, direction and height across the sheet, a rotation,
+            // and noise at the vertices.
+            let waves: Vec<(f64, f64, f64, f64, f64)> = (0..3)
+                .map(|_| {
+                    let k = std::f64::consts::TAU / (0.02 + 0.3 * (r() + 0.5));
+                    (
+                        k,
+                        r() * 6.0,
+                        r() * 6.0,
+                        0.02 * (case as f64 / 90.0) * (r() + 0.5),
+                        r(),
+                    )
+                })
+                .collect();
+            let noise = if case % 5 == 4 { 0.003 } else { 0.0 };
+            // Every other sheet folded over across x: flat to `x0`, round a half cylinder of
+            // radius `radius`, and back above itself.
+            let (x0, radius) = (0.05 + 0.1 * (r() + 0.5), 0.002 + 0.06 * (r() + 0.5));
+            // Every fourth a crease: the vertices past a line turned about it by up to 1.4
+            // radians (where the bound is tight: a segment across the crease is shortened by
+            // the cosine of half the angle, which is the bound's g).
+            // The crease runs along the grid's lines or diagonals, so no triangle straddles it.
+            let crease = [std::f64::consts::FRAC_PI_2, 0.0, std::f64::consts::FRAC_PI_4][(case / 4) % 3];
+            let turn = 0.2 + 1.2 * (r() + 0.5);
+            let fold = |p: &Vec3| -> Vec3 {
+                if case % 4 == 1 {
+                    let (dir, c) = (
+                        Vec3::new(crease.cos(), crease.sin(), 0.0),
+                        Vec3::new(0.12, 0.08, 0.0),
+                    );
+                    let across = Vec3::new(-dir.y, dir.x, 0.0);
+                    let off = (p - c).dot(&across);
+                    if off <= 0.0 {
+                        return *p;
+                    }
+                    let along = (p - c).dot(&dir);
+                    return c + along * dir + off * (turn.cos() * across + turn.sin() * Vec3::z());
+                }
+                if case % 2 != 0 || p.x <= x0 {
+                    return *p;
+                }
+                let s = p.x - x0;
+                let angle = s / radius;
+                if angle <= std::f64::consts::PI {
+                    Vec3::new(x0 + radius * angle.sin(), p.y, radius * (1.0 - angle.cos()))
+                } else {
+                    Vec3::new(x0 - (s - std::f64::consts::PI * radius), p.y, 2.0 * radius)
+                }
+            };
+            let x: Vec<Vec3> = rest
+                .iter()
+                .map(|p| {
+                    let z: f64 = waves
+                        .iter()
+                        .map(|&(k, dir, phase, amp, _)| {
+                            amp * (k * (p.x * dir.cos() + p.y * dir.sin()) + phase).sin()
+                        })
+                        .sum();
+                    let z = if case % 4 != 3 { 0.1 * z } else { z };
+                    fold(p) + Vec3::new(0.0, 0.0, z) + noise * Vec3::new(r(), r(), r())
+                })
+                .collect();
+            let below = u.certified_below(&x, &triangles, reach, e);
+            if below == f64::INFINITY {
+                whole += 1;
+            } else if below > e {
+                partial += 1;
+            }
+            let covered = |d: f64| d >= e && d < below;
+            // Vertices against the closest point of every triangle; random point pairs.
+            for (p, rp) in rest.iter().enumerate() {
+                for tri in &triangles {
+                    let [a, b, c] = tri.map(|i| rest[i as usize]);
+                    let w = closest_on_triangle(rp, &a, &b, &c);
+                    let d_rest = (rp - point(&rest, tri, w)).norm();
+                    let d_now = (x[p] - point(&x, tri, w)).norm();
+                    if covered(d_rest) {
+                        assert!(
+                            d_now >= reach,
+                            "case {case}: {d_now} m now, {d_rest} m at rest, proved below {below}"
+                        );
+                    } else if d_rest >= e && d_now < reach {
+                        refused += 1;
+                    }
+                }
+            }
+            // Point pairs a few exclusions apart, in every direction.
+            let (w, h) = (0.24, 0.16);
+            let at = |p: [f64; 2]| -> Option<([u32; 3], [f64; 3])> {
+                if !(0.0..w).contains(&p[0]) || !(0.0..h).contains(&p[1]) {
+                    return None;
+                }
+                let (i, j) = ((p[0] / 0.01) as u32, (p[1] / 0.01) as u32);
+                let (fx, fy) = (p[0] / 0.01 - f64::from(i), p[1] / 0.01 - f64::from(j));
+                let k = 2 * (j * 24 + i) as usize;
+                // The quad's triangles: (i, j), (i+1, j), (i+1, j+1) below its diagonal,
+                // (i, j), (i+1, j+1), (i, j+1) above.
+                Some(if fx >= fy {
+                    (triangles[k], [1.0 - fx, fx - fy, fy])
+                } else {
+                    (triangles[k + 1], [1.0 - fy, fx, fy - fx])
+                })
+            };
+            for _ in 0..50_000 {
+                let p = [(r() + 0.5) * w, (r() + 0.5) * h];
+                let (d, angle) = (e * (1.0 + 2.0 * (r() + 0.5)), r() * std::f64::consts::TAU);
+                let q = [p[0] + d * angle.cos(), p[1] + d * angle.sin()];
+                let (Some((t1, w1)), Some((t2, w2))) = (at(p), at(q)) else {
+                    continue;
+                };
+                let d_rest = (point(&rest, &t1, w1) - point(&rest, &t2, w2)).norm();
+                assert!((d_rest - d).abs() < 1e-12, "the points are where they were put");
+                if covered(d_rest) {
+                    let d_now = (point(&x, &t1, w1) - point(&x, &t2, w2)).norm();
+                    assert!(
+                        d_now >= reach,
+                        "case {case}: {d_now} m now, {d_rest} m at rest, proved below {below}"
+                    );
+                }
+            }
+        }
+        assert!(
+            whole > 5 && partial > 5,
+            "proved whole {whole} times, in part {partial}"
+        );
+        assert!(refused > 0, "some pairs came within reach");
+    }
+}
