@@ -1069,8 +1069,9 @@ mod tests {
     /// the pairs, sides included, are those of a look without it and of a test of every pair,
     /// on a sheet waved gently (the proof covers every pair: nothing tested), rolled into a
     /// spiral whose turns lie 6 mm apart (the proof covers the short distances; the pairs a
-    /// turn apart are found), creased by a radian along a diagonal, and the folded sheet with
-    /// its lone vertex (never proved whole).
+    /// turn apart are found), creased by a radian along a diagonal, folded back over itself
+    /// round 3 mm (nothing proved), and the folded sheet with its lone vertex (never proved
+    /// whole).
     #[test]
     fn the_proof_leaves_every_look_as_it_was() {
         let (cols, rows, h) = (41u32, 11u32, 0.01);
@@ -1114,12 +1115,29 @@ mod tests {
                 }
             })
             .collect();
+        // Folded back over itself round a radius of 3 mm, the halves 6 mm apart.
+        let folded: Vec<Vec3> = rest
+            .iter()
+            .map(|p| {
+                let (x0, radius) = (0.2, 0.003);
+                let s = p.x - x0;
+                if s <= 0.0 {
+                    *p
+                } else if s <= std::f64::consts::PI * radius {
+                    let a = s / radius;
+                    Vec3::new(x0 + radius * a.sin(), p.y, radius * (1.0 - a.cos()))
+                } else {
+                    Vec3::new(x0 - (s - std::f64::consts::PI * radius), p.y, 2.0 * radius)
+                }
+            })
+            .collect();
         let (thickness, reach) = (0.004, 0.008);
         let excluded = EXCLUDED * thickness;
         for (name, x, whole) in [
             ("waved", &waved, true),
             ("rolled", &rolled, false),
             ("creased", &creased, false),
+            ("folded", &folded, false),
         ] {
             let mut proved = SelfCollision::new(&triangles);
             proved.prepare(&rest, &triangles, thickness).expect("prepared");
@@ -1141,8 +1159,11 @@ mod tests {
             let (vt, ee) = every_pair(x, &rest, &triangles, &proved.edges, reach, excluded);
             assert_eq!(proved.vertex_triangle, vt, "{name}");
             assert_eq!(proved.edge_edge, ee, "{name}");
-            if name == "rolled" {
-                assert!(vt.len() > 100 && ee.len() > 100, "the turns find each other");
+            if name == "rolled" || name == "folded" {
+                assert!(
+                    vt.len() > 100 && ee.len() > 100,
+                    "{name}: the layers find each other"
+                );
             }
         }
         let (x, rest, triangles) = folded_sheet(12, 9);

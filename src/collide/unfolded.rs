@@ -753,12 +753,12 @@ mod tests {
             // Every other sheet folded over across x: flat to `x0`, round a half cylinder of
             // radius `radius`, and back above itself.
             let (x0, radius) = (0.05 + 0.1 * (r() + 0.5), 0.002 + 0.06 * (r() + 0.5));
-            // Every fourth a crease: the vertices past a line turned about it by up to 1.4
+            // Every fourth a crease: the vertices past a line turned about it by up to 2
             // radians (where the bound is tight: a segment across the crease is shortened by
             // the cosine of half the angle, which is the bound's g).
             // The crease runs along the grid's lines or diagonals, so no triangle straddles it.
             let crease = [std::f64::consts::FRAC_PI_2, 0.0, std::f64::consts::FRAC_PI_4][(case / 4) % 3];
-            let turn = 0.2 + 1.2 * (r() + 0.5);
+            let turn = 0.2 + 1.8 * (r() + 0.5);
             let fold = |p: &Vec3| -> Vec3 {
                 if case % 4 == 1 {
                     let (dir, c) = (
