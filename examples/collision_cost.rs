@@ -5,7 +5,7 @@
 //! baseline, best of `rounds`, so both see the same machine. Prints seconds of bake per
 //! simulated second, the ratio, substeps a frame, self-collision looks a frame (and how many of
 //! them the proof of `collide/unfolded.rs` settled whole, testing no pair) and the most
-//! crossing triangle pairs at any frame.
+//! crossing triangle pairs at any sampled frame, without and with.
 //!
 //! `cargo run --release --example collision_cost -- [rounds] [case]` (default 3 rounds, every
 //! case; `case` 0-4 runs one)
@@ -74,8 +74,16 @@ fn bake(c: Case) -> (f64, f64, f64, usize, usize, f64) {
 fn main() {
     let rounds: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(3);
     println!(
-        "{:<34} {:>9} {:>9} {:>6} {:>13} {:>7} {:>7} {:>9} {:>9}",
-        "case", "base s/s", "with s/s", "ratio", "substeps b/w", "looks", "proved", "crossing", "contacts"
+        "{:<34} {:>9} {:>9} {:>6} {:>13} {:>7} {:>7} {:>12} {:>9}",
+        "case",
+        "base s/s",
+        "with s/s",
+        "ratio",
+        "substeps b/w",
+        "looks",
+        "proved",
+        "crossing b/w",
+        "contacts"
     );
     let towel = |frequency, amplitude| Case {
         width: 61,
@@ -115,25 +123,26 @@ fn main() {
         };
         let (mut b, mut w) = (f64::INFINITY, f64::INFINITY);
         let mut stats = (0.0, 0.0, 0, 0, 0.0);
-        let mut base_substeps = 0.0;
+        let (mut base_substeps, mut base_crossing) = (0.0, 0);
         for _ in 0..rounds {
             let r = bake(base);
             b = b.min(r.0);
             base_substeps = r.1;
+            base_crossing = r.3;
             let r = bake(with);
             w = w.min(r.0);
             stats = (r.1, r.2, r.3, r.4, r.5);
         }
         let s = base.seconds;
         println!(
-            "{name:<34} {:>9.3} {:>9.3} {:>6.2} {:>13} {:>7.2} {:>7.2} {:>9} {:>9}",
+            "{name:<34} {:>9.3} {:>9.3} {:>6.2} {:>13} {:>7.2} {:>7.2} {:>12} {:>9}",
             b / s,
             w / s,
             w / b,
             format!("{base_substeps:.1}/{:.1}", stats.0),
             stats.1,
             stats.4,
-            stats.2,
+            format!("{base_crossing}/{}", stats.2),
             stats.3
         );
     }

@@ -111,6 +111,9 @@ pub struct SelfCollision {
     unfolded: Unfolded,
     /// Looks without it (tests compare looks with and without).
     pub(crate) full_looks: bool,
+    /// Looks to make without trying the proof, and how many it was last put off for.
+    proof_wait: u32,
+    proof_backoff: u32,
     /// The triangles' plain rest boxes gathered by the tree's nodes; empty when the tree or
     /// the rest shape is new.
     rest_nodes: Vec<Aabb>,
@@ -205,6 +208,9 @@ fn side(v: f64) -> i8 {
         1
     }
 }
+
+/// The most looks a failed proof is put off for ([`SelfCollision::look`]).
+const PROOF_BACKOFF: u32 = 16;
 
 /// How many listed near pairs a task tests.
 const NEAR_CHUNK: usize = 4096;
@@ -663,12 +669,26 @@ impl SelfCollision {
                 return Ok(());
             }
         }
-        // Pairs nearer than this at rest are surely out of reach (`unfolded.rs`).
+        // Pairs nearer than this at rest are surely out of reach (`unfolded.rs`). A proof that
+        // proved nothing is not tried again for the next looks, twice as many each time it
+        // fails in a row up to `PROOF_BACKOFF` (a cloth bent at every look pays for it once in
+        // that many), and at once after one that did.
         let below = if self.full_looks {
             excluded_within
+        } else if self.proof_wait > 0 {
+            self.proof_wait -= 1;
+            excluded_within
         } else {
-            self.unfolded
-                .certified_below(x, triangles, reach, excluded_within)
+            let below = self
+                .unfolded
+                .certified_below(x, triangles, reach, excluded_within);
+            if below > excluded_within {
+                self.proof_backoff = 0;
+            } else {
+                self.proof_backoff = (2 * self.proof_backoff).clamp(1, PROOF_BACKOFF);
+                self.proof_wait = self.proof_backoff;
+            }
+            below
         };
         if below == f64::INFINITY && self.owners.orphans().is_empty() {
             // Every pair: nothing in reach, nothing to remember.
