@@ -11,6 +11,23 @@ pub(crate) fn numbers(mut seed: u64) -> impl FnMut() -> f64 {
     }
 }
 
+/// A `cols` x `rows` grid of `h` spacing in the xy plane, each quad cut along the diagonal
+/// from its first corner: (rest positions, triangles).
+pub(crate) fn flat_grid(cols: u32, rows: u32, h: f64) -> (Vec<crate::math::Vec3>, Vec<[u32; 3]>) {
+    let rest = (0..rows)
+        .flat_map(|j| (0..cols).map(move |i| crate::math::Vec3::new(f64::from(i) * h, f64::from(j) * h, 0.0)))
+        .collect();
+    let at = |i: u32, j: u32| j * cols + i;
+    let mut triangles = Vec::new();
+    for j in 0..rows - 1 {
+        for i in 0..cols - 1 {
+            triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    (rest, triangles)
+}
+
 /// A `width x height` grid of 0.1 m spacing (0.2 kg) with every vertex moved up to 1.5 cm
 /// (seeded by `seed`) and random velocities: a crumpled, moving patch.
 pub(crate) fn crumpled_grid(

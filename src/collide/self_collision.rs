@@ -1094,18 +1094,7 @@ mod tests {
     /// whole).
     #[test]
     fn the_proof_leaves_every_look_as_it_was() {
-        let (cols, rows, h) = (41u32, 11u32, 0.01);
-        let rest: Vec<Vec3> = (0..rows)
-            .flat_map(|j| (0..cols).map(move |i| Vec3::new(f64::from(i) * h, f64::from(j) * h, 0.0)))
-            .collect();
-        let at = |i: u32, j: u32| j * cols + i;
-        let mut triangles = Vec::new();
-        for j in 0..rows - 1 {
-            for i in 0..cols - 1 {
-                triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-            }
-        }
+        let (rest, triangles) = crate::testing::flat_grid(41, 11, 0.01);
         let waved: Vec<Vec3> = rest
             .iter()
             .map(|p| p + Vec3::new(0.0, 0.0, 0.01 * (p.x * 20.0).sin() + 0.004 * (p.y * 30.0).cos()))

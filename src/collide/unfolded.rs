@@ -545,22 +545,7 @@ fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 mod tests {
     use super::*;
     use crate::collide::geometry::closest_on_triangle;
-
-    /// A `cols` x `rows` grid of `h` spacing in the xy plane: (rest positions, triangles).
-    pub(crate) fn grid(cols: u32, rows: u32, h: f64) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-        let rest = (0..rows)
-            .flat_map(|j| (0..cols).map(move |i| Vec3::new(f64::from(i) * h, f64::from(j) * h, 0.0)))
-            .collect();
-        let at = |i: u32, j: u32| j * cols + i;
-        let mut triangles = Vec::new();
-        for j in 0..rows - 1 {
-            for i in 0..cols - 1 {
-                triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-            }
-        }
-        (rest, triangles)
-    }
+    use crate::testing::flat_grid as grid;
 
     /// A point of triangle `t` at weights `w`.
     fn point(x: &[Vec3], t: &[u32; 3], w: [f64; 3]) -> Vec3 {
