@@ -33,7 +33,10 @@
 //! **Search.** Each call the swept boxes of the mesh's triangles and vertices (start to target)
 //! are refitted into three [`Bvh`]s (with its edges). Each cloth vertex keeps the candidates
 //! found within `margin + skin` of where it was when it last looked, and looks again once it has
-//! moved more than `skin / 2` (a Verlet list); its triangles and edges look again with it. Most
+//! moved more than its slack (a Verlet list); its triangles and edges look again with it. The
+//! slack is `skin / 2`, and half as much again as the gap its lookups left to what they did
+//! not find: far from the mesh, where nearly every lookup finds nothing, a vertex looks again
+//! only when it may have come near (`refresh_candidates` says why the lists stay whole). Most
 //! substeps test only a few exact distances, and visit only the vertices, triangles and edges
 //! that have candidates.
 
@@ -103,6 +106,19 @@ pub struct MeshPassage {
 struct Candidates {
     vertex: Vec<Vec<u32>>,
     vertex_at: Vec<Vec3>,
+    /// How far each cloth vertex may move from `vertex_at` before it looks again: half the
+    /// skin, and half the gap its own and its triangles' and edges' last lookups left to what
+    /// they did not find (`Bvh::overlapping_apart`), see `refresh_candidates`.
+    vertex_slack: Vec<f64>,
+    /// The gaps of the last lookups of each cloth vertex, triangle and edge.
+    vertex_gap: Vec<f64>,
+    triangle_gap: Vec<f64>,
+    edge_gap: Vec<f64>,
+    /// The vertices that looked at this refresh (set while it runs), and those still to look.
+    looked_now: Vec<bool>,
+    pending: Vec<u32>,
+    /// The vertices whose slack a round of lookups changed.
+    affected: Vec<u32>,
     triangle: Vec<Vec<u32>>,
     /// The cloth's edges (each once) and each one's candidate mesh edges.
     cloth_edges: Vec<[u32; 2]>,
@@ -159,9 +175,20 @@ impl Candidates {
             &mut self.dirty_edges,
             &mut self.nearest,
             &mut self.touched,
+            &mut self.pending,
+            &mut self.affected,
         ] {
             list.clear();
         }
+        for list in [
+            &mut self.vertex_slack,
+            &mut self.vertex_gap,
+            &mut self.triangle_gap,
+            &mut self.edge_gap,
+        ] {
+            list.clear();
+        }
+        self.looked_now.clear();
         self.touching.clear();
         self.inside.clear();
         self.distance.clear();
@@ -186,15 +213,19 @@ pub(crate) fn candidate_room(vertices: usize) -> usize {
         .saturating_add(CANDIDATES_FLOOR)
 }
 
-/// Refills `list` with what `query` finds (it calls its argument once a feature) within
-/// `room`; false when the room refused.
-fn refill(list: &mut Vec<u32>, room: &mut Room, query: impl FnOnce(&mut dyn FnMut(u32))) -> bool {
+/// Refills `list` with what `query` finds (it calls its argument once a feature, and returns
+/// the gap to what it did not find) within `room`: the gap, or `None` when the room refused.
+fn refill(
+    list: &mut Vec<u32>,
+    room: &mut Room,
+    query: impl FnOnce(&mut dyn FnMut(u32)) -> f64,
+) -> Option<f64> {
     room.give_back(list.len());
     list.clear();
-    query(&mut |t| {
+    let gap = query(&mut |t| {
         room.push(list, t);
     });
-    room.full.is_none()
+    room.full.is_none().then_some(gap)
 }
 
 /// Updates `with` (ascending indices of non-empty `lists`) after the lists of `changed` were
@@ -870,12 +901,30 @@ impl MeshCollider {
         }
     }
 
-    /// Looks up again the candidates of every cloth vertex that moved more than `skin / 2`
+    /// Looks up again the candidates of every cloth vertex that moved more than its slack
     /// since it last looked, and of its triangles and edges (all of them after the mesh moved).
-    /// A triangle's (edge's) vertices have then moved at most `skin` since it looked (each
-    /// at most `skin / 2` since its own look, which was no later), which its query's `skin` and
-    /// the mesh's boxes' `reach` cover. Refused past the lists' room ([`CANDIDATES_PER_VERTEX`]);
-    /// the caller then marks every list to be looked up again.
+    /// Refused past the lists' room ([`CANDIDATES_PER_VERTEX`]); the caller then marks every
+    /// list to be looked up again.
+    ///
+    /// **Why the lists stay whole.** Each lookup also returns its gap `G`: how far its query
+    /// box is from every box it did not find, along the axis they are furthest apart on. A
+    /// vertex's slack is `skin / 2 + min(G) / 2` over its own lookup and its triangles' and
+    /// edges' (the rule before gaps, `skin / 2`, when every `G` is 0), recomputed whenever one
+    /// of them looks. Then:
+    /// - *the vertex's own list*: it has moved at most its slack, under `skin + G_v`, since
+    ///   its query box (`margin + skin` around it) missed every other triangle's box by `G_v`;
+    ///   so no triangle it did not find comes within `margin` of it;
+    /// - *a triangle's (an edge's) list*: each of its vertices has moved at most twice its
+    ///   slack, `skin + G_t`, since the triangle looked (it was within its slack of where it
+    ///   last looked both then and now, and its slack held `G_t` from then on; a vertex past
+    ///   the new slack when the triangle looks, looks with it). The query took the triangle's
+    ///   box grown by `skin` against the mesh vertices' boxes grown by `margin + skin`, so a
+    ///   mesh vertex it did not find is `2 skin + margin + G_t` from where the box was, and
+    ///   the box has moved at most `skin + G_t`: still past `margin`.
+    ///
+    /// So what each list holds within `margin` (the contacts) is what a fresh lookup finds;
+    /// far from the mesh, where nearly every lookup finds nothing, the gaps let the cloth
+    /// move much further between lookups.
     fn refresh_candidates(
         &mut self,
         x: &[Vec3],
@@ -902,6 +951,12 @@ impl MeshCollider {
             for list in c.vertex.iter_mut().chain(&mut c.triangle).chain(&mut c.edge) {
                 list.clear();
             }
+            // Every list is looked up below, and every gap with it.
+            c.vertex_slack.resize(x.len(), 0.0);
+            c.vertex_gap.resize(x.len(), 0.0);
+            c.triangle_gap.resize(cloth_triangles.len(), 0.0);
+            c.edge_gap.resize(c.cloth_edges.len(), 0.0);
+            c.looked_now.resize(x.len(), false);
             c.total = 0;
             c.stale = false;
         }
@@ -909,93 +964,151 @@ impl MeshCollider {
         // The entries the lists hold once the room is spent as far as it is.
         let refused = |c: &mut Candidates, room: &Room| {
             c.total = capacity - room.left();
+            for &i in &c.looked {
+                c.looked_now[i as usize] = false;
+            }
             Err(room.full.unwrap_or(Full::Entries))
         };
-        let moved = |at: &Vec3, p: &Vec3| (p - at).norm_squared() > 0.25 * skin * skin;
+        let moved = |at: &Vec3, p: &Vec3, slack: f64| (p - at).norm_squared() > slack * slack;
         let bounds = self.tri_bvh.bounds();
         c.looked.clear();
         c.dirty_triangles.clear();
         c.dirty_edges.clear();
-        for i in 0..x.len() {
-            if !(all || moved(&c.vertex_at[i], &x[i])) {
-                continue;
-            }
-            let p = x[i];
-            c.vertex_at[i] = p;
-            let q = Aabb { min: p, max: p }.inflated(reach);
-            if !refill(&mut c.vertex[i], &mut room, |push| {
-                self.tri_bvh.overlapping(&q, push)
-            }) {
-                return refused(c, &room);
-            }
-            let list = &mut c.vertex[i];
-            if list.is_empty() && self.closed && bounds.contains(&p) {
-                // Possibly deep inside: the nearest triangle of the whole mesh decides.
-                let (tris, target) = (&self.triangles, &self.target);
-                let nearest = self.tri_bvh.nearest(&p, f64::INFINITY, |t| {
-                    closest_at(target, &tris[t as usize], &p).1.norm_squared()
-                });
-                if let Some((t, _)) = nearest {
-                    if !room.push(list, t) {
-                        return refused(c, &room);
-                    }
-                    // Inside, the nearest of the whole mesh changes with every move: looked up
-                    // again at the next substep (outside, it is beyond reach: no contact).
-                    let (w, r) = closest_at(target, &tris[t as usize], &p);
-                    let n = pseudo_normal(
-                        tris,
-                        &self.neighbours,
-                        &self.face_normal,
-                        &self.vertex_normal,
-                        t,
-                        w,
-                    );
-                    if r.dot(&n) < 0.0 {
-                        c.vertex_at[i] = Vec3::repeat(f64::INFINITY);
+        c.pending.clear();
+        c.pending.extend((0..x.len() as u32).filter(|&i| {
+            all || moved(
+                &c.vertex_at[i as usize],
+                &x[i as usize],
+                c.vertex_slack[i as usize],
+            )
+        }));
+        // Rounds: the vertices that moved past their slack look, with their triangles and
+        // edges; a vertex of those triangles and edges that is past its new slack looks in the
+        // next round (rarely more than one).
+        while !c.pending.is_empty() {
+            let (triangles_from, edges_from) = (c.dirty_triangles.len(), c.dirty_edges.len());
+            for k in 0..c.pending.len() {
+                let i = c.pending[k] as usize;
+                let p = x[i];
+                c.vertex_at[i] = p;
+                c.looked_now[i] = true;
+                c.looked.push(i as u32);
+                let q = Aabb { min: p, max: p }.inflated(reach);
+                let Some(gap) = refill(&mut c.vertex[i], &mut room, |push| {
+                    self.tri_bvh.overlapping_apart(&q, push)
+                }) else {
+                    return refused(c, &room);
+                };
+                c.vertex_gap[i] = gap;
+                let list = &mut c.vertex[i];
+                if list.is_empty() && self.closed && bounds.contains(&p) {
+                    // Possibly deep inside: the nearest triangle of the whole mesh decides.
+                    let (tris, target) = (&self.triangles, &self.target);
+                    let nearest = self.tri_bvh.nearest(&p, f64::INFINITY, |t| {
+                        closest_at(target, &tris[t as usize], &p).1.norm_squared()
+                    });
+                    if let Some((t, _)) = nearest {
+                        if !room.push(list, t) {
+                            return refused(c, &room);
+                        }
+                        // Inside, the nearest of the whole mesh changes with every move: looked up
+                        // again at the next substep (outside, it is beyond reach: no contact).
+                        let (w, r) = closest_at(target, &tris[t as usize], &p);
+                        let n = pseudo_normal(
+                            tris,
+                            &self.neighbours,
+                            &self.face_normal,
+                            &self.vertex_normal,
+                            t,
+                            w,
+                        );
+                        if r.dot(&n) < 0.0 {
+                            c.vertex_at[i] = Vec3::repeat(f64::INFINITY);
+                        }
                     }
                 }
+                if !all {
+                    c.dirty_triangles.extend_from_slice(c.vertex_triangles.row(i));
+                    c.dirty_edges.extend_from_slice(c.vertex_edges.row(i));
+                }
             }
-            if !all {
-                c.looked.push(i as u32);
-                c.dirty_triangles.extend_from_slice(c.vertex_triangles.row(i));
-                c.dirty_edges.extend_from_slice(c.vertex_edges.row(i));
+            c.pending.clear();
+            if all {
+                c.dirty_triangles.extend(0..cloth_triangles.len() as u32);
+                c.dirty_edges.extend(0..c.cloth_edges.len() as u32);
+            } else {
+                sort_dedup_tail(&mut c.dirty_triangles, triangles_from);
+                sort_dedup_tail(&mut c.dirty_edges, edges_from);
+            }
+            for &t in &c.dirty_triangles[triangles_from..] {
+                let tri = &cloth_triangles[t as usize];
+                // The vertices' boxes hold `reach` already; the triangle's grows by the skin.
+                let q = Aabb::of(tri.iter().map(|&i| &x[i as usize])).inflated(skin);
+                let Some(gap) = refill(&mut c.triangle[t as usize], &mut room, |push| {
+                    self.vert_bvh.overlapping_apart(&q, push)
+                }) else {
+                    return refused(c, &room);
+                };
+                c.triangle_gap[t as usize] = gap;
+            }
+            for &e in &c.dirty_edges[edges_from..] {
+                let [i0, i1] = c.cloth_edges[e as usize];
+                // The mesh edges' boxes hold `reach` already.
+                let q = Aabb::of([&x[i0 as usize], &x[i1 as usize]]).inflated(skin);
+                let Some(gap) = refill(&mut c.edge[e as usize], &mut room, |push| {
+                    self.edge_bvh.overlapping_apart(&q, push)
+                }) else {
+                    return refused(c, &room);
+                };
+                c.edge_gap[e as usize] = gap;
+            }
+            // The new slacks of every vertex of what looked; those past theirs look next.
+            c.affected.clear();
+            if all {
+                c.affected.extend(0..x.len() as u32);
+            } else {
+                c.affected.extend(
+                    c.dirty_triangles[triangles_from..]
+                        .iter()
+                        .flat_map(|&t| cloth_triangles[t as usize])
+                        .chain(
+                            c.dirty_edges[edges_from..]
+                                .iter()
+                                .flat_map(|&e| c.cloth_edges[e as usize]),
+                        ),
+                );
+                sort_dedup_tail(&mut c.affected, 0);
+            }
+            for &b in &c.affected {
+                let b = b as usize;
+                let gap = c
+                    .vertex_triangles
+                    .row(b)
+                    .iter()
+                    .map(|&t| c.triangle_gap[t as usize])
+                    .chain(c.vertex_edges.row(b).iter().map(|&e| c.edge_gap[e as usize]))
+                    .fold(c.vertex_gap[b], f64::min);
+                let slack = if skin > 0.0 { 0.5 * (skin + gap) } else { 0.0 };
+                c.vertex_slack[b] = slack;
+                if !c.looked_now[b] && moved(&c.vertex_at[b], &x[b], slack) {
+                    c.looked_now[b] = true;
+                    c.pending.push(b as u32);
+                }
             }
         }
-        if all {
-            c.dirty_triangles.extend(0..cloth_triangles.len() as u32);
-            c.dirty_edges.extend(0..c.cloth_edges.len() as u32);
-        } else {
+        for &i in &c.looked {
+            c.looked_now[i as usize] = false;
+        }
+        if !all {
             c.dirty_triangles.sort_unstable();
             c.dirty_triangles.dedup();
             c.dirty_edges.sort_unstable();
             c.dirty_edges.dedup();
         }
-        for &t in &c.dirty_triangles {
-            let tri = &cloth_triangles[t as usize];
-            // The vertices' boxes hold `reach` already; the triangle's grows by the skin its
-            // vertices may move before it looks again.
-            let q = Aabb::of(tri.iter().map(|&i| &x[i as usize])).inflated(skin);
-            if !refill(&mut c.triangle[t as usize], &mut room, |push| {
-                self.vert_bvh.overlapping(&q, push)
-            }) {
-                return refused(c, &room);
-            }
-        }
-        for &e in &c.dirty_edges {
-            let [i0, i1] = c.cloth_edges[e as usize];
-            // The mesh edges' boxes hold `reach` already.
-            let q = Aabb::of([&x[i0 as usize], &x[i1 as usize]]).inflated(skin);
-            if !refill(&mut c.edge[e as usize], &mut room, |push| {
-                self.edge_bvh.overlapping(&q, push)
-            }) {
-                return refused(c, &room);
-            }
-        }
         if all {
             c.with_vertex.clear();
             c.with_triangle.clear();
             c.with_edge.clear();
-            c.looked.extend(0..x.len() as u32);
         }
         update_with(&mut c.with_vertex, &c.vertex, &c.looked);
         update_with(&mut c.with_triangle, &c.triangle, &c.dirty_triangles);
@@ -1003,6 +1116,19 @@ impl MeshCollider {
         c.total = capacity - room.left();
         Ok(())
     }
+}
+
+/// Sorts `list[from..]` and removes its repeats in place, leaving `list[..from]` as it is.
+fn sort_dedup_tail(list: &mut Vec<u32>, from: usize) {
+    list[from..].sort_unstable();
+    let mut kept = from;
+    for k in from..list.len() {
+        if k == from || list[k] != list[kept - 1] {
+            list[kept] = list[k];
+            kept += 1;
+        }
+    }
+    list.truncate(kept);
 }
 
 /// The weights of the point of triangle `tri` (of vertices `x`) nearest to `p`, and the vector
