@@ -505,38 +505,20 @@ impl Bvh {
     }
 
     /// Calls `f` with every item whose box overlaps `q`.
-    pub fn overlapping(&self, q: &Aabb, mut f: impl FnMut(u32)) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            if !node.bounds.overlaps(q) {
-                continue;
-            }
-            let first = node.first as usize;
-            if node.count > 0 {
-                let range = first..first + node.count as usize;
-                for (&i, b) in self.order[range.clone()].iter().zip(&self.boxes[range]) {
-                    if b.overlaps(q) {
-                        f(i);
-                    }
-                }
-            } else if top + 2 <= stack.len() {
-                stack[top] = first as u32;
-                stack[top + 1] = first as u32 + 1;
-                top += 2;
-            }
-        }
+    pub fn overlapping(&self, q: &Aabb, f: impl FnMut(u32)) {
+        self.walk_overlapping::<false>(q, f);
     }
 
     /// As [`Bvh::overlapping`], returning how far apart `q` is from the boxes of every item
     /// it did not report: a lower bound of their [`Aabb::separation`]s from `q`, taken from the
     /// boxes the walk passed over (an item's box lies in its nodes'); infinite with none.
-    pub fn overlapping_apart(&self, q: &Aabb, mut f: impl FnMut(u32)) -> f64 {
+    pub fn overlapping_apart(&self, q: &Aabb, f: impl FnMut(u32)) -> f64 {
+        self.walk_overlapping::<true>(q, f)
+    }
+
+    /// The walk of [`Bvh::overlapping`], keeping the gap when `GAP` (else infinite).
+    #[inline(always)]
+    fn walk_overlapping<const GAP: bool>(&self, q: &Aabb, mut f: impl FnMut(u32)) -> f64 {
         let mut gap = f64::INFINITY;
         if self.nodes.is_empty() {
             return gap;
@@ -547,7 +529,9 @@ impl Bvh {
             top -= 1;
             let node = &self.nodes[stack[top] as usize];
             if !node.bounds.overlaps(q) {
-                gap = gap.min(node.bounds.separation(q));
+                if GAP {
+                    gap = gap.min(node.bounds.separation(q));
+                }
                 continue;
             }
             let first = node.first as usize;
@@ -556,7 +540,7 @@ impl Bvh {
                 for (&i, b) in self.order[range.clone()].iter().zip(&self.boxes[range]) {
                     if b.overlaps(q) {
                         f(i);
-                    } else {
+                    } else if GAP {
                         gap = gap.min(b.separation(q));
                     }
                 }
