@@ -1440,9 +1440,9 @@ mod tests {
     }
 
     /// Steps a sheet of 12 x 12 vertices `spacing` apart, vertex `(u, v)` (centred) at
-    /// `sheet(u, v, s)` at time `s`, and a vertex in no triangle, for `steps` substeps of 1 ms against a ball and a thin
-    /// bar, comparing each substep's contacts from the kept candidates with a fresh search's;
-    /// the vertex, triangle and edge contacts compared.
+    /// `sheet(u, v, s)` at time `s`, and a vertex in no triangle, for `steps` substeps of 1 ms
+    /// against a ball and a thin bar, comparing each substep's contacts from the kept
+    /// candidates with a fresh search's: how many vertex, triangle and edge contacts it compared.
     fn compare_kept_with_fresh(
         steps: u32,
         spacing: f64,
@@ -1464,7 +1464,7 @@ mod tests {
         let (mut with_vertex, mut with_triangle, mut with_edge) = (0, 0, 0);
         for step in 0..steps {
             let s = f64::from(step) * 1e-3;
-            // And a vertex in no triangle, a third of a spacing off the sheet's middle.
+            // And a vertex in no triangle, half a spacing off the sheet's middle.
             let cloth: Vec<Vec3> = (0..n * n)
                 .map(|k| {
                     let at = |i: u32| (f64::from(i) - 5.5) * spacing;
