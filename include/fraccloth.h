@@ -1049,8 +1049,10 @@ FcStatus fc_cloth_add_mesh_collider(FcCloth *cloth,
  * Moves or deforms mesh collider `id`: `vertex_count` new positions (3 floats each, m) of
  * the same vertices in the same order, and their velocities (NULL: from the motion). The mesh
  * travels there in a straight line over the next `fc_cloth_step` call, as the pins do; call
- * it once a frame with the evaluated mesh (armature, shape keys, modifiers). No allocation
- * once a call has been made with as many vertices (and velocities, when given).
+ * it once a frame with the evaluated mesh (armature, shape keys, modifiers). A mesh sent again
+ * where it is (the same floats) keeps its search: a still collider sent every frame costs a
+ * comparison of its positions, not a new search. No allocation once a call has been made with as
+ * many vertices (and velocities, when given).
  *
  * Errors: `FC_ERROR_OUT_OF_RANGE` for no mesh collider `id`; `FC_ERROR_INVALID_ARGUMENT` for
  * a vertex count other than the mesh's or a non-finite value. Nothing changes on an error.
