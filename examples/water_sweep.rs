@@ -10,7 +10,7 @@
 //! explicit, 1/30 s implicit], `auto=1` (each `dt` split by the automatic step, as a host with
 //! `max_substep` automatic; with `dt=0.0333`, frames), `seconds=12`, `ramp=0` (s), and the preset's coefficients to try
 //! others: `added=` (normal added mass, kg/m^2), `entrained=` (kg/m^2), `cd=` (form drag), `scale=` (its smoothing length, m),
-//! `skin=` (N s/m^3), `coarse=` (coarse added mass, kg/m^2) and `coarse_len=` [0.2] (its patch spacing, m), `damping=` (spring damping), `dscale=S,H,B` (its multiple per family: stretch, shear, bend), `bend=` (the bend springs' stiffness, times the
+//! `skin=` (N s/m^3), `unsteady=` (N s/m^3) and `memory=` (s) (the unsteady skin drag and its running mean's time constant), `coarse=` (coarse added mass, kg/m^2) and `coarse_len=` [0.2] (its patch spacing, m), `damping=` (spring damping), `dscale=S,H,B` (its multiple per family: stretch, shear, bend), `bend=` (the bend springs' stiffness, times the
 //! preset's), `stretch=` (the stretch and shear springs' stiffness, times the preset's), `mode=velocity|fractional|strain|none` (what the
 //! springs damp), `history=` (history drag per area, N s^1/2/m^3; the SOE history is kept).
 
@@ -57,6 +57,8 @@ fn main() {
     w_.form_drag = num("cd", w_.form_drag);
     w_.form_drag_scale = num("scale", w_.form_drag_scale);
     w_.skin_drag = num("skin", w_.skin_drag);
+    w_.skin_drag_unsteady = num("unsteady", w_.skin_drag_unsteady);
+    w_.skin_drag_memory = num("memory", w_.skin_drag_memory);
     w_.coarse_added_mass = num("coarse", w_.coarse_added_mass);
     w_.coarse_length = num("coarse_len", 0.2);
     model.spring_damping = num("damping", model.spring_damping);
@@ -84,7 +86,7 @@ fn main() {
     let seconds = num("seconds", 12.0);
     let fps = 30.0;
     println!(
-        "# {w}x{h} {} added {} (coarse {} over {} m) entrained {} C_d {} over {} m, skin {} damping {}",
+        "# {w}x{h} {} added {} (coarse {} over {} m) entrained {} C_d {} over {} m, skin {} (+{} unsteady over {} s) damping {}",
         integrator.key(),
         model.water.added_mass,
         model.water.coarse_added_mass,
@@ -93,6 +95,8 @@ fn main() {
         model.water.form_drag,
         model.water.form_drag_scale,
         model.water.skin_drag,
+        model.water.skin_drag_unsteady,
+        model.water.skin_drag_memory,
         model.spring_damping
     );
     println!("freq Hz | half-waves | travel m/s | mid | bottom | zigzag | hang m | max speed m/s | status");

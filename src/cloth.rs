@@ -191,6 +191,9 @@ pub struct Cloth {
     /// The motion's frequency, averaged over calls: implicit Euler's accuracy bound on the
     /// automatic step (`cloth/motion.rs`).
     motion: motion::MotionRate,
+    /// The running mean of the velocity relative to the water that the unsteady skin drag
+    /// acts against (`Water::skin_drag_unsteady`), m/s; empty when the model has none.
+    skin_mean: Vec<Vec3>,
     /// Where the step runs (`plumbing/parallel.rs`).
     threads: Threads,
 }
@@ -221,7 +224,11 @@ impl Cloth {
         };
         crate::memory::ensure_available(
             (n as u64).saturating_mul(
-                crate::memory::STATE_BYTES_PER_PARTICLE + 2 * history_bytes + self_collision_bytes,
+                crate::memory::STATE_BYTES_PER_PARTICLE
+                    + 2 * history_bytes
+                    + self_collision_bytes
+                    // The unsteady skin drag's running mean and its rollback copy.
+                    + if config.model.water.unsteady_skin() { 48 } else { 0 },
             ),
             &format!(
                 "a cloth of {n} particles{}",
@@ -262,6 +269,12 @@ impl Cloth {
             solver_stats: SolverStats::default(),
             step_stats: StepStats::default(),
             motion: motion::MotionRate::default(),
+            // At rest in the water's current: a flow that has always been there.
+            skin_mean: if config.model.water.unsteady_skin() {
+                vec![-config.model.current; n]
+            } else {
+                Vec::new()
+            },
             threads: Threads::default(),
             topology,
             config,
@@ -300,6 +313,16 @@ impl Cloth {
         if thickness != old_thickness {
             // The pair list was found for the old reach.
             self.self_collision.look_again();
+        }
+        // The unsteady skin drag turned on starts from the flow as it is (no sudden start);
+        // turned off, its mean is dropped.
+        match (config.model.water.unsteady_skin(), self.skin_mean.is_empty()) {
+            (true, true) => {
+                let c = config.model.current;
+                self.skin_mean = self.v.iter().map(|v| v - c).collect();
+            }
+            (false, false) => self.skin_mean = Vec::new(),
+            _ => {}
         }
         self.config = config;
         Ok(())

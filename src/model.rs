@@ -120,8 +120,22 @@ pub struct Water {
     /// drag (`forces/wide_drag.rs`). The rms radius of the smoothing, the same on any mesh.
     pub form_drag_scale: f64,
     /// Skin (tangential) drag on the velocity along the cloth relative to the water, N s/m^3:
-    /// `-skin_drag area (v_rel - (v_rel . n) n)`.
+    /// `-skin_drag area (v_rel - (v_rel . n) n)`. The friction of a steady flow along the
+    /// cloth (an old, thick boundary layer).
     pub skin_drag: f64,
+    /// Skin drag on the unsteady part of the tangential relative velocity, N s/m^3 (0 = off):
+    /// adds `-skin_drag_unsteady area P_t (v_rel - mean)`, `mean` the running mean of `v_rel`
+    /// over [`Water::skin_drag_memory`] and `P_t` the projection on the cloth's plane. Motion
+    /// along the cloth that reverses meets a young, thin boundary layer (a Stokes layer:
+    /// `sqrt(2 rho_w mu omega)` on both faces, in phase) where a steady flow meets the old one
+    /// [`Water::skin_drag`] states; the sum acts on motion faster than the memory, `skin_drag`
+    /// alone on a steady current. Keeps a running mean (24 bytes a particle, in snapshots).
+    pub skin_drag_unsteady: f64,
+    /// Time constant of the running mean [`Water::skin_drag_unsteady`] acts against, s (> 0
+    /// when it is on): about how long a boundary layer takes to grow from a sudden start to a
+    /// steady flow's (a Rayleigh layer's friction falls to the laminar plate's after
+    /// `0.72 L / U`: 1 s for 0.3 m/s along 0.4 m).
+    pub skin_drag_memory: f64,
     /// Viscous drag per unit area, N s/m^3 (adds to [`Model::viscous_drag`] times the area).
     pub viscous_drag: f64,
     /// History drag per unit area, N s^{1/2}/m^3 (adds to [`Model::history_drag`] times the area).
@@ -143,6 +157,12 @@ pub struct Water {
 }
 
 impl Water {
+    /// Whether the skin drag keeps a running mean of the relative velocity
+    /// ([`Water::skin_drag_unsteady`]).
+    pub fn unsteady_skin(&self) -> bool {
+        self.skin_drag_unsteady != 0.0
+    }
+
     /// Whether any water rides on the cloth's normal motion (the turning forces' pass).
     pub fn normal_water(&self) -> bool {
         self.added_mass != 0.0 || self.coarse_added_mass != 0.0
@@ -225,6 +245,14 @@ impl Model {
         check_non_negative("form_drag", w.form_drag)?;
         check_non_negative("form_drag_scale", w.form_drag_scale)?;
         check_non_negative("skin_drag", w.skin_drag)?;
+        check_non_negative("skin_drag_unsteady", w.skin_drag_unsteady)?;
+        check_non_negative("skin_drag_memory", w.skin_drag_memory)?;
+        if w.skin_drag_unsteady > 0.0 {
+            check_positive(
+                "skin_drag_memory (with skin_drag_unsteady on)",
+                w.skin_drag_memory,
+            )?;
+        }
         check_non_negative("viscous_drag_per_area", w.viscous_drag)?;
         check_non_negative("history_drag_per_area", w.history_drag)?;
         check_non_negative("normal_drag_per_area", w.normal_drag)?;
@@ -299,13 +327,16 @@ impl Model {
     ///   the full drag);
     /// - skin drag on the tangential velocity, [`UNDERWATER_SKIN_DRAG`] (laminar skin friction
     ///   on both faces, linearised at 0.3 m/s on a 0.4 m cloth): a current along the cloth
-    ///   drags it, and motion in its plane dies out.
+    ///   drags it, and motion in its plane dies out;
+    /// - more skin drag on the tangential motion that changes faster than a second,
+    ///   [`UNDERWATER_SKIN_DRAG_UNSTEADY`] over [`UNDERWATER_SKIN_DRAG_MEMORY`] (a young
+    ///   boundary layer, a Stokes layer's friction at 0.5 Hz in all).
     ///
-    /// Swung 4 cm at 0.25 to 2 Hz the towel hangs (0.89 of its length at 2 Hz) and shows bumps
-    /// travelling down, more and shorter the brisker the swing (about 3.5 half-waves at
-    /// 0.5 Hz, 0.16 m/s; 6 at 2 Hz), the same within 8 % from 2 cm to 0.5 cm spacing (its bend
-    /// springs' constant is stated at 1 cm, [`UNDERWATER_BEND_SPACING`], and scaled to the
-    /// cloth's spacing).
+    /// Swung 4 cm at 0.25 to 2 Hz the towel hangs (at least 0.9 of its length: 0.905 at 2 Hz)
+    /// and shows bumps travelling down, more and shorter the brisker the swing (about 3.6
+    /// half-waves at 0.5 Hz, 0.16 m/s; 6 at 2 Hz), the same within 7 % from 2 cm to 0.5 cm
+    /// spacing (its bend springs' constant is stated at 1 cm, [`UNDERWATER_BEND_SPACING`], and
+    /// scaled to the cloth's spacing).
     pub fn underwater() -> Self {
         Self {
             spring_damping: UNDERWATER_SPRING_DAMPING,
@@ -319,6 +350,8 @@ impl Model {
                 form_drag: UNDERWATER_FORM_DRAG,
                 form_drag_scale: UNDERWATER_FORM_DRAG_SCALE,
                 skin_drag: UNDERWATER_SKIN_DRAG,
+                skin_drag_unsteady: UNDERWATER_SKIN_DRAG_UNSTEADY,
+                skin_drag_memory: UNDERWATER_SKIN_DRAG_MEMORY,
                 ..Water::default()
             },
             ..Self::fractional()
@@ -335,8 +368,9 @@ pub const UNDERWATER_BEND_SPACING: f64 = 0.01;
 /// `rho_w lambda / pi` for a sheet rippled at wavelength lambda (about 80 kg/m^2 for the
 /// 0.25 m bumps the preset shows at 0.5 Hz) and up to `rho_w pi W / 4` for a whole sheet of
 /// width W moving rigidly. The preset carries far less: more gives more and deeper bumps and
-/// a shorter hang, and 8 keeps a towel swung 4 cm at 2 Hz hanging at 0.89 of its length
-/// with 6 half-waves (10 with the drag smoothed over 1 cm hangs 0.352 m; `docs/underwater.md`).
+/// a shorter hang, and 8 keeps a towel swung 4 cm at 2 Hz hanging at 0.9 of its length
+/// with 6 half-waves (10 with the drag smoothed over 1 cm and the steady skin drag alone hangs
+/// 0.352 m; `docs/underwater.md`).
 pub const UNDERWATER_ADDED_MASS: f64 = 8.0;
 /// Form-drag coefficient of the underwater preset (a flat plate face on: 1-2).
 pub const UNDERWATER_FORM_DRAG: f64 = 1.0;
@@ -345,11 +379,23 @@ pub const UNDERWATER_FORM_DRAG: f64 = 1.0;
 /// few centimetres long shed little, so bumps keep growing in number with the drive's
 /// frequency (without it the visible half-waves fell from 4.6 at 1 Hz to 3.8 at 2 Hz: a
 /// quadratic drag takes the same share of a wave's energy each cycle at any frequency).
-pub const UNDERWATER_FORM_DRAG_SCALE: f64 = 0.012;
+/// 1.2 cm until 0.9.26; 1 cm with the unsteady skin drag hangs the 2 Hz swing at 0.9 of its
+/// length with the half-waves still growing (`docs/underwater.md`, stop 62).
+pub const UNDERWATER_FORM_DRAG_SCALE: f64 = 0.010;
 /// Skin drag of the underwater preset, N s/m^3: laminar skin friction on both faces,
 /// `2 * 0.664 rho_w sqrt(nu / L) U^1.5` (`C_f = 1.328 / sqrt(Re)` per face, water
 /// `nu = 1e-6 m^2/s`), is 0.345 N/m^2 at U = 0.3 m/s over L = 0.4 m; over U, 1.15 N s/m^3.
 pub const UNDERWATER_SKIN_DRAG: f64 = 1.15;
+/// Skin drag of the underwater preset on the unsteady part of the tangential motion, N s/m^3
+/// ([`Water::skin_drag_unsteady`]): a plate oscillating in its plane at `omega` meets the Stokes
+/// layer's in-phase friction `sqrt(2 rho_w mu omega)` on its two faces, 2.51 N s/m^3 at the
+/// 0.5 Hz the preset's look is stated at (1.77 at 0.25 Hz, 5.0 at 2 Hz); this is what it adds to
+/// the steady [`UNDERWATER_SKIN_DRAG`] to make that, 2.51 - 1.15.
+pub const UNDERWATER_SKIN_DRAG_UNSTEADY: f64 = 1.36;
+/// The running mean's time constant of the underwater preset's unsteady skin drag, s: a
+/// Rayleigh layer's friction `sqrt(rho_w mu / (pi t))` per face falls to the laminar plate's
+/// after `0.72 L / U`, 0.96 s at 0.3 m/s along 0.4 m.
+pub const UNDERWATER_SKIN_DRAG_MEMORY: f64 = 1.0;
 
 /// Velocity spring damping of the underwater preset, N s/m: light. It only keeps grid-scale
 /// motion from ringing; the water's terms make the look (none gives the same bumps at 0.5 Hz,

@@ -62,7 +62,11 @@ fn the_header_names_the_underwater_presets_coefficients() {
         format!("normal added mass ({} kg/m^2", w.added_mass),
         format!("form drag (C_d = {})", w.form_drag),
         format!("smoothed over {} m", w.form_drag_scale),
-        format!("skin drag ({} N s/m^3)", w.skin_drag),
+        format!("skin drag ({} N s/m^3", w.skin_drag),
+        format!(
+            "plus {} on the unsteady part over a {} s mean",
+            w.skin_drag_unsteady, w.skin_drag_memory
+        ),
     ] {
         assert!(text.contains(&said), "the header should say {said:?}: {text}");
     }

@@ -274,14 +274,15 @@ fn steps_do_not_allocate() {
         let id = scene.cloth.add_mesh_collider(&x, &tris, None).unwrap();
         // The host's positions and velocities for every frame, made before counting.
         type Frame = (Vec<Vec3>, Option<Vec<Vec3>>);
-        let frames: Vec<Frame> = (1..=60)
+        let frames: Vec<Frame> = (1..=120)
             .map(|f| {
                 let (now, before) = (ball(f).0, ball(f - 1).0);
                 let v = now.iter().zip(&before).map(|(a, b)| (a - b) / dt).collect();
                 (now, (f % 2 == 0).then_some(v))
             })
             .collect();
-        let (warm, counted) = frames.split_at(30);
+        // Three of the ball's pushes (about 31 frames each) to grow the lists, then one counted.
+        let (warm, counted) = frames.split_at(90);
         for (x, v) in warm {
             scene.cloth.set_mesh_collider(id, x, v.as_deref()).unwrap();
             scene.step().unwrap();
@@ -400,7 +401,7 @@ fn steps_do_not_allocate() {
         let indices: Vec<u32> = tris.iter().flatten().copied().collect();
         // Every frame's inputs made before counting.
         type Frame = (Vec<f32>, Option<Vec<f32>>, Vec<f32>, [f32; 3], [f32; 3]);
-        let frames: Vec<Frame> = (1..=120)
+        let frames: Vec<Frame> = (1..=480)
             .map(|f| {
                 let (now, before) = (ball(f).0, ball(f - 1).0);
                 let v: Vec<Vec3> = now.iter().zip(&before).map(|(a, b)| (a - b) / dt).collect();
@@ -462,7 +463,11 @@ fn steps_do_not_allocate() {
             assert_eq!(fc_cloth_set_current(c, current.as_ptr()), FC_OK);
             assert_eq!(fc_cloth_step(c, dt), FC_OK);
         };
-        let (warm, counted) = frames.split_at(90);
+        // Fifteen rounds of the motions to grow the lists, the sixteenth counted: the cloth's
+        // answer to them does not repeat exactly, and a vertex the ball first reaches in a
+        // later round grows its candidate list then (with 0.9.26's preset, three allocations
+        // in the eighth round, none in the sixteenth).
+        let (warm, counted) = frames.split_at(450);
         let read = |positions: &mut [f32], normals: &mut [f32]| unsafe {
             assert_eq!(
                 fc_cloth_get_positions(c, positions.as_mut_ptr(), positions.len()),

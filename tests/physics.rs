@@ -247,6 +247,7 @@ fn spring_damping_can_be_set_per_family() {
             colliders: &[],
             prior_forces: &[],
             weights: Default::default(),
+            skin_mean: &[],
         };
         total_forces(&input, &mut ForceScratch::default(), &mut f);
         f

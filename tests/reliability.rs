@@ -97,8 +97,9 @@ fn snapshots_with_a_valid_checksum_but_impossible_contents_are_refused() {
         refused(&mut c, &bytes, l.velocity0, f64::NAN, "velocity");
         refused(&mut c, &bytes, l.velocity0, 1e6, "max_speed");
         refused(&mut c, &bytes, l.velocity0 - 24 * N - 8 + 8, 1e300, "float range");
-        // The motion averages (two f64 before the checksum; `src/cloth/motion.rs`).
-        let motion = bytes.len() - 4 - 16;
+        // The motion averages (two f64 before the skin drag's empty mean and the checksum;
+        // `src/cloth/motion.rs`).
+        let motion = bytes.len() - 4 - 8 - 16;
         refused(&mut c, &bytes, motion, f64::NAN, "motion averages");
         refused(&mut c, &bytes, motion + 8, -1.0, "motion averages");
         refused(&mut c, &bytes, motion, f64::INFINITY, "motion averages");

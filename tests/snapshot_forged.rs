@@ -82,10 +82,10 @@ fn finite_but_absurd_soe_modes_are_refused_naming_the_history() {
     let (a, snap) = stepped(Scheme::DEFAULT);
     // The SOE state ends: modes (n K 3 f64), prev and newest (u64 length + 24 n bytes each), a
     // flag byte and two f64; then the (empty) strain history, the collision state (three empty
-    // counts), the motion averages (two f64) and the checksum.
+    // counts), the motion averages (two f64), the skin drag's (empty) mean and the checksum.
     let n = a.vertex_count();
     let k = a.history().mode_count();
-    let end = snap.len() - 4 - 16 - 24 - 8 - 8 - 1 - 2 * (8 + 24 * n);
+    let end = snap.len() - 4 - 8 - 16 - 24 - 8 - 8 - 1 - 2 * (8 + 24 * n);
     for value in [1e300f64, -3e200, 1e30] {
         let mut forged = snap.clone();
         for p in (end - 8 * n * k * 3..end).step_by(8) {
@@ -110,8 +110,8 @@ fn a_full_history_whose_now_is_outside_the_cloths_life_is_refused() {
     for now in [-1e9, -1.0, 1e9] {
         let mut forged = snap.clone();
         // The history's last f64, before the collision state (three empty counts) and the
-        // motion averages (two f64).
-        let at = forged.len() - 4 - 16 - 24 - 8;
+        // motion averages (two f64) and the skin drag's (empty) mean.
+        let at = forged.len() - 4 - 8 - 16 - 24 - 8;
         forged[at..at + 8].copy_from_slice(&f64::to_le_bytes(now));
         reseal(&mut forged);
         refused_and_unchanged(&forged, Scheme::Full, "full history");

@@ -180,6 +180,75 @@ fn a_plate_falling_edgewise_reaches_the_terminal_speed_of_skin_drag() {
     }
 }
 
+/// The edgewise fall of [`a_plate_falling_edgewise_meets_a_young_boundary_layer_first`] as
+/// its two equations say, by RK4 at a fine step: `mu v' = mu g' - k_s v - k_u (v - M)`,
+/// `M' = (v - M) / T`, from rest; the speed at each of `times`.
+fn edgewise_fall(ks: f64, ku: f64, memory: f64, times: &[f64]) -> Vec<f64> {
+    let f = |v: f64, m: f64| ((MU * g_eff() - ks * v - ku * (v - m)) / MU, (v - m) / memory);
+    let (mut v, mut m, mut t, h) = (0.0, 0.0, 0.0, 1e-5);
+    times
+        .iter()
+        .map(|&end| {
+            while t < end - 0.5 * h {
+                let (a1, b1) = f(v, m);
+                let (a2, b2) = f(v + 0.5 * h * a1, m + 0.5 * h * b1);
+                let (a3, b3) = f(v + 0.5 * h * a2, m + 0.5 * h * b2);
+                let (a4, b4) = f(v + h * a3, m + h * b3);
+                v += h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+                m += h / 6.0 * (b1 + 2.0 * b2 + 2.0 * b3 + b4);
+                t += h;
+            }
+            v
+        })
+        .collect()
+}
+
+#[test]
+fn a_plate_falling_edgewise_meets_a_young_boundary_layer_first() {
+    // The unsteady skin drag: along its plane the plate meets k_s + k_u while its boundary
+    // layer is young (the running mean M of its velocity has not caught up) and k_s alone once
+    // the flow is steady. Its mean speed through the whole step against the two equations
+    // (`edgewise_fall`), and the terminal speed the steady drag alone sets.
+    let (ks, ku, memory) = (1.0, 2.0, 0.5);
+    let water = Water {
+        skin_drag: ks,
+        skin_drag_unsteady: ku,
+        skin_drag_memory: memory,
+        form_drag: 2.0,
+        added_mass: 20.0,
+        ..Water::default()
+    };
+    let times = [0.25, 0.5, 1.0, 2.0, 6.0];
+    let want = edgewise_fall(ks, ku, memory, &times);
+    let steady_only = edgewise_fall(ks, 0.0, memory, &times);
+    let dt = 5e-5;
+    let mut c = plate(10, Vec3::new(0.0, -9.81, 0.0), water, Integrator::SymplecticEuler);
+    let mut t = 0.0;
+    for (k, &end) in times.iter().enumerate() {
+        run(&mut c, end - t, dt);
+        t = end;
+        let v = -mean_velocity(&c).y;
+        println!(
+            "t {end} s: {v:.5} m/s, equations {:.5} (steady drag alone {:.5})",
+            want[k], steady_only[k]
+        );
+        assert!(
+            (v - want[k]).abs() < 1e-3 * want[k],
+            "t {end}: {v} against {}",
+            want[k]
+        );
+    }
+    // The young layer slows the start by a third and more; the steady drag alone sets the end
+    // (the equations after a minute: the mean's slow mode takes tens of seconds).
+    assert!(want[1] < 0.7 * steady_only[1], "{want:?} against {steady_only:?}");
+    let terminal = MU * g_eff() / ks;
+    let end = edgewise_fall(ks, ku, memory, &[60.0])[0];
+    assert!(
+        (end - terminal).abs() < 1e-3 * terminal,
+        "{end} against {terminal}"
+    );
+}
+
 #[test]
 fn per_area_drags_give_the_same_motion_at_any_resolution() {
     // A hanging cloth released from rest at two resolutions, with only per-area drags: the

@@ -264,7 +264,7 @@ impl Cloth {
             let drag = (crate::forces::terms::per_particle(m.viscous_drag, m.water.viscous_drag, area)
                 + crate::forces::terms::per_particle(m.normal_drag, m.water.normal_drag, area)
                 + w0 * crate::forces::terms::per_particle(m.history_drag, m.water.history_drag, area)
-                + m.water.skin_drag * area
+                + (m.water.skin_drag + m.water.skin_drag_unsteady) * area
                 + rho_w * cd * area * speed)
                 / mass;
             let mut omega2 = 2.0 * k / mass;

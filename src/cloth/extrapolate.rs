@@ -56,6 +56,9 @@ impl Cloth {
         for (v, whole) in self.v.iter_mut().zip(&probe.v) {
             *v = 2.0 * *v - whole;
         }
+        for (m, whole) in self.skin_mean.iter_mut().zip(&probe.skin_mean) {
+            *m = 2.0 * *m - whole;
+        }
         if !integrator.is_implicit() {
             self.keep_pin_secants(&probe.v);
         }

@@ -1,7 +1,9 @@
 //! Snapshots: the complete state of a cloth as bytes, to save a bake and resume it later
 //! (or undo in a host), continuing bitwise identically.
 //!
-//! Format version 7, little-endian; version 6 (no motion averages) is read with the motion
+//! Format version 8, little-endian; version 7 (no skin drag mean) is read with the unsteady
+//! skin drag's running mean at the loaded relative velocities (a flow that has always been
+//! there, as at creation); version 6 (no motion averages) is read with the motion
 //! unseen (implicit Euler's automatic step then bounds nothing by accuracy until the averages
 //! fill, `cloth/motion.rs`), version 5 (no colliders' own margins) is read with every
 //! collider at the model's margin, version 4 (no collision state) as a cloth with no mesh
@@ -11,7 +13,7 @@
 //! sum instead of the sample that waits to be folded (`history/soe.rs`).
 //!
 //! ```text
-//! header   b"FCSNAP\0\0"  u32 version = 7  u32 flags = 0  u64 payload_len
+//! header   b"FCSNAP\0\0"  u32 version = 8  u32 flags = 0  u64 payload_len
 //! payload  u64 vertex_count  u64 spring_count  u64 triangle_count  u64 topology_fingerprint
 //!          u8 history_tag  u64 history_config_fingerprint
 //!          f64 time  u64 steps  vec3 current  f64 solver_tolerance  u32 solver_max_iterations
@@ -26,6 +28,8 @@
 //!          u64 n + n (u32 vertex, u32 triangle, i8 side)  self-collision pairs
 //!          u64 n + n (u32 edge, u32 edge, i8 side)
 //!          f64 motion accel2  f64 motion vel2  (`cloth/motion.rs`; version 7)
+//!          vec3s skin_mean  (0 or vertex_count; the unsteady skin drag's running mean;
+//!            version 8)
 //! trailer  u32 CRC-32 (IEEE) of header and payload
 //! ```
 //!
@@ -48,7 +52,7 @@ use crate::math::Vec3;
 
 const MAGIC: &[u8; 8] = b"FCSNAP\0\0";
 /// Current format version.
-pub const SNAPSHOT_VERSION: u32 = 7;
+pub const SNAPSHOT_VERSION: u32 = 8;
 const HEADER: usize = 8 + 4 + 4 + 8;
 
 /// FNV-1a over a stream of u64 words: cheap identity checks, not security.
@@ -180,6 +184,7 @@ struct LoadedState {
     histories: Histories,
     meshes: Vec<Option<MeshCollider>>,
     motion: super::motion::MotionRate,
+    skin_mean: Vec<Vec3>,
 }
 
 impl Cloth {
@@ -238,6 +243,7 @@ impl Cloth {
         self.write_collision_state(w);
         w.f64(self.motion.accel2);
         w.f64(self.motion.vel2);
+        w.vec3s(&self.skin_mean);
         Ok(())
     }
 
@@ -372,6 +378,26 @@ impl Cloth {
         if !motion.is_sound() {
             return Err(Error::invalid("snapshot: bad motion averages"));
         }
+        let mut skin_mean = Vec::new();
+        if version >= 8 {
+            r.vec3s_into(None, &mut skin_mean)?;
+            if !(skin_mean.is_empty() || skin_mean.len() == n) {
+                return Err(Error::invalid(format!(
+                    "snapshot: {} skin drag means for {n} vertices",
+                    skin_mean.len()
+                )));
+            }
+            skin_mean
+                .iter()
+                .try_for_each(|p| check_finite_vec("skin drag mean", p))?;
+        }
+        // This cloth's model decides whether the mean is kept: one saved without it starts
+        // from the loaded flow, one saved with it is dropped by a cloth without.
+        if !self.config.model.water.unsteady_skin() {
+            skin_mean.clear();
+        } else if skin_mean.is_empty() {
+            skin_mean = v.iter().map(|vk| vk - current).collect();
+        }
         if r.remaining() != 4 {
             return Err(Error::invalid("snapshot has trailing data"));
         }
@@ -436,6 +462,7 @@ impl Cloth {
             histories,
             meshes: collisions.meshes,
             motion,
+            skin_mean,
         };
         self.swap_state(&mut state);
         self.self_collision
@@ -471,6 +498,7 @@ impl Cloth {
         std::mem::swap(&mut self.histories, &mut s.histories);
         std::mem::swap(&mut self.mesh_slots, &mut s.meshes);
         std::mem::swap(&mut self.motion, &mut s.motion);
+        std::mem::swap(&mut self.skin_mean, &mut s.skin_mean);
         for (p, &w) in self.pinned.iter_mut().zip(&self.pin_weight) {
             *p = w == 1.0;
         }
@@ -613,6 +641,90 @@ mod tests {
         }
     }
 
+    /// The unsteady skin drag's running mean is state: a snapshot carries it, so a cloth made
+    /// from it continues bitwise (left out of the load, the mean restarts from the flow and the
+    /// positions differ); a version-7 snapshot, without it, loads with the mean at the loaded
+    /// velocities relative to the water.
+    #[test]
+    fn the_skin_drags_running_mean_continues_bitwise_from_a_snapshot() {
+        let make = || {
+            let t = GridSpec {
+                width: 6,
+                height: 5,
+                spacing: 0.01,
+                total_mass: 0.003,
+            }
+            .build()
+            .unwrap();
+            let mut c = Cloth::new(
+                t,
+                ClothConfig {
+                    model: crate::Model::underwater(),
+                    scheme: Scheme::Off,
+                    integrator: crate::Integrator::SymplecticEuler,
+                    ..ClothConfig::default()
+                },
+            )
+            .unwrap();
+            c.set_pinned(&[0, 1, 2]).unwrap();
+            c
+        };
+        let mut a = make();
+        let rest: Vec<Vec3> = a.positions()[..3].to_vec();
+        // The pins slide to and fro along the cloth's plane.
+        let drive = |c: &mut Cloth, k: u32| {
+            let s = Vec3::new(0.02 * (f64::from(k) * 0.01).sin(), 0.0, 0.0);
+            let targets: Vec<Vec3> = rest.iter().map(|&r| r + s).collect();
+            c.set_pin_targets(&[0, 1, 2], &targets).unwrap();
+        };
+        for k in 0..300 {
+            drive(&mut a, k);
+            a.step(1e-3).unwrap();
+        }
+        let n = a.vertex_count();
+        assert_eq!(a.skin_mean.len(), n);
+        assert!(a.skin_mean.iter().any(|m| m.x.abs() > 1e-4));
+        let snap = a.save_snapshot().unwrap();
+        let mut b = make();
+        b.load_snapshot(&snap).unwrap();
+        assert_eq!(b.skin_mean, a.skin_mean);
+        // The same load with the mean restarted from the flow.
+        let mut c = make();
+        c.load_snapshot(&snap).unwrap();
+        let current = c.config.model.current;
+        c.skin_mean = c.v.iter().map(|v| v - current).collect();
+        for k in 300..400 {
+            for cloth in [&mut a, &mut b, &mut c] {
+                drive(cloth, k);
+                cloth.step(1e-3).unwrap();
+            }
+        }
+        assert_eq!(a.positions(), b.positions());
+        assert_ne!(a.positions(), c.positions(), "the mean is state");
+        // A version-7 snapshot (no mean): the mean starts from the loaded flow.
+        let mut old = snap[..snap.len() - 4 - 8 - 24 * n].to_vec();
+        old[8..12].copy_from_slice(&7u32.to_le_bytes());
+        let payload = (old.len() - HEADER) as u64;
+        old[16..24].copy_from_slice(&payload.to_le_bytes());
+        let crc = crc32fast::hash(&old);
+        old.extend_from_slice(&crc.to_le_bytes());
+        let mut d = make();
+        d.load_snapshot(&old).unwrap();
+        let want: Vec<Vec3> = d.v.iter().map(|v| v - current).collect();
+        assert_eq!(d.skin_mean, want);
+        // A mean of the wrong length is refused, the cloth unchanged.
+        let mut bad = snap[..snap.len() - 4 - 8 - 24 * n].to_vec();
+        bad.extend_from_slice(&1u64.to_le_bytes());
+        bad.extend_from_slice(&[0u8; 24]);
+        let payload = (bad.len() - HEADER) as u64;
+        bad[16..24].copy_from_slice(&payload.to_le_bytes());
+        let crc = crc32fast::hash(&bad);
+        bad.extend_from_slice(&crc.to_le_bytes());
+        let before = d.save_snapshot().unwrap();
+        assert!(d.load_snapshot(&bad).is_err());
+        assert_eq!(d.save_snapshot().unwrap(), before);
+    }
+
     /// Implicit Euler's automatic step reads the motion's averages (`cloth/motion.rs`): a
     /// snapshot carries them, so a cloth made from it takes the same substeps and bits.
     /// With them left out of the load, the loaded cloth reads no motion and the test fails.
@@ -649,8 +761,10 @@ mod tests {
         }
         assert_eq!(a.positions(), b.positions());
 
-        // A version-6 snapshot (no averages) loads with the motion unseen.
-        let mut old = snap[..snap.len() - 4 - 16].to_vec();
+        // A version-6 snapshot (no averages, and no skin drag mean: 8 bytes of an empty
+        // list here) loads with the motion unseen.
+        assert!(a.skin_mean.is_empty());
+        let mut old = snap[..snap.len() - 4 - 8 - 16].to_vec();
         old[8..12].copy_from_slice(&6u32.to_le_bytes());
         let payload = (old.len() - HEADER) as u64;
         old[16..24].copy_from_slice(&payload.to_le_bytes());

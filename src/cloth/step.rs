@@ -145,6 +145,8 @@ pub(super) struct Rollback {
     histories: Option<Histories>,
     /// Self-collision's remembered pairs and sides (state: a snapshot carries them).
     pub(super) self_collision: crate::collide::self_collision::SavedMemory,
+    /// The unsteady skin drag's running mean.
+    pub(super) skin_mean: Vec<Vec3>,
     mesh_from: f64,
     time: f64,
     steps: u64,
@@ -166,6 +168,7 @@ impl Rollback {
         }
         self.x.clone_from(&c.x);
         self.v.clone_from(&c.v);
+        self.skin_mean.clone_from(&c.skin_mean);
         match &mut self.histories {
             Some(h) => h.clone_from(&c.histories),
             None => self.histories = Some(c.histories.clone()),
@@ -180,6 +183,7 @@ impl Rollback {
     pub(super) fn restore(&mut self, c: &mut Cloth) {
         std::mem::swap(&mut c.x, &mut self.x);
         std::mem::swap(&mut c.v, &mut self.v);
+        std::mem::swap(&mut c.skin_mean, &mut self.skin_mean);
         if let Some(h) = &mut self.histories {
             std::mem::swap(&mut c.histories, h);
         }
@@ -203,6 +207,7 @@ macro_rules! force_input {
             colliders: &$c.colliders,
             prior_forces: &$s.prior_forces,
             weights: $weights,
+            skin_mean: &$c.skin_mean,
         }
     };
 }
@@ -362,6 +367,7 @@ impl Cloth {
             colliders: &self.colliders,
             prior_forces: &s.prior_forces,
             weights,
+            skin_mean: &self.skin_mean,
         };
         let sound = explicit_tiles(
             &input,
@@ -623,6 +629,18 @@ impl Cloth {
         let s = &mut self.scratch;
         std::mem::swap(&mut self.x, &mut s.x_new);
         std::mem::swap(&mut self.v, &mut s.v_new);
+        if !self.skin_mean.is_empty() {
+            let (m, v) = (&self.config.model, &self.v[..]);
+            if parallel::worth_it(v.len()) {
+                use rayon::prelude::*;
+                self.skin_mean
+                    .par_chunks_mut(parallel::CHUNK)
+                    .zip(v.par_chunks(parallel::CHUNK))
+                    .for_each(|(mean, v)| forces::follow_skin_mean(m, v, h, mean));
+            } else {
+                forces::follow_skin_mean(m, v, h, &mut self.skin_mean);
+            }
+        }
         for memory in Memory::ALL {
             let history = self.histories.get_mut(memory);
             if history.is_off() {

@@ -104,17 +104,14 @@ mod tests {
     fn a_short_struct_reads_its_fields_and_defaults_the_rest() {
         let mut host = fc_cloth_desc_default();
         host.width = 7;
-        host.coarse_length = 0.5; // the field before the last: inside a host 8 bytes shorter
-        host.self_collision_relative = 0.4; // the last field: beyond it
+        host.skin_drag_unsteady = 0.5; // the field before the last: inside a host 8 bytes shorter
+        host.skin_drag_memory = 0.4; // the last field: beyond it
         host.struct_size = (DESC_SIZE - 8) as u32;
         // SAFETY: a whole struct is readable.
         let d = unsafe { read_desc(&host, fc_cloth_desc_default()) }.expect("accepted");
         assert_eq!(d.width, 7);
-        assert_eq!(d.coarse_length, 0.5);
-        assert_eq!(
-            d.self_collision_relative,
-            fc_cloth_desc_default().self_collision_relative
-        );
+        assert_eq!(d.skin_drag_unsteady, 0.5);
+        assert_eq!(d.skin_drag_memory, fc_cloth_desc_default().skin_drag_memory);
         assert_eq!(d.struct_size as usize, DESC_SIZE);
     }
 

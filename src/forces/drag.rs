@@ -91,10 +91,119 @@ pub(super) fn add_form(m: &Model, v: [&[f64]; 3], n: &[Vec3], areas: &[f64], f: 
     });
 }
 
-/// Skin drag: `-k_s A (v_rel - (v_rel . n) n)`, on the tangential velocity.
-pub(super) fn add_skin(m: &Model, v: [&[f64]; 3], n: &[Vec3], areas: &[f64], f: [&mut [f64]; 3]) {
-    let k = m.water.skin_drag;
-    add_with_normals(m, v, n, areas, f, |rel, nt, a| {
-        -(k * a) * (rel - rel.dot(nt) * nt)
-    });
+/// Skin drag: `-k_s A (v_rel - (v_rel . n) n)`, on the tangential velocity; with an unsteady
+/// part (`mean` the running mean of `v_rel`, one per particle of the tile),
+/// `-A P_t ((k_s + k_u) v_rel - k_u mean)`: the steady `k_s` on a flow the mean has caught up
+/// with, `k_s + k_u` on motion faster than the memory.
+pub(super) fn add_skin(
+    m: &Model,
+    v: [&[f64]; 3],
+    n: &[Vec3],
+    areas: &[f64],
+    mean: Option<&[Vec3]>,
+    f: [&mut [f64]; 3],
+) {
+    let (k, ku) = (m.water.skin_drag, m.water.skin_drag_unsteady);
+    match mean {
+        Some(mean) if ku != 0.0 => {
+            let [fx, fy, fz] = f;
+            for (t, nt) in n.iter().enumerate().take(fx.len()) {
+                let rel = Vec3::new(v[0][t], v[1][t], v[2][t]) - m.current;
+                let w = (k + ku) * rel - ku * mean[t];
+                let total = Vec3::new(fx[t], fy[t], fz[t]) - areas[t] * (w - w.dot(nt) * nt);
+                (fx[t], fy[t], fz[t]) = (total.x, total.y, total.z);
+            }
+        }
+        _ => add_with_normals(m, v, n, areas, f, |rel, nt, a| {
+            -(k * a) * (rel - rel.dot(nt) * nt)
+        }),
+    }
+}
+
+/// The running mean of the velocity relative to the water that the unsteady skin drag acts
+/// against, after an accepted step of `h` s ending at velocities `v`: a first-order low-pass
+/// of time constant `memory`, `mean += (1 - e^{-h / memory}) (v_rel - mean)` (exact for a
+/// velocity held over the step).
+pub fn follow_skin_mean(m: &Model, v: &[Vec3], h: f64, mean: &mut [Vec3]) {
+    let a = -(-h / m.water.skin_drag_memory).exp_m1();
+    let c = m.current;
+    for (mk, vk) in mean.iter_mut().zip(v) {
+        *mk += a * (vk - c - *mk);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The skin drag on one particle of area `a`, normal `n`, velocity `v` and running mean
+    /// `mean`.
+    fn skin(m: &Model, v: Vec3, n: Vec3, a: f64, mean: Option<Vec3>) -> Vec3 {
+        let (vs, mut f) = ([[v.x], [v.y], [v.z]], [[0.0], [0.0], [0.0]]);
+        let means = mean.map(|m| [m]);
+        let [fx, fy, fz] = &mut f;
+        add_skin(
+            m,
+            [&vs[0], &vs[1], &vs[2]],
+            &[n],
+            &[a],
+            means.as_ref().map(|m| &m[..]),
+            [fx, fy, fz],
+        );
+        Vec3::new(f[0][0], f[1][0], f[2][0])
+    }
+
+    #[test]
+    fn a_steady_flow_meets_the_steady_skin_drag_and_a_sudden_one_both() {
+        let mut m = Model::underwater();
+        m.current = Vec3::new(0.3, 0.0, 0.1);
+        let (ks, ku) = (m.water.skin_drag, m.water.skin_drag_unsteady);
+        assert!(ks > 0.0 && ku > 0.0);
+        let n = Vec3::new(0.0, 0.0, 1.0);
+        let (v, a) = (Vec3::new(-0.1, 0.2, 0.5), 2e-4);
+        let rel = v - m.current;
+        let along = rel - rel.dot(&n) * n;
+        // The mean caught up with the flow: the steady friction alone.
+        let steady = skin(&m, v, n, a, Some(rel));
+        assert!((steady + ks * a * along).norm() < 1e-15 * along.norm());
+        // A flow the mean has not seen (a sudden start, or motion much faster than the
+        // memory): both.
+        let sudden = skin(&m, v, n, a, Some(Vec3::zeros()));
+        assert!((sudden + (ks + ku) * a * along).norm() < 1e-15 * along.norm());
+        // Nothing along the normal, whatever the mean.
+        let odd = skin(&m, v, n, a, Some(Vec3::new(0.7, -0.2, 3.0)));
+        assert_eq!(odd.z, 0.0);
+        // Without a mean (the unsteady part off), the steady friction as before.
+        m.water.skin_drag_unsteady = 0.0;
+        assert_eq!(skin(&m, v, n, a, None), steady);
+    }
+
+    #[test]
+    fn the_mean_follows_the_flow_with_its_time_constant() {
+        let mut m = Model::underwater();
+        m.current = Vec3::new(0.0, 0.0, 0.2);
+        let memory = m.water.skin_drag_memory;
+        // A velocity held from rest: after the memory, 1 - 1/e of the way, in any step size.
+        let v = [Vec3::new(0.1, 0.0, 0.0)];
+        for steps in [1, 10, 1000] {
+            let mut mean = [Vec3::zeros()];
+            for _ in 0..steps {
+                follow_skin_mean(&m, &v, memory / steps as f64, &mut mean);
+            }
+            let want = (1.0 - (-1.0f64).exp()) * (v[0] - m.current);
+            assert!((mean[0] - want).norm() < 1e-14, "{steps} steps: {:?}", mean[0]);
+        }
+        // An oscillation much faster than the memory barely moves it.
+        let (mut mean, h, omega) = ([Vec3::zeros()], 1e-3, 2.0 * std::f64::consts::PI * 2.0);
+        m.current = Vec3::zeros();
+        let mut peak: f64 = 0.0;
+        for k in 0..4000 {
+            let v = [Vec3::new(0.1 * (omega * k as f64 * h).sin(), 0.0, 0.0)];
+            follow_skin_mean(&m, &v, h, &mut mean);
+            peak = peak.max(mean[0].norm());
+        }
+        // A first-order low-pass passes 1 / sqrt(1 + (omega T)^2) of the amplitude.
+        let pass = 1.0 / (1.0 + (omega * memory).powi(2)).sqrt();
+        assert!(peak < 0.1 * 2.0 * pass, "peak {peak}");
+    }
 }

@@ -208,6 +208,7 @@ mod tests {
                 colliders: &[],
                 prior_forces: &prior,
                 weights: Weights([self.w0; 2]),
+                skin_mean: &[],
             };
             let mut f = vec![Vec3::zeros(); n];
             total_forces(&input, &mut ForceScratch::default(), &mut f);
@@ -230,6 +231,7 @@ mod tests {
                 colliders: &[],
                 prior_forces: &[],
                 weights: Weights([self.w0; 2]),
+                skin_mean: &[],
             };
             let mut out = Linearisation::default();
             linearise(&input, &[], &[], &mut out);

@@ -40,6 +40,7 @@ mod wide_drag;
 // and the forces of a state (`total_forces` on a `ForceInput`).
 pub use body::{body_acceleration, body_force};
 pub use contact::{Capsule, Collider, Plane, Sphere};
+pub use drag::follow_skin_mean;
 pub use elements::{damping_rate, DampingRate, Memory, Weights};
 pub use inertia::Inertia;
 pub use memories::{memories, Memories};

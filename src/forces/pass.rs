@@ -39,6 +39,9 @@ pub struct ForceInput<'a> {
     /// The current-rate weight w0 of each memory's D^{1/2} this step (what the implicit
     /// integrator treats as damping).
     pub weights: super::Weights,
+    /// The running mean of the relative velocity the unsteady skin drag acts against (m/s,
+    /// one per particle); empty when the model has none.
+    pub skin_mean: &'a [Vec3],
 }
 
 /// Scratch buffers the force pass reuses (no allocation in a step).
@@ -210,6 +213,7 @@ pub fn for_each_tile_ahead<S>(
             normals: normals.map(|n| &n[p0..p0 + len]),
             masses: &masses[p0..p0 + len],
             areas: &areas[p0..p0 + len],
+            skin_mean: input.skin_mean.get(p0..p0 + len),
         };
         let [fx, fy, fz] = s;
         if let Some(prior) = input.prior_forces.get(p0..p0 + len) {

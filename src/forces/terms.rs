@@ -34,6 +34,9 @@ pub struct Tile<'b> {
     pub masses: &'b [f64],
     /// Lumped areas, m^2 (what per-unit-area coefficients multiply).
     pub areas: &'b [f64],
+    /// The running mean of the relative velocity the unsteady skin drag acts against, m/s
+    /// (None when the model has none).
+    pub skin_mean: Option<&'b [Vec3]>,
 }
 
 /// What the terms read at one step besides a tile.
@@ -226,15 +229,17 @@ const FORM_DRAG: Term = Term {
 /// Skin drag on the velocity along the cloth relative to the water, linear.
 const SKIN_DRAG: Term = Term {
     name: "skin drag",
-    on: |m, _| m.water.skin_drag != 0.0,
+    on: |m, _| m.water.skin_drag != 0.0 || m.water.skin_drag_unsteady != 0.0,
     reads: Reads::NORMALS,
     add: |c, t, f| {
         if let Some(n) = t.normals {
-            drag::add_skin(c.model, t.v, n, t.areas, f);
+            drag::add_skin(c.model, t.v, n, t.areas, t.skin_mean, f);
         }
     },
     linearise: Some(|c, p, b| {
-        let k = c.model.water.skin_drag * p.area;
+        // The running mean is held over the step: the velocity's own coefficient.
+        let w = &c.model.water;
+        let k = (w.skin_drag + w.skin_drag_unsteady) * p.area;
         b.damping += k * (Matrix3::identity() - p.normal * p.normal.transpose());
     }),
 };
@@ -323,6 +328,8 @@ mod tests {
             normals: Some(&normals),
             masses: &[2e-4],
             areas: &[1.5e-4],
+            // The unsteady skin drag's running mean, held over the step.
+            skin_mean: Some(&[Vec3::new(0.04, -0.01, 0.02)]),
         };
         let mut f = [[0.0], [0.0], [0.0]];
         let [a, b, d] = &mut f;
@@ -351,6 +358,8 @@ mod tests {
         m.water.normal_drag = 5.0;
         m.water.form_drag = 1.2;
         m.water.skin_drag = 0.7;
+        m.water.skin_drag_unsteady = 0.9;
+        m.water.skin_drag_memory = 1.0;
         m.current = Vec3::new(0.05, -0.02, 0.01);
         let plane = Collider::Plane(Plane {
             point: Vec3::new(0.0, -0.004, 0.0),

@@ -787,6 +787,7 @@ mod tests {
                 colliders: &[],
                 prior_forces: &[],
                 weights: Default::default(),
+                skin_mean: &[],
             };
             let mut f = vec![Vec3::zeros(); n];
             total_forces(&input, &mut ForceScratch::default(), &mut f);

@@ -17,7 +17,8 @@
 //! spreads a vertex's value over its first ring with mean square radius `r1^2` (measured on
 //! the rest mesh, [`pass_spread`]), and the mean squares of passes add, so a smoothing of rms
 //! radius `L` takes `L^2 / r1^2` passes: the same length on any mesh, at any resolution (and
-//! a cost that grows as `(L / spacing)^2`: 2 passes at 1 cm for the preset's 1.2 cm, 8 at
+//! a cost that grows as `(L / spacing)^2`: about 1.4 passes at 1 cm for the preset's 1 cm (2 for
+//! the 1.2 cm it had before 0.9.26), 5.6 at
 //! 0.5 cm, at most [`MAX_PASSES`]). A pass runs its rows in blocks of eight, one vector lane a
 //! row ([`Blocks`]), with the bits of the rows summed one by one.
 

@@ -29,7 +29,7 @@ this add-on.
 bl_info = {
     "name": "fraccloth: underwater cloth",
     "author": "fraccloth developers",
-    "version": (0, 9, 25),
+    "version": (0, 9, 26),
     "blender": (4, 2, 0),
     "location": "Properties > Physics > fraccloth",
     "description": "Cloth that moves as if underwater (fractional mass-spring model), baked to a point cache",
@@ -84,19 +84,19 @@ PRESETS = {
         "stretch_stiffness": 4.0, "shear_stiffness": 0.8, "bend_stiffness": 0.02, "bend_spacing": 0.01,
         "damping_mode": "VELOCITY", "spring_damping": 0.005, "history_drag": 0.0, "viscous_drag": 0.0,
         "normal_drag": 0.0, "mass_per_area": 0.1, "cloth_density": 1300.0, "water_density": 1000.0,
-        "entrained_mass": 2.0, "added_mass": 0.0, "form_drag": 1.0, "form_drag_scale": 0.0, "skin_drag": 0.5, "coarse_added_mass": 0.0,
+        "entrained_mass": 2.0, "added_mass": 0.0, "form_drag": 1.0, "form_drag_scale": 0.0, "skin_drag": 0.5, "skin_drag_unsteady": 0.0, "skin_drag_memory": 1.0, "coarse_added_mass": 0.0,
         "history": "OFF", "integrator": "SYMPLECTIC"}),
     "CANVAS": ("Heavy canvas", "A heavy sheet: sinks and folds in broad, slow waves", {
         "stretch_stiffness": 40.0, "shear_stiffness": 8.0, "bend_stiffness": 4.0, "bend_spacing": 0.01,
         "damping_mode": "VELOCITY", "spring_damping": 0.05, "history_drag": 0.0, "viscous_drag": 0.0,
         "normal_drag": 0.0, "mass_per_area": 2.0, "cloth_density": 1500.0, "water_density": 1000.0,
-        "entrained_mass": 10.0, "added_mass": 0.0, "form_drag": 1.5, "form_drag_scale": 0.0, "skin_drag": 0.0, "coarse_added_mass": 0.0,
+        "entrained_mass": 10.0, "added_mass": 0.0, "form_drag": 1.5, "form_drag_scale": 0.0, "skin_drag": 0.0, "skin_drag_unsteady": 0.0, "skin_drag_memory": 1.0, "coarse_added_mass": 0.0,
         "history": "OFF", "integrator": "SYMPLECTIC"}),
     "PAPER": ("Fractional (paper)", "The paper's fractional cloth: half-derivative springs and drags, no water inertia", {
         "stretch_stiffness": 10.0, "shear_stiffness": 2.0, "bend_stiffness": 0.5, "bend_spacing": 0.0,
         "damping_mode": "FRACTIONAL", "spring_damping": 0.35, "history_drag": 2e-3, "viscous_drag": 1e-3,
         "normal_drag": 0.0, "mass_per_area": 1.0, "cloth_density": 1100.0, "water_density": 1000.0,
-        "entrained_mass": 0.0, "added_mass": 0.0, "form_drag": 0.0, "form_drag_scale": 0.0, "skin_drag": 0.0, "coarse_added_mass": 0.0,
+        "entrained_mass": 0.0, "added_mass": 0.0, "form_drag": 0.0, "form_drag_scale": 0.0, "skin_drag": 0.0, "skin_drag_unsteady": 0.0, "skin_drag_memory": 1.0, "coarse_added_mass": 0.0,
         "history": "SOE", "integrator": "SYMPLECTIC"}),
 }
 PRESET_ITEMS = [("CUSTOM", "Custom", "Your own values")] + [(k, v[0], v[1]) for k, v in PRESETS.items()]
@@ -136,6 +136,7 @@ def _library_preset():
         "mass_per_area": d.areal_density, "cloth_density": d.cloth_density, "water_density": d.water_density,
         "entrained_mass": d.entrained_mass, "added_mass": d.added_mass, "form_drag": d.form_drag,
         "form_drag_scale": d.form_drag_scale, "skin_drag": d.skin_drag,
+        "skin_drag_unsteady": d.skin_drag_unsteady, "skin_drag_memory": d.skin_drag_memory or SKIN_MEMORY,
         # The patch size is unused while the large-scale water is off (the preset's 0): the
         # panel then shows a usable one.
         "coarse_added_mass": d.coarse_added_mass, "coarse_length": d.coarse_length or COARSE_LENGTH,
@@ -147,6 +148,8 @@ def _library_preset():
 # The panel's patch size for the large-scale water when the library's preset gives none (its
 # term off), m: a few patches across a towel (docs/underwater.md, "The water's inertia by scale").
 COARSE_LENGTH = 0.2
+# The skin drag's memory the panel shows while its unsteady part is off (the library's 0 then).
+SKIN_MEMORY = 1.0
 
 
 # True while a preset writes its values (so that they do not count as the artist's edits).
@@ -194,8 +197,10 @@ class FracclothSettings(bpy.types.PropertyGroup):
     entrained_mass: bpy.props.FloatProperty(name="Water carried", description="Water the cloth drags along as it moves, kg per m^2 of cloth: makes it slow and heavy in the water", default=0.0, min=0.0, soft_max=40.0, update=_edited)
     added_mass: bpy.props.FloatProperty(name="Added mass (across)", description="Water moved by motion across the cloth only, kg per m^2", default=8.0, min=0.0, soft_max=40.0, update=_edited)
     form_drag: bpy.props.FloatProperty(name="Form drag", description="Drag coefficient of the cloth moving face first through water (1 to 2 for a sheet)", default=1.0, min=0.0, soft_max=4.0, update=_edited)
-    form_drag_scale: bpy.props.FloatProperty(name="Drag ripple size", description="Ripples shorter than about this shed little drag, so a brisk swing keeps its small bumps while the cloth's motion at large is slowed in full (0: every ripple is dragged), m", default=0.012, min=0.0, soft_max=0.1, precision=3, update=_edited)
-    skin_drag: bpy.props.FloatProperty(name="Skin drag", description="Drag of water sliding along the cloth, N s/m^3", default=1.15, min=0.0, soft_max=5.0, update=_edited)
+    form_drag_scale: bpy.props.FloatProperty(name="Drag ripple size", description="Ripples shorter than about this shed little drag, so a brisk swing keeps its small bumps while the cloth's motion at large is slowed in full (0: every ripple is dragged), m", default=0.010, min=0.0, soft_max=0.1, precision=3, update=_edited)
+    skin_drag: bpy.props.FloatProperty(name="Skin drag", description="Drag of water sliding along the cloth in a steady flow, N s/m^3", default=1.15, min=0.0, soft_max=5.0, update=_edited)
+    skin_drag_unsteady: bpy.props.FloatProperty(name="Skin drag, to and fro", description="More drag on sliding that changes faster than the memory below (a swing's motion along the cloth), N s/m^3; 0: off", default=1.36, min=0.0, soft_max=5.0, update=_edited)
+    skin_drag_memory: bpy.props.FloatProperty(name="Skin drag memory", description="How long a flow along the cloth takes to count as steady, s", default=1.0, min=1e-3, soft_max=10.0, update=_edited)
     coarse_added_mass: bpy.props.FloatProperty(name="Added mass at large", description="More water carried when the cloth moves as a whole (smoother than the patch size), kg per m^2; ripples carry only the added mass across. 0: off (the presets). Costs a small solve a step", default=0.0, min=0.0, soft_max=200.0, update=_edited)
     coarse_length: bpy.props.FloatProperty(name="Patch size", description="Size of the patches over which the cloth's motion counts as motion at large, m (the library refuses one that makes more than 256 patches over the cloth, naming one that fits)", default=COARSE_LENGTH, min=1e-3, soft_max=1.0, precision=3, update=_edited)
     current: bpy.props.FloatVectorProperty(name="Current", description="Water current, m/s (world)", default=(0.0, 0.0, 0.0), size=3)
@@ -443,6 +448,8 @@ def describe(s, scene=None):
     desc.form_drag = s.form_drag
     desc.form_drag_scale = s.form_drag_scale
     desc.skin_drag = s.skin_drag
+    desc.skin_drag_unsteady = s.skin_drag_unsteady
+    desc.skin_drag_memory = s.skin_drag_memory if s.skin_drag_unsteady > 0.0 else 0.0
     desc.coarse_added_mass = s.coarse_added_mass
     desc.coarse_length = s.coarse_length if s.coarse_added_mass > 0.0 else 0.0
     desc.collision_margin = s.collision_margin
@@ -798,7 +805,7 @@ class FRACCLOTH_PT_panel(bpy.types.Panel):
             ("Cloth", ("mass_per_area", "cloth_density", "stretch_stiffness", "shear_stiffness", "bend_stiffness",
                        "bend_spacing", "damping_mode", "spring_damping")),
             ("Water", ("water_density", "entrained_mass", "added_mass", "coarse_added_mass", "coarse_length", "form_drag",
-                       "form_drag_scale", "skin_drag", "history_drag",
+                       "form_drag_scale", "skin_drag", "skin_drag_unsteady", "skin_drag_memory", "history_drag",
                        "viscous_drag", "normal_drag", "current")),
             ("Colliders", ("collider_shape", "friction", "collision_margin", "self_collision", "self_collision_spacings",
                            "self_friction")),

@@ -188,7 +188,7 @@ def test_the_underwater_preset_is_the_librarys(addon, tmp_path):
     want = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
     for field in ("stretch_stiffness", "shear_stiffness", "bend_stiffness", "bend_reference_spacing", "spring_damping", "spring_damping_mode",
                   "entrained_mass", "added_mass", "coarse_added_mass", "coarse_length", "form_drag", "form_drag_scale",
-                  "skin_drag", "cloth_density", "water_density",
+                  "skin_drag", "skin_drag_unsteady", "skin_drag_memory", "cloth_density", "water_density",
                   "integrator", "viscous_drag", "history_drag", "normal_drag", "viscous_drag_per_area",
                   "history_drag_per_area", "normal_drag_per_area"):
         assert getattr(got, field) == pytest.approx(getattr(want, field), rel=1e-6), field

@@ -340,7 +340,7 @@ def test_triangle_mesh_collider_and_self_collision():
 def test_a_description_prints_its_fields():
     desc = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
     text = repr(desc)
-    assert text.startswith("FcClothDesc(") and "added_mass=8.0" in text and "form_drag_scale=0.012" in text and "gravity=(0.0, -9.81, 0.0)" in text
+    assert text.startswith("FcClothDesc(") and "added_mass=8.0" in text and "form_drag_scale=0.01" in text and "skin_drag_unsteady=1.36" in text and "gravity=(0.0, -9.81, 0.0)" in text
     assert str(desc) == text and text.count("=") == len(fraccloth.FcClothDesc._fields_)
 
 
