@@ -12,7 +12,7 @@ bake() {  # name, then the baker's options
   local name="$1"; shift
   "$BIN" --quiet --out "$OUT/$name" "$@" > "$OUT/$name.txt" 2>&1 || { echo "$name: refused"; tail -3 "$OUT/$name.txt"; return 0; }
   echo "== $name ($*)"
-  grep -E "^(half-waves|travel|mid / bottom|zigzag|hang depth|streaming angle|flutter) " "$OUT/$name.txt" | sed 's/^/   /'
+  grep -E "^(half-waves|travel|mid / bottom|zigzag|hang depth|streaming angle|flutter|look) " "$OUT/$name.txt" | sed 's/^/   /' || true
 }
 mkdir -p "$OUT"
 for f in 0.25 0.5 1 2; do bake "swing-${f}hz" --frequency "$f"; done
