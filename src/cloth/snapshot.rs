@@ -587,7 +587,8 @@ mod tests {
     use super::*;
     use crate::{ClothConfig, GridSpec, Vec3};
 
-    fn cloth(scheme: Scheme) -> Cloth {
+    /// A 6 x 5 cloth of `model`, symplectic Euler, its first three vertices pinned.
+    fn small(model: crate::Model, scheme: Scheme) -> Cloth {
         let t = GridSpec {
             width: 6,
             height: 5,
@@ -599,6 +600,7 @@ mod tests {
         let mut c = Cloth::new(
             t,
             ClothConfig {
+                model,
                 scheme,
                 integrator: crate::Integrator::SymplecticEuler,
                 ..ClothConfig::default()
@@ -606,6 +608,11 @@ mod tests {
         )
         .unwrap();
         c.set_pinned(&[0, 1, 2]).unwrap();
+        c
+    }
+
+    fn cloth(scheme: Scheme) -> Cloth {
+        let mut c = small(crate::Model::default(), scheme);
         c.pin_group(&[5], 0.5).unwrap();
         let id = c
             .add_collider(Collider::Capsule(Capsule {
@@ -647,28 +654,7 @@ mod tests {
     /// velocities relative to the water.
     #[test]
     fn the_skin_drags_running_mean_continues_bitwise_from_a_snapshot() {
-        let make = || {
-            let t = GridSpec {
-                width: 6,
-                height: 5,
-                spacing: 0.01,
-                total_mass: 0.003,
-            }
-            .build()
-            .unwrap();
-            let mut c = Cloth::new(
-                t,
-                ClothConfig {
-                    model: crate::Model::underwater(),
-                    scheme: Scheme::Off,
-                    integrator: crate::Integrator::SymplecticEuler,
-                    ..ClothConfig::default()
-                },
-            )
-            .unwrap();
-            c.set_pinned(&[0, 1, 2]).unwrap();
-            c
-        };
+        let make = || small(crate::Model::underwater(), Scheme::Off);
         let mut a = make();
         let rest: Vec<Vec3> = a.positions()[..3].to_vec();
         // The pins slide to and fro along the cloth's plane.
