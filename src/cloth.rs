@@ -306,6 +306,13 @@ impl Cloth {
             ));
         }
         forces::coarse_water::check(&self.topology, &config.model)?;
+        // The unsteady skin drag turned on starts from the flow as it is (no sudden start),
+        // its room asked for before anything changes.
+        let new_mean = if config.model.water.unsteady_skin() && self.skin_mean.is_empty() {
+            Some(self.flow_mean(config.model.current)?)
+        } else {
+            None
+        };
         let thickness = config.model.self_collision_thickness;
         let old_thickness = old.model.self_collision_thickness;
         self.self_collision
@@ -314,18 +321,24 @@ impl Cloth {
             // The pair list was found for the old reach.
             self.self_collision.look_again();
         }
-        // The unsteady skin drag turned on starts from the flow as it is (no sudden start);
-        // turned off, its mean is dropped.
-        match (config.model.water.unsteady_skin(), self.skin_mean.is_empty()) {
-            (true, true) => {
-                let c = config.model.current;
-                self.skin_mean = self.v.iter().map(|v| v - c).collect();
-            }
-            (false, false) => self.skin_mean = Vec::new(),
-            _ => {}
+        if let Some(mean) = new_mean {
+            self.skin_mean = mean;
+        } else if !config.model.water.unsteady_skin() {
+            // Turned off: its mean is dropped.
+            self.skin_mean = Vec::new();
         }
         self.config = config;
         Ok(())
+    }
+
+    /// The velocities relative to a water of current `current`: where the unsteady skin drag's
+    /// running mean starts (a flow that has always been there). Out of memory, an error.
+    fn flow_mean(&self, current: Vec3) -> Result<Vec<Vec3>, Error> {
+        let mut mean = Vec::new();
+        mean.try_reserve_exact(self.v.len())
+            .map_err(|_| Error::out_of_memory("the skin drag's running mean cannot be allocated"))?;
+        mean.extend(self.v.iter().map(|v| v - current));
+        Ok(mean)
     }
 
     pub fn topology(&self) -> &Topology {

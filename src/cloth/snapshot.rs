@@ -396,7 +396,10 @@ impl Cloth {
         if !self.config.model.water.unsteady_skin() {
             skin_mean.clear();
         } else if skin_mean.is_empty() {
-            skin_mean = v.iter().map(|vk| vk - current).collect();
+            skin_mean
+                .try_reserve_exact(n)
+                .map_err(|_| Error::out_of_memory("loading a snapshot: no room for the skin drag's mean"))?;
+            skin_mean.extend(v.iter().map(|vk| vk - current));
         }
         if r.remaining() != 4 {
             return Err(Error::invalid("snapshot has trailing data"));
@@ -709,6 +712,33 @@ mod tests {
         let before = d.save_snapshot().unwrap();
         assert!(d.load_snapshot(&bad).is_err());
         assert_eq!(d.save_snapshot().unwrap(), before);
+    }
+
+    /// A reconfigure that turns the unsteady skin drag off drops its mean; one that turns it
+    /// on starts it from the flow as it is; one that keeps it keeps the mean.
+    #[test]
+    fn reconfiguring_the_unsteady_skin_drag_drops_or_starts_its_mean() {
+        let mut c = small(crate::Model::underwater(), Scheme::Off);
+        for k in 0..50 {
+            let s = Vec3::new(0.001 * f64::from(k), 0.0, 0.0);
+            let targets: Vec<Vec3> = (0..3).map(|i| c.topology.rest_positions[i] + s).collect();
+            c.set_pin_targets(&[0, 1, 2], &targets).unwrap();
+            c.step(1e-3).unwrap();
+        }
+        let kept = c.skin_mean.clone();
+        assert_eq!(kept.len(), c.vertex_count());
+        let mut config = c.config.clone();
+        config.model.current = Vec3::new(0.0, 0.0, 0.05);
+        c.reconfigure(config.clone()).unwrap();
+        assert_eq!(c.skin_mean, kept, "kept while the term stays on");
+        config.model.water.skin_drag_unsteady = 0.0;
+        c.reconfigure(config.clone()).unwrap();
+        assert!(c.skin_mean.is_empty());
+        config.model.water.skin_drag_unsteady = 1.0;
+        c.reconfigure(config).unwrap();
+        let want: Vec<Vec3> = c.v.iter().map(|v| v - Vec3::new(0.0, 0.0, 0.05)).collect();
+        assert_eq!(c.skin_mean, want);
+        c.step(1e-3).unwrap();
     }
 
     /// Implicit Euler's automatic step reads the motion's averages (`cloth/motion.rs`): a
