@@ -614,6 +614,17 @@ mod tests {
         c
     }
 
+    /// A snapshot's body (header and payload, no checksum) made whole as format `version`: its
+    /// version and payload length written, its checksum appended.
+    fn sealed(mut body: Vec<u8>, version: u32) -> Vec<u8> {
+        body[8..12].copy_from_slice(&version.to_le_bytes());
+        let payload = (body.len() - HEADER) as u64;
+        body[16..24].copy_from_slice(&payload.to_le_bytes());
+        let crc = crc32fast::hash(&body);
+        body.extend_from_slice(&crc.to_le_bytes());
+        body
+    }
+
     fn cloth(scheme: Scheme) -> Cloth {
         let mut c = small(crate::Model::default(), scheme);
         c.pin_group(&[5], 0.5).unwrap();
@@ -681,7 +692,7 @@ mod tests {
         let mut c = make();
         c.load_snapshot(&snap).unwrap();
         let current = c.config.model.current;
-        c.skin_mean = c.v.iter().map(|v| v - current).collect();
+        c.skin_mean = c.flow_mean(current).unwrap();
         for k in 300..400 {
             for cloth in [&mut a, &mut b, &mut c] {
                 drive(cloth, k);
@@ -691,12 +702,7 @@ mod tests {
         assert_eq!(a.positions(), b.positions());
         assert_ne!(a.positions(), c.positions(), "the mean is state");
         // A version-7 snapshot (no mean): the mean starts from the loaded flow.
-        let mut old = snap[..snap.len() - 4 - 8 - 24 * n].to_vec();
-        old[8..12].copy_from_slice(&7u32.to_le_bytes());
-        let payload = (old.len() - HEADER) as u64;
-        old[16..24].copy_from_slice(&payload.to_le_bytes());
-        let crc = crc32fast::hash(&old);
-        old.extend_from_slice(&crc.to_le_bytes());
+        let old = sealed(snap[..snap.len() - 4 - 8 - 24 * n].to_vec(), 7);
         let mut d = make();
         d.load_snapshot(&old).unwrap();
         let want: Vec<Vec3> = d.v.iter().map(|v| v - current).collect();
@@ -705,10 +711,7 @@ mod tests {
         let mut bad = snap[..snap.len() - 4 - 8 - 24 * n].to_vec();
         bad.extend_from_slice(&1u64.to_le_bytes());
         bad.extend_from_slice(&[0u8; 24]);
-        let payload = (bad.len() - HEADER) as u64;
-        bad[16..24].copy_from_slice(&payload.to_le_bytes());
-        let crc = crc32fast::hash(&bad);
-        bad.extend_from_slice(&crc.to_le_bytes());
+        let bad = sealed(bad, SNAPSHOT_VERSION);
         let before = d.save_snapshot().unwrap();
         assert!(d.load_snapshot(&bad).is_err());
         assert_eq!(d.save_snapshot().unwrap(), before);
@@ -780,12 +783,7 @@ mod tests {
         // A version-6 snapshot (no averages, and no skin drag mean: 8 bytes of an empty
         // list here) loads with the motion unseen.
         assert!(a.skin_mean.is_empty());
-        let mut old = snap[..snap.len() - 4 - 8 - 16].to_vec();
-        old[8..12].copy_from_slice(&6u32.to_le_bytes());
-        let payload = (old.len() - HEADER) as u64;
-        old[16..24].copy_from_slice(&payload.to_le_bytes());
-        let crc = crc32fast::hash(&old);
-        old.extend_from_slice(&crc.to_le_bytes());
+        let old = sealed(snap[..snap.len() - 4 - 8 - 16].to_vec(), 6);
         let mut c = make();
         c.load_snapshot(&old).unwrap();
         assert_eq!(c.motion_frequency(), 0.0);

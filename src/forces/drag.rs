@@ -55,8 +55,8 @@ fn add_history_kernel(m: &Model, v: [&[f64]; 3], d: [&[f64]; 3], areas: &[f64], 
     }
 }
 
-/// Adds `g(k, rel, n, area)` to every particle's force, particle by particle, with `rel` the
-/// velocity relative to the water and `n` the unit normal.
+/// Adds `g(t, rel, n, area)` to every particle's force, particle by particle, with `t` its
+/// place in the tile, `rel` the velocity relative to the water and `n` the unit normal.
 #[inline(always)]
 fn add_with_normals(
     m: &Model,
@@ -64,12 +64,12 @@ fn add_with_normals(
     n: &[Vec3],
     areas: &[f64],
     f: [&mut [f64]; 3],
-    g: impl Fn(Vec3, &Vec3, f64) -> Vec3,
+    g: impl Fn(usize, Vec3, &Vec3, f64) -> Vec3,
 ) {
     let [fx, fy, fz] = f;
     for (t, nt) in n.iter().enumerate().take(fx.len()) {
         let rel = Vec3::new(v[0][t], v[1][t], v[2][t]) - m.current;
-        let total = Vec3::new(fx[t], fy[t], fz[t]) + g(rel, nt, areas[t]);
+        let total = Vec3::new(fx[t], fy[t], fz[t]) + g(t, rel, nt, areas[t]);
         (fx[t], fy[t], fz[t]) = (total.x, total.y, total.z);
     }
 }
@@ -77,7 +77,7 @@ fn add_with_normals(
 /// Normal drag with unit normals `n`: `-k (v_rel . n) n`.
 pub(super) fn add_normal(m: &Model, v: [&[f64]; 3], n: &[Vec3], areas: &[f64], f: [&mut [f64]; 3]) {
     let (k, ka) = (m.normal_drag, m.water.normal_drag);
-    add_with_normals(m, v, n, areas, f, |rel, nt, a| {
+    add_with_normals(m, v, n, areas, f, |_, rel, nt, a| {
         -(super::terms::per_particle(k, ka, a) * rel.dot(nt) * nt)
     });
 }
@@ -85,7 +85,7 @@ pub(super) fn add_normal(m: &Model, v: [&[f64]; 3], n: &[Vec3], areas: &[f64], f
 /// Form drag: `-1/2 rho_w C_d A |v_n| v_n n`, quadratic in the normal velocity.
 pub(super) fn add_form(m: &Model, v: [&[f64]; 3], n: &[Vec3], areas: &[f64], f: [&mut [f64]; 3]) {
     let c = 0.5 * m.water_density * m.water.form_drag;
-    add_with_normals(m, v, n, areas, f, |rel, nt, a| {
+    add_with_normals(m, v, n, areas, f, |_, rel, nt, a| {
         let vn = rel.dot(nt);
         -(c * a * vn.abs() * vn) * nt
     });
@@ -105,16 +105,11 @@ pub(super) fn add_skin(
 ) {
     let (k, ku) = (m.water.skin_drag, m.water.skin_drag_unsteady);
     match mean {
-        Some(mean) if ku != 0.0 => {
-            let [fx, fy, fz] = f;
-            for (t, nt) in n.iter().enumerate().take(fx.len()) {
-                let rel = Vec3::new(v[0][t], v[1][t], v[2][t]) - m.current;
-                let w = (k + ku) * rel - ku * mean[t];
-                let total = Vec3::new(fx[t], fy[t], fz[t]) - areas[t] * (w - w.dot(nt) * nt);
-                (fx[t], fy[t], fz[t]) = (total.x, total.y, total.z);
-            }
-        }
-        _ => add_with_normals(m, v, n, areas, f, |rel, nt, a| {
+        Some(mean) if ku != 0.0 => add_with_normals(m, v, n, areas, f, |t, rel, nt, a| {
+            let w = (k + ku) * rel - ku * mean[t];
+            -(a * (w - w.dot(nt) * nt))
+        }),
+        _ => add_with_normals(m, v, n, areas, f, |_, rel, nt, a| {
             -(k * a) * (rel - rel.dot(nt) * nt)
         }),
     }
