@@ -315,8 +315,11 @@ impl Cloth {
         };
         let thickness = config.model.self_collision_thickness;
         let old_thickness = old.model.self_collision_thickness;
-        self.self_collision
-            .prepare(&self.topology.rest_positions, &self.topology.triangles, thickness)?;
+        // On the cloth's threads (its lists are made on the pool for a large cloth): a cloth
+        // told to stay on the calling thread touches no other.
+        let (threads, topology) = (self.threads.clone(), &self.topology);
+        let self_collision = &mut self.self_collision;
+        threads.run(|| self_collision.prepare(&topology.rest_positions, &topology.triangles, thickness))?;
         if thickness != old_thickness {
             // The pair list was found for the old reach.
             self.self_collision.look_again();

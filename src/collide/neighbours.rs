@@ -10,9 +10,33 @@
 
 use super::bvh::{Aabb, Bvh};
 use super::ownership::Ownership;
-use super::room::Room;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU8, AtomicUsize, Ordering::Relaxed};
+
+use super::room::{Full, Room};
 use super::self_collision::{edge_edge, vertex_triangle};
 use crate::math::Vec3;
+
+/// The triangles' rest boxes grown by half the exclusion radius, and their tree: two triangles
+/// are rest-near when their boxes overlap, and a vertex is within the radius of a triangle's
+/// box when its own point grown by half the radius overlaps it. Built once for both lists.
+pub(super) struct RestTree {
+    boxes: Vec<Aabb>,
+    bvh: Bvh,
+    half: f64,
+}
+
+impl RestTree {
+    pub(super) fn new(rest: &[Vec3], triangles: &[[u32; 3]], radius: f64) -> RestTree {
+        let half = 0.5 * radius;
+        let boxes: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize])).inflated(half))
+            .collect();
+        let bvh = Bvh::build(&boxes);
+        RestTree { boxes, bvh, half }
+    }
+}
 
 /// Each vertex's (edge's) excluded triangles (edges), sorted, as compressed rows.
 #[derive(Clone, Debug, Default)]
@@ -25,61 +49,48 @@ pub(super) struct Exclusions {
 }
 
 impl Exclusions {
-    /// The pairs nearer than `radius` at the rest positions `rest`; `None` when `room` ran out
-    /// (it says why).
+    /// The pairs nearer than `radius` at the rest positions `rest` (`tree` the triangles' at
+    /// that radius); `None` when `room` ran out (it says why). The searches run on rayon's
+    /// current pool when `parallel`; the lists, and whether the room suffices, are the same
+    /// either way.
     pub(super) fn new(
         rest: &[Vec3],
         triangles: &[[u32; 3]],
         edges: &[[u32; 2]],
         radius: f64,
+        tree: &RestTree,
         room: &mut Room,
+        parallel: bool,
     ) -> Option<Exclusions> {
-        let boxes: Vec<Aabb> = triangles
-            .iter()
-            .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize])).inflated(radius))
-            .collect();
-        let bvh = Bvh::build(&boxes);
-        let (mut vt_start, mut vt) = (vec![0u32], Vec::new());
-        for p in 0..rest.len() as u32 {
-            let first = vt.len();
+        let (vt_start, vt) = rows(rest.len(), parallel, room, |p, push| {
             let q = Aabb {
                 min: rest[p as usize],
                 max: rest[p as usize],
-            };
-            bvh.overlapping(&q, |t| {
+            }
+            .inflated(tree.half);
+            tree.bvh.overlapping(&q, |t| {
                 let tri = &triangles[t as usize];
                 if tri.contains(&p) || vertex_triangle(rest, p, tri).0 < radius {
-                    room.push(&mut vt, t);
+                    push(t);
                 }
             });
-            if room.full.is_some() {
-                return None;
-            }
-            vt[first..].sort_unstable();
-            vt_start.push(vt.len() as u32);
-        }
+        })?;
         let boxes: Vec<Aabb> = edges
             .iter()
             .map(|e| Aabb::of(e.iter().map(|&i| &rest[i as usize])).inflated(0.5 * radius))
             .collect();
         let bvh = Bvh::build(&boxes);
-        let (mut ee_start, mut ee) = (vec![0u32], Vec::new());
-        for (e, edge) in edges.iter().enumerate() {
-            let first = ee.len();
-            bvh.overlapping(&boxes[e], |f| {
+        let (ee_start, ee) = rows(edges.len(), parallel, room, |e, push| {
+            let edge = &edges[e as usize];
+            bvh.overlapping(&boxes[e as usize], |f| {
                 let other = &edges[f as usize];
-                if f as usize > e
+                if f > e
                     && (edge.iter().any(|v| other.contains(v)) || edge_edge(rest, edge, other).0 < radius)
                 {
-                    room.push(&mut ee, f);
+                    push(f);
                 }
             });
-            if room.full.is_some() {
-                return None;
-            }
-            ee[first..].sort_unstable();
-            ee_start.push(ee.len() as u32);
-        }
+        })?;
         Some(Exclusions {
             radius,
             vt_start,
@@ -127,6 +138,107 @@ impl Exclusions {
     }
 }
 
+/// Items per task of [`rows`]: fixed, so the rows never depend on the thread count.
+const ROWS_PER_TASK: usize = 4096;
+
+/// Why a task of [`rows`] stopped early.
+const STOPPED_ENTRIES: u8 = 1;
+const STOPPED_MEMORY: u8 = 2;
+
+/// Compressed rows (starts, entries) of items `0..count`: item `i`'s entries are what
+/// `row(i, push)` pushes, sorted. Tasks of [`ROWS_PER_TASK`] items run in parallel when
+/// `parallel`; their rows are joined in order, so the result never depends on the split. Every
+/// row is counted against `room` exactly once, whole, so whether the room suffices does not
+/// depend on the order the tasks run in (a sum of some rows past it means the sum of all is);
+/// every list grows fallibly. `None` (with `room.full` saying why) when the room or memory ran
+/// out.
+fn rows<F>(count: usize, parallel: bool, room: &mut Room, row: F) -> Option<(Vec<u32>, Vec<u32>)>
+where
+    F: Fn(u32, &mut dyn FnMut(u32)) + Sync,
+{
+    if room.full.is_some() {
+        return None;
+    }
+    let left = AtomicUsize::new(room.left());
+    let stopped = AtomicU8::new(0);
+    // One task: its rows' lengths and entries.
+    let task = |k: usize| -> Option<(Vec<u32>, Vec<u32>)> {
+        let items = k * ROWS_PER_TASK..((k + 1) * ROWS_PER_TASK).min(count);
+        let (mut lengths, mut entries) = (Vec::new(), Vec::<u32>::new());
+        if lengths.try_reserve_exact(items.len()).is_err() {
+            stopped.store(STOPPED_MEMORY, Relaxed);
+            return None;
+        }
+        for i in items {
+            if stopped.load(Relaxed) != 0 {
+                return None;
+            }
+            let first = entries.len();
+            let mut refused = false;
+            row(i as u32, &mut |t| {
+                if fallible_room(&mut entries, 1) {
+                    entries.push(t);
+                } else {
+                    refused = true;
+                }
+            });
+            let len = entries.len() - first;
+            if refused {
+                stopped.store(STOPPED_MEMORY, Relaxed);
+                return None;
+            }
+            if left
+                .fetch_update(Relaxed, Relaxed, |l| l.checked_sub(len))
+                .is_err()
+            {
+                stopped.store(STOPPED_ENTRIES, Relaxed);
+                return None;
+            }
+            entries[first..].sort_unstable();
+            lengths.push(len as u32);
+        }
+        Some((lengths, entries))
+    };
+    let tasks = count.div_ceil(ROWS_PER_TASK);
+    let done: Vec<Option<(Vec<u32>, Vec<u32>)>> = if parallel {
+        (0..tasks).into_par_iter().map(task).collect()
+    } else {
+        (0..tasks).map(task).collect()
+    };
+    let why = match stopped.load(Relaxed) {
+        STOPPED_ENTRIES => Some(Full::Entries),
+        STOPPED_MEMORY => Some(Full::Memory),
+        _ => None,
+    };
+    let total: usize = done.iter().flatten().map(|(_, e)| e.len()).sum();
+    let (mut starts, mut entries) = (Vec::new(), Vec::new());
+    if why.is_none()
+        && (starts.try_reserve_exact(count + 1).is_err() || entries.try_reserve_exact(total).is_err())
+    {
+        room.full = Some(Full::Memory);
+        return None;
+    }
+    if let Some(why) = why {
+        room.full = Some(why);
+        return None;
+    }
+    room.spend(total);
+    starts.push(0u32);
+    for (lengths, part) in done.into_iter().flatten() {
+        for len in lengths {
+            let end = starts.last().copied().unwrap_or(0) + len;
+            starts.push(end);
+        }
+        entries.extend_from_slice(&part);
+    }
+    Some((starts, entries))
+}
+
+/// Room for `k` more entries in `list`, asked of the allocator fallibly; false when refused.
+fn fallible_room<T>(list: &mut Vec<T>, k: usize) -> bool {
+    list.capacity() - list.len() >= k || list.try_reserve(list.len().max(64).max(k)).is_ok()
+}
+
 /// The rest-near triangle pairs' vertex-triangle and edge-edge pairs that are neither excluded
 /// nor share a vertex, with the triangles' rest boxes that tell rest-near pairs.
 #[derive(Clone, Debug, Default)]
@@ -144,25 +256,42 @@ pub(super) struct NearPairs {
 
 impl NearPairs {
     /// The near pairs of the cloth at rest positions `rest` for the exclusions `excluded`
-    /// (their radius is the one that tells rest-near triangles); `None` when `room` ran out.
+    /// (`tree` the triangles' at their radius, which tells rest-near triangles; its boxes are
+    /// kept); `None` when `room` ran out. The tree's walk runs in tasks on rayon's current pool
+    /// when `parallel`; the lists, and whether the room suffices, are the same either way.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn new(
         rest: &[Vec3],
         triangles: &[[u32; 3]],
         edges: &[[u32; 2]],
         owners: &Ownership,
         excluded: &Exclusions,
+        tree: RestTree,
         room: &mut Room,
+        parallel: bool,
     ) -> Option<NearPairs> {
-        let rest_boxes: Vec<Aabb> = triangles
-            .iter()
-            .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize])).inflated(0.5 * excluded.radius))
-            .collect();
-        let bvh = Bvh::build(&rest_boxes);
-        let (mut vt, mut ee) = (Vec::new(), Vec::new());
-        for task in bvh.self_tasks(1) {
+        let RestTree {
+            boxes: rest_boxes,
+            bvh,
+            ..
+        } = tree;
+        if room.full.is_some() {
+            return None;
+        }
+        // As `rows`: tasks of the tree's walk, each pair counted against the room exactly
+        // once, the lists joined and sorted (so neither depends on the split).
+        let left = AtomicUsize::new(room.left());
+        let stopped = AtomicU8::new(0);
+        type Lists = (Vec<(u32, u32)>, Vec<(u32, u32)>);
+        let task = |&task: &(u32, u32)| -> Option<Lists> {
+            let (mut vt, mut ee) = (Vec::new(), Vec::new());
             bvh.self_overlapping(task, |i, j| {
+                if stopped.load(Relaxed) != 0 {
+                    return;
+                }
                 // A triangle pair yields at most 6 vertex-triangle and 9 edge-edge pairs.
-                if !room.reserve(&mut vt, 6) || !room.reserve(&mut ee, 9) {
+                if !fallible_room(&mut vt, 6) || !fallible_room(&mut ee, 9) {
+                    stopped.store(STOPPED_MEMORY, Relaxed);
                     return;
                 }
                 let before = vt.len() + ee.len();
@@ -181,15 +310,51 @@ impl NearPairs {
                         }
                     },
                 );
-                room.spend(vt.len() + ee.len() - before);
+                let added = vt.len() + ee.len() - before;
+                if left
+                    .fetch_update(Relaxed, Relaxed, |l| l.checked_sub(added))
+                    .is_err()
+                {
+                    stopped.store(STOPPED_ENTRIES, Relaxed);
+                }
             });
+            (stopped.load(Relaxed) == 0).then_some((vt, ee))
+        };
+        let tasks = bvh.self_tasks(if parallel { 64 } else { 1 });
+        let done: Vec<Option<Lists>> = if parallel {
+            tasks.par_iter().map(task).collect()
+        } else {
+            tasks.iter().map(task).collect()
+        };
+        match stopped.load(Relaxed) {
+            STOPPED_ENTRIES => room.full = Some(Full::Entries),
+            STOPPED_MEMORY => room.full = Some(Full::Memory),
+            _ => {}
+        }
+        let (mut vt, mut ee) = (Vec::new(), Vec::new());
+        let count = |k: fn(&Lists) -> usize| done.iter().flatten().map(k).sum::<usize>();
+        if room.full.is_none()
+            && (vt.try_reserve_exact(count(|l| l.0.len())).is_err()
+                || ee.try_reserve_exact(count(|l| l.1.len())).is_err())
+        {
+            room.full = Some(Full::Memory);
         }
         if room.full.is_some() {
             return None;
         }
+        for (v, e) in done.into_iter().flatten() {
+            vt.extend_from_slice(&v);
+            ee.extend_from_slice(&e);
+        }
+        room.spend(vt.len() + ee.len());
         // In order, so that a vertex's (an edge's) pairs come together.
-        vt.sort_unstable();
-        ee.sort_unstable();
+        if parallel {
+            vt.par_sort_unstable();
+            ee.par_sort_unstable();
+        } else {
+            vt.sort_unstable();
+            ee.sort_unstable();
+        }
         // The furthest points of a vertex and a triangle are corners, of two edges ends.
         let far = |p: u32, q: u32| (rest[p as usize] - rest[q as usize]).norm();
         let max_span = vt
@@ -222,5 +387,99 @@ impl NearPairs {
     /// edge, is excluded or shares a vertex.
     pub(super) fn rest_boxes(&self) -> &[Aabb] {
         &self.rest_boxes
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A wavy 75 x 71 grid of 1 cm (5 325 vertices: two tasks of rows for the vertices, four
+    /// for the edges), its triangles and edges.
+    fn wavy_grid() -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<[u32; 2]>) {
+        let (w, h) = (75u32, 71u32);
+        let rest: Vec<Vec3> = (0..h)
+            .flat_map(|j| {
+                (0..w).map(move |i| {
+                    let (x, y) = (0.01 * i as f64, 0.01 * j as f64);
+                    Vec3::new(x, y, 0.004 * (7.0 * x).sin() * (5.0 * y).cos())
+                })
+            })
+            .collect();
+        let mut triangles = Vec::new();
+        for j in 0..h - 1 {
+            for i in 0..w - 1 {
+                let (a, b, c, d) = (j * w + i, j * w + i + 1, (j + 1) * w + i + 1, (j + 1) * w + i);
+                // Diagonals alternating, as a DCC's triangulation may.
+                if (i + j) % 3 == 0 {
+                    triangles.extend([[a, b, d], [b, c, d]]);
+                } else {
+                    triangles.extend([[a, b, c], [a, c, d]]);
+                }
+            }
+        }
+        let edges = super::super::geometry::edges_of(&triangles);
+        (rest, triangles, edges)
+    }
+
+    #[test]
+    fn the_lists_made_in_parallel_are_the_lists_made_on_one_thread_and_every_near_pair() {
+        let (rest, triangles, edges) = wavy_grid();
+        let radius = 0.0088;
+        let owners = Ownership::new(rest.len(), &triangles, &edges);
+        let make = |parallel: bool, entries: usize| {
+            let mut room = Room::new(entries);
+            let tree = RestTree::new(&rest, &triangles, radius);
+            let lists = Exclusions::new(&rest, &triangles, &edges, radius, &tree, &mut room, parallel)
+                .and_then(|ex| {
+                    NearPairs::new(&rest, &triangles, &edges, &owners, &ex, tree, &mut room, parallel)
+                        .map(|near| (ex, near))
+                });
+            (lists, room.full, room.left())
+        };
+        let (Some((one, near_one)), None, left) = make(false, usize::MAX) else {
+            panic!("room for the test mesh on one thread");
+        };
+        let (Some((many, near_many)), None, left_many) = make(true, usize::MAX) else {
+            panic!("room for the test mesh in parallel");
+        };
+        assert_eq!(left, left_many, "the same entries counted");
+        assert_eq!(
+            (&one.vt_start, &one.vt, &one.ee_start, &one.ee),
+            (&many.vt_start, &many.vt, &many.ee_start, &many.ee)
+        );
+        assert_eq!(near_one.vertex_triangle, near_many.vertex_triangle);
+        assert_eq!(near_one.edge_edge, near_many.edge_edge);
+        assert!(!near_one.vertex_triangle.is_empty() && !near_one.edge_edge.is_empty());
+        // Every vertex-triangle pair nearer than the radius at rest is excluded, and no other:
+        // against a test of every pair (for a tenth of the vertices, spread over the tasks).
+        for p in (0..rest.len() as u32).step_by(10) {
+            for (t, tri) in triangles.iter().enumerate() {
+                let near = tri.contains(&p) || vertex_triangle(&rest, p, tri).0 < radius;
+                assert_eq!(one.vertex_excludes(p, t as u32), near, "vertex {p}, triangle {t}");
+            }
+        }
+        for e in (0..edges.len()).step_by(40) {
+            for f in e + 1..edges.len() {
+                let (a, b) = (&edges[e], &edges[f]);
+                let near = a.iter().any(|v| b.contains(v)) || edge_edge(&rest, a, b).0 < radius;
+                assert_eq!(one.edge_excludes(e as u32, f as u32), near, "edges {e}, {f}");
+            }
+        }
+        // A room one entry short is refused on one thread and in parallel alike, as too many
+        // entries; one of exactly the entries needed is not.
+        let needed = usize::MAX - left;
+        for parallel in [false, true] {
+            let (lists, full, _) = make(parallel, needed - 1);
+            assert!(
+                lists.is_none() && full == Some(Full::Entries),
+                "parallel {parallel}"
+            );
+            let (lists, full, left) = make(parallel, needed);
+            assert!(
+                lists.is_some() && full.is_none() && left == 0,
+                "parallel {parallel}"
+            );
+        }
     }
 }

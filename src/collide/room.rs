@@ -48,18 +48,6 @@ impl Room {
         true
     }
 
-    /// Makes space for `k` more entries in `list` (fallibly); false when it cannot.
-    pub(crate) fn reserve<T>(&mut self, list: &mut Vec<T>, k: usize) -> bool {
-        if self.full.is_some() {
-            return false;
-        }
-        if list.capacity() - list.len() < k && list.try_reserve(list.len().max(64).max(k)).is_err() {
-            self.full = Some(Full::Memory);
-            return false;
-        }
-        true
-    }
-
     /// Gives back the room of `k` entries (a list about to be cleared and filled again).
     pub(crate) fn give_back(&mut self, k: usize) {
         self.left += k;
@@ -70,7 +58,7 @@ impl Room {
         self.left
     }
 
-    /// Counts `k` entries pushed after a [`Room::reserve`] against the room.
+    /// Counts `k` entries pushed (their room asked for elsewhere) against the room.
     pub(crate) fn spend(&mut self, k: usize) {
         if k > self.left {
             self.left = 0;
@@ -90,14 +78,13 @@ mod tests {
         let mut room = Room::new(3);
         let mut a = Vec::new();
         assert!(room.push(&mut a, 1u32) && room.push(&mut a, 2));
-        assert!(room.reserve(&mut a, 9));
         a.push(3);
         room.spend(1);
         assert_eq!(room.full, None);
         assert!(!room.push(&mut a, 4), "a fourth entry in a room of three");
         assert_eq!(room.full, Some(Full::Entries));
         assert_eq!(a, [1, 2, 3]);
-        assert!(!room.reserve(&mut a, 1), "nothing more once full");
+        assert!(!room.push(&mut a, 5), "nothing more once full");
         // Spending more than is left fills it too.
         let mut room = Room::new(2);
         room.spend(3);

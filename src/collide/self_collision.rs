@@ -35,7 +35,7 @@ use super::contact::Contact;
 use super::geometry::{closest_on_segments, edges_of, offset_from_triangle};
 use super::guard::Guard;
 use super::impact_zones::{PairRef, Passage};
-use super::neighbours::{Exclusions, NearPairs};
+use super::neighbours::{Exclusions, NearPairs, RestTree};
 use super::ownership::Ownership;
 use super::room::{Full, Room};
 use super::unfolded::Unfolded;
@@ -410,10 +410,19 @@ impl SelfCollision {
         let entries = PAIRS_PER_VERTEX.saturating_mul(rest.len()).saturating_add(4096);
         let mut room = Room::new(entries.min(u32::MAX as usize - 1));
         let owners = Ownership::new(rest.len(), triangles, &self.edges);
-        let lists = Exclusions::new(rest, triangles, &self.edges, radius, &mut room).and_then(|excluded| {
-            NearPairs::new(rest, triangles, &self.edges, &owners, &excluded, &mut room)
+        // Set up on the pool for a cloth large enough that its step uses it (a million
+        // particles: 9 s on one thread, docs/collisions.md); the lists are the same either way.
+        let parallel = crate::parallel::worth_it(rest.len());
+        let tree = RestTree::new(rest, triangles, radius);
+        let edges = &self.edges;
+        let lists = Exclusions::new(rest, triangles, edges, radius, &tree, &mut room, parallel).and_then(
+            |excluded| {
+                NearPairs::new(
+                    rest, triangles, edges, &owners, &excluded, tree, &mut room, parallel,
+                )
                 .map(|near| (excluded, near))
-        });
+            },
+        );
         match (lists, room.full) {
             (Some((excluded, near)), _) => {
                 let edges = &self.edges;
@@ -1024,7 +1033,9 @@ mod tests {
             triangles,
             edges,
             excluded_within,
+            &RestTree::new(rest, triangles, excluded_within),
             &mut Room::new(usize::MAX),
+            false,
         )
         .expect("room for a test mesh");
         let mut vt = Vec::new();

@@ -15,6 +15,10 @@ use super::FcCloth;
 /// - `n >= 2` (at most 256): a pool of `n` threads owned by this cloth, started now; the calling
 ///   thread waits for each step. `FC_ERROR_INVALID_ARGUMENT` if the threads cannot be started.
 ///
+/// A cloth with self-collision makes its neighbour lists when it is created (on the shared pool
+/// for a cloth whose step would use it: this call comes after) and again when `fc_cloth_set_desc`
+/// changes the thickness (then on the threads chosen here).
+///
 /// # Safety
 /// `cloth` NULL or live.
 #[no_mangle]
