@@ -71,7 +71,10 @@ pub struct Model {
     /// Self-collision: the distance the cloth keeps from itself, m (0 = off, and costs
     /// nothing). Pairs nearer than 2.2 times this at rest (neighbours) are not tested
     /// (`collide/self_collision.rs`). A cloth refuses one past about 1.5 of its mean edge
-    /// lengths (`collide::self_collision::PAIRS_PER_VERTEX`).
+    /// lengths (`collide::self_collision::PAIRS_PER_VERTEX`). No free vertex moves more than
+    /// half of it in a substep (a faster one is slowed), so a fixed substep longer than that
+    /// allows at the cloth's speed damps its motion; the automatic step's substeps are short
+    /// enough (docs/collisions.md, stop 63).
     pub self_collision_thickness: f64,
     /// Self-collision thickness in the cloth's spacings (dimensionless, >= 0; 0 adds nothing):
     /// adds `self_collision_relative * spacing` m to [`Model::self_collision_thickness`] when
