@@ -164,6 +164,39 @@ fn differences(a: &[f64], base: &[f64], lo: &mut [f64; LANES], hi: &mut [f64; LA
     }
 }
 
+/// Splits a node's `items` as the build does: the lower half (by the centres along the axis
+/// they spread most on) first, the item at the median in between.
+fn split_at_median(items: &mut [u32], centres: &[Vec3]) {
+    let spread = Aabb::of(items.iter().map(|&i| &centres[i as usize]));
+    let axis = (spread.max - spread.min).imax();
+    items.select_nth_unstable_by(items.len() / 2, |&a, &b| {
+        centres[a as usize][axis].total_cmp(&centres[b as usize][axis])
+    });
+}
+
+/// Fewest items a node must hold for [`split_items`] to split its halves on two threads.
+const PARALLEL_SPLIT: usize = 16_384;
+
+/// Every split of the tree over `items` (the nodes' item ranges as [`Bvh::try_build_on`]
+/// makes them), the halves of large nodes on two threads when `parallel`.
+fn split_items(items: &mut [u32], centres: &[Vec3], parallel: bool) {
+    if items.len() <= LEAF {
+        return;
+    }
+    split_at_median(items, centres);
+    let large = parallel && items.len() >= PARALLEL_SPLIT;
+    let (lower, upper) = items.split_at_mut(items.len() / 2);
+    if large {
+        rayon::join(
+            || split_items(lower, centres, true),
+            || split_items(upper, centres, true),
+        );
+    } else {
+        split_items(lower, centres, false);
+        split_items(upper, centres, false);
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Node {
     bounds: Aabb,
@@ -187,7 +220,13 @@ pub struct Bvh {
 impl Bvh {
     /// Builds the hierarchy over `boxes` (item k has box k).
     pub fn build(boxes: &[Aabb]) -> Bvh {
-        match Self::try_build(boxes) {
+        Self::build_on(boxes, false)
+    }
+
+    /// [`Bvh::build`], split on rayon's current pool when `parallel` (the same tree; see
+    /// [`Bvh::try_build_on`]).
+    pub fn build_on(boxes: &[Aabb], parallel: bool) -> Bvh {
+        match Self::try_build_on(boxes, parallel) {
             Ok(bvh) => bvh,
             // As a `Vec` that cannot grow.
             Err(_) => std::alloc::handle_alloc_error(std::alloc::Layout::new::<Node>()),
@@ -197,6 +236,13 @@ impl Bvh {
     /// [`Bvh::build`], asking the allocator fallibly for everything whose size the item
     /// count sets (the walk's own list of nodes to split is as deep as the tree).
     pub fn try_build(boxes: &[Aabb]) -> Result<Bvh, std::collections::TryReserveError> {
+        Self::try_build_on(boxes, false)
+    }
+
+    /// [`Bvh::try_build`], its splits made on rayon's current pool when `parallel`: the same
+    /// tree either way (each node's split reads and reorders only its own items, so the order
+    /// the nodes are split in changes nothing; the nodes are then numbered as one thread does).
+    pub fn try_build_on(boxes: &[Aabb], parallel: bool) -> Result<Bvh, std::collections::TryReserveError> {
         let n = boxes.len();
         if n == 0 {
             return Ok(Bvh::default());
@@ -221,7 +267,11 @@ impl Bvh {
             first: 0,
             count: boxes.len() as u32,
         });
-        // (node, first item, item count): split until leaves are small.
+        if parallel {
+            split_items(&mut bvh.order, &centres, true);
+        }
+        // (node, first item, item count): split until leaves are small (already split in
+        // parallel: only numbered and bounded here).
         let mut todo = vec![(0usize, 0usize, boxes.len())];
         while let Some((node, lo, n)) = todo.pop() {
             let items = &mut bvh.order[lo..lo + n];
@@ -233,12 +283,10 @@ impl Bvh {
                 bvh.nodes[node].count = n as u32;
                 continue;
             }
-            let spread = Aabb::of(items.iter().map(|&i| &centres[i as usize]));
-            let axis = (spread.max - spread.min).imax();
             let half = n / 2;
-            items.select_nth_unstable_by(half, |&a, &b| {
-                centres[a as usize][axis].total_cmp(&centres[b as usize][axis])
-            });
+            if !parallel {
+                split_at_median(items, &centres);
+            }
             let child = bvh.nodes.len();
             for _ in 0..2 {
                 bvh.nodes.push(Node {
@@ -627,6 +675,27 @@ mod tests {
                 let room = if n == 0 { 0 } else { 4 * n / LEAF + 1 };
                 assert_eq!(bvh.nodes.capacity(), room, "{n} boxes: no growth");
                 assert_eq!(bvh.len(), n);
+            }
+        }
+    }
+
+    #[test]
+    fn a_tree_split_in_parallel_is_the_tree_split_on_one_thread() {
+        // Past the size a node's halves go to two threads at, several levels deep; and a
+        // sheet's boxes, many of them with equal centres along an axis.
+        let sheet: Vec<Aabb> = (0..300 * 200)
+            .map(|k| {
+                let c = Vec3::new((k % 300) as f64, (k / 300) as f64, 0.0) * 0.01;
+                Aabb { min: c, max: c }.inflated(0.004)
+            })
+            .collect();
+        for b in [boxes(100_000), sheet, boxes(3)] {
+            let (one, two) = (Bvh::build(&b), Bvh::build_on(&b, true));
+            assert_eq!(one.order, two.order);
+            assert_eq!(one.boxes, two.boxes);
+            assert_eq!(one.nodes.len(), two.nodes.len());
+            for (p, q) in one.nodes.iter().zip(&two.nodes) {
+                assert_eq!((p.bounds, p.first, p.count), (q.bounds, q.first, q.count));
             }
         }
     }

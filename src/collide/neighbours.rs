@@ -27,13 +27,14 @@ pub(super) struct RestTree {
 }
 
 impl RestTree {
-    pub(super) fn new(rest: &[Vec3], triangles: &[[u32; 3]], radius: f64) -> RestTree {
+    /// The tree split on rayon's current pool when `parallel` (the same tree either way).
+    pub(super) fn new(rest: &[Vec3], triangles: &[[u32; 3]], radius: f64, parallel: bool) -> RestTree {
         let half = 0.5 * radius;
         let boxes: Vec<Aabb> = triangles
             .iter()
             .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize])).inflated(half))
             .collect();
-        let bvh = Bvh::build(&boxes);
+        let bvh = Bvh::build_on(&boxes, parallel);
         RestTree { boxes, bvh, half }
     }
 }
@@ -79,7 +80,7 @@ impl Exclusions {
             .iter()
             .map(|e| Aabb::of(e.iter().map(|&i| &rest[i as usize])).inflated(0.5 * radius))
             .collect();
-        let bvh = Bvh::build(&boxes);
+        let bvh = Bvh::build_on(&boxes, parallel);
         let (ee_start, ee) = rows(edges.len(), parallel, room, |e, push| {
             let edge = &edges[e as usize];
             bvh.overlapping(&boxes[e as usize], |f| {
@@ -429,7 +430,7 @@ mod tests {
         let owners = Ownership::new(rest.len(), &triangles, &edges);
         let make = |parallel: bool, entries: usize| {
             let mut room = Room::new(entries);
-            let tree = RestTree::new(&rest, &triangles, radius);
+            let tree = RestTree::new(&rest, &triangles, radius, parallel);
             let lists = Exclusions::new(&rest, &triangles, &edges, radius, &tree, &mut room, parallel)
                 .and_then(|ex| {
                     NearPairs::new(&rest, &triangles, &edges, &owners, &ex, tree, &mut room, parallel)

@@ -413,7 +413,7 @@ impl SelfCollision {
         // Set up on the pool for a cloth large enough that its step uses it (a million
         // particles: 9 s on one thread, docs/collisions.md); the lists are the same either way.
         let parallel = crate::parallel::worth_it(rest.len());
-        let tree = RestTree::new(rest, triangles, radius);
+        let tree = RestTree::new(rest, triangles, radius, parallel);
         let edges = &self.edges;
         let lists = Exclusions::new(rest, triangles, edges, radius, &tree, &mut room, parallel).and_then(
             |excluded| {
@@ -1033,7 +1033,7 @@ mod tests {
             triangles,
             edges,
             excluded_within,
-            &RestTree::new(rest, triangles, excluded_within),
+            &RestTree::new(rest, triangles, excluded_within, false),
             &mut Room::new(usize::MAX),
             false,
         )
