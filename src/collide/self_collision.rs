@@ -411,7 +411,7 @@ impl SelfCollision {
         let mut room = Room::new(entries.min(u32::MAX as usize - 1));
         let owners = Ownership::new(rest.len(), triangles, &self.edges);
         // Set up on the pool for a cloth large enough that its step uses it (a million
-        // particles: 9 s on one thread, docs/collisions.md); the lists are the same either way.
+        // particles: 9-11 s on one thread, docs/collisions.md); the lists are the same either way.
         let parallel = crate::parallel::worth_it(rest.len());
         let tree = RestTree::new(rest, triangles, radius, parallel);
         let edges = &self.edges;
