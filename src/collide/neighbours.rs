@@ -13,7 +13,7 @@ use super::ownership::Ownership;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU8, AtomicUsize, Ordering::Relaxed};
 
-use super::room::{Full, Room};
+use super::room::{make_room, Full, Room};
 use super::self_collision::{edge_edge, vertex_triangle};
 use crate::math::Vec3;
 
@@ -177,7 +177,7 @@ where
             let first = entries.len();
             let mut refused = false;
             row(i as u32, &mut |t| {
-                if fallible_room(&mut entries, 1) {
+                if make_room(&mut entries, 1) {
                     entries.push(t);
                 } else {
                     refused = true;
@@ -206,21 +206,19 @@ where
     } else {
         (0..tasks).map(task).collect()
     };
-    let why = match stopped.load(Relaxed) {
-        STOPPED_ENTRIES => Some(Full::Entries),
-        STOPPED_MEMORY => Some(Full::Memory),
-        _ => None,
-    };
+    match stopped.load(Relaxed) {
+        STOPPED_ENTRIES => room.full = Some(Full::Entries),
+        STOPPED_MEMORY => room.full = Some(Full::Memory),
+        _ => {}
+    }
     let total: usize = done.iter().flatten().map(|(_, e)| e.len()).sum();
     let (mut starts, mut entries) = (Vec::new(), Vec::new());
-    if why.is_none()
+    if room.full.is_none()
         && (starts.try_reserve_exact(count + 1).is_err() || entries.try_reserve_exact(total).is_err())
     {
         room.full = Some(Full::Memory);
-        return None;
     }
-    if let Some(why) = why {
-        room.full = Some(why);
+    if room.full.is_some() {
         return None;
     }
     room.spend(total);
@@ -233,11 +231,6 @@ where
         entries.extend_from_slice(&part);
     }
     Some((starts, entries))
-}
-
-/// Room for `k` more entries in `list`, asked of the allocator fallibly; false when refused.
-fn fallible_room<T>(list: &mut Vec<T>, k: usize) -> bool {
-    list.capacity() - list.len() >= k || list.try_reserve(list.len().max(64).max(k)).is_ok()
 }
 
 /// The rest-near triangle pairs' vertex-triangle and edge-edge pairs that are neither excluded
@@ -291,7 +284,7 @@ impl NearPairs {
                     return;
                 }
                 // A triangle pair yields at most 6 vertex-triangle and 9 edge-edge pairs.
-                if !fallible_room(&mut vt, 6) || !fallible_room(&mut ee, 9) {
+                if !make_room(&mut vt, 6) || !make_room(&mut ee, 9) {
                     stopped.store(STOPPED_MEMORY, Relaxed);
                     return;
                 }

@@ -39,7 +39,7 @@ impl Room {
             self.full = Some(Full::Entries);
             return false;
         }
-        if list.len() == list.capacity() && list.try_reserve(list.len().max(64)).is_err() {
+        if !make_room(list, 1) {
             self.full = Some(Full::Memory);
             return false;
         }
@@ -67,6 +67,12 @@ impl Room {
             self.left -= k;
         }
     }
+}
+
+/// Room for `k` more entries in `list`, asked of the allocator fallibly (at least doubling, or
+/// 64 entries); false when it refuses.
+pub(crate) fn make_room<T>(list: &mut Vec<T>, k: usize) -> bool {
+    list.capacity() - list.len() >= k || list.try_reserve(list.len().max(64).max(k)).is_ok()
 }
 
 #[cfg(test)]

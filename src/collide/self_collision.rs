@@ -425,7 +425,6 @@ impl SelfCollision {
         );
         match (lists, room.full) {
             (Some((excluded, near)), _) => {
-                let edges = &self.edges;
                 let apart = |&(e, f): &(u32, u32)| {
                     let (a, b) = (edges[e as usize], edges[f as usize]);
                     !a.iter().any(|v| b.contains(v))
