@@ -16,7 +16,7 @@
 
 #define FC_VERSION_MAJOR 0
 #define FC_VERSION_MINOR 9
-#define FC_VERSION_PATCH 27
+#define FC_VERSION_PATCH 28
 /* Equals fc_version() of the library this header belongs to. */
 #define FC_VERSION (FC_VERSION_MAJOR * 1000000 + FC_VERSION_MINOR * 1000 + FC_VERSION_PATCH)
 
@@ -403,11 +403,12 @@ typedef struct {
    * Self-collision: the distance the cloth keeps from itself, m (0 = off, the default).
    * Points nearer than 2.2 times this at rest (neighbours) are not tested: a few millimetres
    * for a cloth of 1-2 cm spacing.
-   * No vertex moves more than half of it in one substep (a faster one is slowed to that):
-   * use the automatic step (`FC_MAX_SUBSTEP_AUTO`) with it. A fixed substep longer than
-   * half the thickness over the cloth's speed damps the motion (implicit Euler at 1/30 s
-   * on the 4 cm, 0.5 Hz swing at 4 mm: 2.0 half-waves instead of 3.6) and can hold an
-   * unstable step under the speed limit instead of refusing it. At most about 1.5 times the mesh's mean edge length: a larger one would list too many
+   * No vertex moves more than half of it in one substep: a substep in which one would is
+   * taken in 2, 4, ... up to 32 equal pieces instead (`fc_cloth_get_step_stats` counts
+   * them), so a fixed step keeps its motion (implicit Euler at one 1/30 s substep a frame
+   * on the 4 cm, 0.5 Hz swing at 4 mm: 3.6 half-waves, 2.6 substeps a call); past 32 the
+   * fastest vertices are slowed to it. A fixed substep too long to be stable may so be
+   * held in short pieces instead of refused. At most about 1.5 times the mesh's mean edge length: a larger one would list too many
    * neighbour pairs and is refused (`FC_ERROR_INVALID_ARGUMENT`, the message says how large
    * a one the mesh takes). See docs/collisions.md.
    */
@@ -713,7 +714,9 @@ size_t fc_cloth_history_bytes_per_particle(const FcCloth *cloth);
 
 /**
  * Advances by `dt` seconds in `substeps` equal substeps (1 ..= 1000000); pins travel in a
- * straight line to their targets over the whole call. Atomic over the whole call.
+ * straight line to their targets over the whole call. Atomic over the whole call. With
+ * self-collision a substep in which a vertex would move more than half its thickness is taken
+ * in up to 32 equal pieces (`fc_cloth_get_step_stats` counts them).
  *
  * # Safety
  * `cloth` NULL or live.
@@ -741,7 +744,8 @@ FcStatus fc_cloth_get_solver_stats(const FcCloth *cloth,
 
 /**
  * Reads what the last `fc_cloth_step` or `fc_cloth_step_substeps` did: the substeps it took
- * (with the automatic step, those of the attempt that succeeded), how many times the automatic
+ * (with the automatic step, those of the attempt that succeeded; with self-collision, the
+ * pieces of the substeps it split counted one by one), how many times the automatic
  * step retried with twice the substeps after a refused substep, and its substep estimate in
  * seconds (0 with a fixed step). All 0 before the first step. Any output may be NULL.
  *

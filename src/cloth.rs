@@ -14,11 +14,12 @@ mod motion;
 mod pins;
 mod prepass;
 mod snapshot;
+mod split;
 mod step;
 
 use histories::Histories;
 use pins::check_weight;
-use step::{Rollback, StepPlan, StepScratch};
+use step::{Rollback, StepScratch};
 
 pub use auto_step::{safety, StepStats, AUTO, MAX_RETRIES, SAFETY, SAFETY_SYMPLECTIC};
 pub use snapshot::SNAPSHOT_VERSION;
@@ -639,7 +640,8 @@ impl Cloth {
 
     /// Advances by `dt` seconds in `substeps` equal substeps. Pins travel in a straight
     /// line to their targets over the whole call. Atomic over the whole call: if any
-    /// substep fails, the cloth is restored to its state before the call.
+    /// substep fails, the cloth is restored to its state before the call. With self-collision
+    /// a substep may be taken in pieces (`cloth/split.rs`).
     pub fn step_substeps(&mut self, dt: f64, substeps: u32) -> Result<(), Error> {
         match &self.threads {
             // A cloth that spreads its passes over the shared pool, called from outside it:
@@ -689,48 +691,39 @@ impl Cloth {
             substeps,
             ..StepStats::default()
         };
-        let extrapolated = self.config.integrator.is_extrapolated();
         self.mesh_from = 0.0;
-        if substeps == 1 && !extrapolated {
-            // Nothing to roll back but what self-collision learns in the step (its sides).
-            let mut saved = std::mem::take(&mut self.rollback.self_collision);
-            self.self_collision.save_memory(&mut saved);
-            let done = self.advance(StepPlan::new(
-                self.config.integrator,
-                dt,
-                None,
-                step::Stage::Whole,
-            ));
-            if done.is_err() {
-                self.self_collision.swap_memory(&mut saved);
-            }
-            self.rollback.self_collision = saved;
-            return done;
-        }
         let h = dt / f64::from(substeps);
         let mut snap = std::mem::take(&mut self.rollback);
-        if let Err(e) = snap.save(self) {
-            self.rollback = snap;
-            return Err(e);
-        }
-        self.start_pin_paths();
-        for k in 1..=substeps {
-            let goal = (k < substeps).then_some(f64::from(k) / f64::from(substeps));
-            let done = if extrapolated {
-                self.extrapolated_advance(h, f64::from(k - 1) / f64::from(substeps), goal)
-            } else {
-                self.advance(StepPlan::new(self.config.integrator, h, goal, step::Stage::Whole))
-            };
-            if let Err(mut e) = done {
-                snap.restore(self);
+        // A call of one first-order step commits nothing before its end, so it needs no copy
+        // of its start (unless self-collision splits it: `split.rs` makes one then).
+        let mut saved = substeps > 1 || self.config.integrator.is_extrapolated();
+        if saved {
+            if let Err(e) = snap.save(self) {
                 self.rollback = snap;
-                if substeps > 1 {
-                    e.message = format!("substep {k} of {substeps}: {}", e.message);
-                }
                 return Err(e);
             }
         }
+        self.start_pin_paths();
+        let mut pieces = 0u32;
+        for k in 1..=substeps {
+            let f0 = f64::from(k - 1) / f64::from(substeps);
+            let goal = (k < substeps).then_some(f64::from(k) / f64::from(substeps));
+            match self.take_substep(h, f0, goal, &mut snap, &mut saved) {
+                Ok(taken) => pieces = pieces.saturating_add(taken),
+                Err(mut e) => {
+                    if saved {
+                        snap.restore(self);
+                    }
+                    self.rollback = snap;
+                    if substeps > 1 {
+                        e.message = format!("substep {k} of {substeps}: {}", e.message);
+                    }
+                    return Err(e);
+                }
+            }
+        }
         self.rollback = snap;
+        self.step_stats.substeps = pieces;
         Ok(())
     }
 

@@ -72,9 +72,9 @@ pub struct Model {
     /// nothing). Pairs nearer than 2.2 times this at rest (neighbours) are not tested
     /// (`collide/self_collision.rs`). A cloth refuses one past about 1.5 of its mean edge
     /// lengths (`collide::self_collision::PAIRS_PER_VERTEX`). No free vertex moves more than
-    /// half of it in a substep (a faster one is slowed), so a fixed substep longer than that
-    /// allows at the cloth's speed damps its motion; the automatic step's substeps are short
-    /// enough (docs/collisions.md, stop 63).
+    /// half of it in a substep: a substep in which one would is taken in 2, 4, ... up to 32
+    /// equal pieces instead (`cloth/split.rs`; [`crate::Cloth::step_stats`] counts them), and
+    /// past 32 the fastest vertices are slowed (docs/collisions.md, stop 64).
     pub self_collision_thickness: f64,
     /// Self-collision thickness in the cloth's spacings (dimensionless, >= 0; 0 adds nothing):
     /// adds `self_collision_relative * spacing` m to [`Model::self_collision_thickness`] when

@@ -277,6 +277,18 @@ fn the_drop_with_implicit_euler_does_not_cross_itself() {
     assert_eq!(worst, 0);
 }
 
+/// The drop with implicit Euler at one substep a frame (a host's fixed step, `max_substep` 0):
+/// self-collision's step limit splits the substeps in which the falling cloth would move more
+/// than half the thickness (`src/cloth/split.rs`), and the pile does not cross itself.
+#[test]
+fn the_drop_at_one_substep_a_frame_does_not_cross_itself() {
+    let (worst, top, pairs) = drop_at(0.005, Integrator::ImplicitEuler, 0.0);
+    println!("implicit Euler, one substep a frame: {worst} self-intersections ({pairs} pairs, pile top {top:.3} m)");
+    assert!(top < 0.3, "the towel has landed: top at {top} m");
+    assert!(pairs > 0, "it folded onto itself");
+    assert_eq!(worst, 0);
+}
+
 /// A towel lying on a floor mesh in a current along the floor: with friction it keeps its
 /// place and its contact (no vertex lifts off the floor by more than the margin); without
 /// friction the same current slides it away. The water's inertia does not launch it.
@@ -449,8 +461,8 @@ fn brisk_swing_with(
 
 /// The brisk swing (2 Hz, 8 cm: it crumples under its pins, docs/underwater.md) with
 /// self-collision on: no triangle pair crosses at any frame (counted exactly, every frame for
-/// 4 s), at the automatic step with the explicit and the implicit integrator and at a fixed
-/// substep. Without self-collision it crosses itself (241 pairs at worst). Before the impact
+/// 4 s), at the automatic step with the explicit and the implicit integrator, at a fixed
+/// substep, and with implicit Euler at one substep a frame. Without self-collision it crosses itself (241 pairs at worst). Before the impact
 /// zones (`collide/impact_zones.rs`) 7 pairs crossed, all begun at the pinned row.
 #[test]
 fn the_brisk_swing_with_self_collision_does_not_cross_itself() {
@@ -460,6 +472,8 @@ fn the_brisk_swing_with_self_collision_does_not_cross_itself() {
         (Integrator::SymplecticEuler, fraccloth::cloth::AUTO),
         (Integrator::ImplicitEuler, fraccloth::cloth::AUTO),
         (Integrator::SymplecticEuler, 1.0 / 3000.0),
+        // One substep a frame, split where the crumple is fast (`src/cloth/split.rs`).
+        (Integrator::ImplicitEuler, 0.0),
     ] {
         let (with, pairs) = brisk_swing_with(31, 21, 0.08, 0.006, 120, integrator, max_substep);
         println!("2 Hz 8 cm swing, 31 x 21, {integrator:?} max_substep {max_substep}: {with} crossing pairs with self-collision (up to {pairs} pairs in reach), {without} without");

@@ -88,7 +88,8 @@ const GAMMA_3_2: f64 = 0.886_226_925_452_758;
 /// What the last call to `step` did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepStats {
-    /// Substeps the last call took (the successful attempt's).
+    /// Substeps the last call took (the successful attempt's; the pieces of a substep
+    /// self-collision split counted one by one, `cloth/split.rs`).
     pub substeps: u32,
     /// Attempts refused and retried with twice the substeps (automatic step only).
     pub retries: u32,
@@ -155,7 +156,8 @@ impl Cloth {
                         self.motion.update(&t.masses, &self.pinned, start, end, dt);
                     }
                     self.step_stats = StepStats {
-                        substeps,
+                        // Self-collision may have split some (`split.rs`).
+                        substeps: self.step_stats.substeps,
                         retries,
                         estimate: h,
                     };

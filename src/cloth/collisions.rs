@@ -2,6 +2,7 @@
 //! pass, which turns both into [`Contact`] elements (their forces join the force pass, their
 //! Jacobian blocks the implicit system, their friction the friction pass).
 
+use super::step::StepLimit;
 use super::Cloth;
 use crate::bytes::{ByteReader, ByteWriter};
 use crate::collide::impact_zones::{keep_from_passing, ZoneInput, ZoneTotals};
@@ -391,14 +392,15 @@ impl Cloth {
         self.self_collision.relearn_sides(&self.scratch.zone_stopped);
     }
 
-    /// Self-collision's step limit ([`SELF_COLLISION_STEP_LIMIT`]): a free vertex that would
-    /// move farther in this step is moved only that far, its velocity scaled alike (a cloth
-    /// pinched between two colliders, or flung faster than its thickness a step, cannot pass
-    /// through itself). Returns how many vertices were limited.
-    pub(super) fn limit_collision_step(&mut self) -> usize {
+    /// Self-collision's step limit ([`SELF_COLLISION_STEP_LIMIT`]) on the proposed step: a
+    /// free vertex that would move farther (a cloth pinched between two colliders, or flung
+    /// faster than its thickness a step, would pass through itself) either refuses the step,
+    /// saying by how much it is over ([`StepLimit::Refuse`]: the driver splits the step), or
+    /// is moved only that far, its velocity scaled alike ([`StepLimit::Slow`]).
+    pub(super) fn limit_collision_step(&mut self, mode: StepLimit) -> Limited {
         let thickness = self.config.model.self_collision_thickness;
         if thickness <= 0.0 {
-            return 0;
+            return Limited::Slowed(0);
         }
         let limit = SELF_COLLISION_STEP_LIMIT * thickness;
         let s = &mut self.scratch;
@@ -411,27 +413,44 @@ impl Cloth {
             &self.pinned,
             limit * limit * (1.0 - 1e-12),
         ) {
-            return 0;
+            return Limited::Slowed(0);
+        }
+        // How far free vertex `i` would move, when over the limit (squared first: the square
+        // root only for a vertex over it; a NaN displacement is left to the step's check).
+        let over = |x_new: &[Vec3], i: usize| {
+            let len2 = (x_new[i] - self.x[i]).norm_squared();
+            (!self.pinned[i] && len2 > limit * limit && !len2.is_nan())
+                .then(|| len2.sqrt())
+                .filter(|&len| len > limit)
+        };
+        if mode == StepLimit::Refuse {
+            let farthest = (0..self.x.len())
+                .filter_map(|i| over(&s.x_new, i))
+                .fold(0.0, f64::max);
+            return match farthest > limit {
+                true => Limited::Over(farthest / limit),
+                false => Limited::Slowed(0),
+            };
         }
         let mut limited = 0;
         for i in 0..self.x.len() {
-            let d = s.x_new[i] - self.x[i];
-            // Squared first: the square root only for a vertex over the limit.
-            let len2 = d.norm_squared();
-            if self.pinned[i] || len2 <= limit * limit || len2.is_nan() {
-                continue;
-            }
-            let len = len2.sqrt();
-            if len <= limit {
-                continue;
-            }
+            let Some(len) = over(&s.x_new, i) else { continue };
             let scale = limit / len;
-            s.x_new[i] = self.x[i] + scale * d;
+            s.x_new[i] = self.x[i] + scale * (s.x_new[i] - self.x[i]);
             s.v_new[i] *= scale;
             limited += 1;
         }
-        limited
+        Limited::Slowed(limited)
     }
+}
+
+/// What self-collision's step limit did with a proposed step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Limited {
+    /// This many free vertices were slowed to the limit (0: none was over it).
+    Slowed(usize),
+    /// Refused: the farthest free vertex would move this many times the limit.
+    Over(f64),
 }
 
 crate::simd_dispatch! { fn any_past_widest(x_new: &[f64], x: &[f64], pinned: &[bool], limit2: f64) -> bool => any_past }

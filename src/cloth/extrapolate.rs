@@ -17,7 +17,7 @@
 //! [`Integrator::ExtrapolatedSymplectic`]: crate::Integrator::ExtrapolatedSymplectic
 //! [`Integrator::ExtrapolatedImplicit`]: crate::Integrator::ExtrapolatedImplicit
 
-use super::step::{Stage, StepPlan};
+use super::step::{Advanced, Stage, StepLimit, StepPlan};
 use super::Cloth;
 use crate::error::Error;
 use crate::integrate;
@@ -25,10 +25,17 @@ use crate::integrate;
 impl Cloth {
     /// One extrapolated step of size `h` whose pins start at fraction `f0` of the call's pin
     /// travel and end at `f1` (None: at their targets). Not atomic by itself: the caller
-    /// restores its rollback on an error.
-    pub(super) fn extrapolated_advance(&mut self, h: f64, f0: f64, f1: Option<f64>) -> Result<(), Error> {
+    /// restores its rollback on an error. Self-collision's step limit acts on the whole step
+    /// as `limit` says (refused: nothing committed) and slows vertices in the half steps.
+    pub(super) fn extrapolated_advance(
+        &mut self,
+        h: f64,
+        f0: f64,
+        f1: Option<f64>,
+        limit: StepLimit,
+    ) -> Result<Advanced, Error> {
         let mut probe = std::mem::take(&mut self.probe);
-        let done = self.extrapolate_with(&mut probe, h, f0, f1);
+        let done = self.extrapolate_with(&mut probe, h, f0, f1, limit);
         self.probe = probe;
         done
     }
@@ -39,12 +46,17 @@ impl Cloth {
         h: f64,
         f0: f64,
         f1: Option<f64>,
-    ) -> Result<(), Error> {
+        limit: StepLimit,
+    ) -> Result<Advanced, Error> {
         let steps = self.steps;
         probe.save(self)?;
         let integrator = self.config.integrator;
-        // The whole step, kept aside in `probe` (restoring swaps it there).
-        self.advance(StepPlan::new(integrator, h, f1, Stage::Whole))?;
+        // The whole step, kept aside in `probe` (restoring swaps it there). A whole step too
+        // far for self-collision's limit is refused before anything is committed.
+        let whole = StepPlan::new(integrator, h, f1, Stage::Whole).limited(limit);
+        if let Advanced::TooFar(ratio) = self.advance(whole)? {
+            return Ok(Advanced::TooFar(ratio));
+        }
         probe.restore(self);
         // Two half steps, the first with the pins aimed at their mid goals (`pins.rs`).
         let fmid = self.plan_mid_goals(h, f0, f1);
@@ -80,6 +92,6 @@ impl Cloth {
                 self.config.max_speed
             )));
         }
-        Ok(())
+        Ok(Advanced::Taken)
     }
 }

@@ -565,6 +565,7 @@ impl Cloth {
         // The mesh colliders as loaded (their lists and trees empty: small to copy), so that
         // the step's refresh of them is not kept.
         let meshes = self.mesh_slots.clone();
+        // Self-collision's limit slows a vertex here (`StepPlan::new`'s), never refuses.
         let done = self.advance(StepPlan::new(self.config.integrator, h, None, Stage::Whole));
         self.mesh_slots = meshes;
         snap.restore(self);
@@ -573,7 +574,7 @@ impl Cloth {
         self.config.accept_unconverged = unconverged;
         (self.solver_stats, self.step_stats, self.mesh_carried) = (solver, stats, carried);
         self.rollback = snap;
-        done
+        done.map(|_| ())
     }
 
     /// Size in bytes of [`Cloth::save_snapshot`]'s result now, counted without building it.

@@ -29,6 +29,31 @@ pub(super) struct StepPlan {
     pub stage: Stage,
     /// Which velocity a hard pin gives the history.
     pub sampling: PinSampling,
+    /// What self-collision's step limit does to a vertex that would move too far.
+    pub limit: StepLimit,
+}
+
+/// What self-collision's step limit ([`super::collisions::SELF_COLLISION_STEP_LIMIT`]) does
+/// with a step in which a free vertex would move farther than it allows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum StepLimit {
+    /// Slows the vertex to the limit (the last resort: the step is already as short as the
+    /// driver splits it, or nothing can split it).
+    Slow,
+    /// Refuses the step, nothing committed ([`Advanced::TooFar`]), so that the driver takes it
+    /// in shorter pieces (`Cloth::take_substep`).
+    Refuse,
+}
+
+/// What [`Cloth::advance`] did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Advanced {
+    /// The step is committed.
+    Taken,
+    /// Nothing is committed: a free vertex would move this many times the step limit
+    /// ([`StepLimit::Refuse`] only). Self-collision's remembered pairs may have changed: the
+    /// driver restores them.
+    TooFar(f64),
 }
 
 /// Which part of an integrator's step a step is.
@@ -54,7 +79,13 @@ impl StepPlan {
             fraction,
             stage,
             sampling: PinSampling::of(integrator, stage),
+            limit: StepLimit::Slow,
         }
+    }
+
+    /// The same plan, its step limit `limit`.
+    pub(super) fn limited(self, limit: StepLimit) -> Self {
+        StepPlan { limit, ..self }
     }
 }
 
@@ -108,6 +139,8 @@ pub(super) struct StepScratch {
     pub prior_forces: Vec<Vec3>,
     /// The collision pass's contact elements (mesh colliders, self-collision).
     pub contacts: Vec<crate::collide::Contact>,
+    /// Self-collision's memory before a piece of a split substep (`split.rs`).
+    pub piece_memory: crate::collide::self_collision::SavedMemory,
     /// The free vertices self-collision's impact zones moved this step.
     pub zone_moved: Vec<u32>,
     /// The cloth's passages through the mesh colliders this step, the free vertices they
@@ -237,8 +270,9 @@ macro_rules! first_pass {
 }
 
 impl Cloth {
-    /// One step as `plan` says. Nothing is committed unless every pass succeeds.
-    pub(super) fn advance(&mut self, plan: StepPlan) -> Result<(), Error> {
+    /// One step as `plan` says. Nothing is committed unless every pass succeeds and the step
+    /// is [`Advanced::Taken`].
+    pub(super) fn advance(&mut self, plan: StepPlan) -> Result<Advanced, Error> {
         let h = plan.h;
         self.prepare()?;
         self.pin_goals(&plan);
@@ -258,7 +292,10 @@ impl Cloth {
             (None, Route::Implicit) => self.forces_and_implicit_step(h, weights)?,
         };
         let friction = self.friction(h) | self.contact_friction(h);
-        let limited = self.limit_collision_step() > 0;
+        let limited = match self.limit_collision_step(plan.limit) {
+            super::collisions::Limited::Over(ratio) => return Ok(Advanced::TooFar(ratio)),
+            super::collisions::Limited::Slowed(count) => count > 0,
+        };
         self.pins(h);
         let carried = self.carry_through_meshes(h, plan.fraction);
         self.mesh_carried += carried as u64;
@@ -270,7 +307,7 @@ impl Cloth {
         }
         self.commit(h);
         self.mesh_from = plan.fraction.unwrap_or(1.0);
-        Ok(())
+        Ok(Advanced::Taken)
     }
 
     /// Sizes the step's buffers and lets the histories make room for the step.

@@ -490,7 +490,9 @@ pub unsafe extern "C" fn fc_cloth_history_bytes_per_particle(cloth: *const FcClo
 }
 
 /// Advances by `dt` seconds in `substeps` equal substeps (1 ..= 1000000); pins travel in a
-/// straight line to their targets over the whole call. Atomic over the whole call.
+/// straight line to their targets over the whole call. Atomic over the whole call. With
+/// self-collision a substep in which a vertex would move more than half its thickness is taken
+/// in up to 32 equal pieces (`fc_cloth_get_step_stats` counts them).
 ///
 /// # Safety
 /// `cloth` NULL or live.
@@ -547,7 +549,8 @@ pub unsafe extern "C" fn fc_cloth_get_solver_stats(
 }
 
 /// Reads what the last `fc_cloth_step` or `fc_cloth_step_substeps` did: the substeps it took
-/// (with the automatic step, those of the attempt that succeeded), how many times the automatic
+/// (with the automatic step, those of the attempt that succeeded; with self-collision, the
+/// pieces of the substeps it split counted one by one), how many times the automatic
 /// step retried with twice the substeps after a refused substep, and its substep estimate in
 /// seconds (0 with a fixed step). All 0 before the first step. Any output may be NULL.
 ///

@@ -1,0 +1,253 @@
+//! Self-collision's split of a substep: a substep in which a free vertex would move farther than
+//! self-collision's step limit ([`SELF_COLLISION_STEP_LIMIT`] of the thickness) is taken in
+//! 2, 4, ... equal pieces instead, each within the limit, so that a long fixed substep (a host's
+//! `fc_cloth_step` at frame rate) keeps its motion instead of having it slowed.
+//!
+//! **How.** Before a substep the pieces are predicted from the free vertices' speeds
+//! (`|v| h` over the limit; at most [`SPLIT_AIM`] of it a piece). A piece whose proposed state
+//! still moves a vertex too far is refused, nothing committed ([`Advanced::TooFar`]), and the
+//! rest of the substep is taken in as many more pieces as its overshoot says. Pieces are
+//! always `h / 2^level`, so those taken stay on the grid of the finer ones.
+//!
+//! **Where it stops.** At [`MAX_SPLIT_LEVEL`] (32 pieces) a vertex still too fast is slowed to
+//! the limit, as before the split existed ([`StepLimit::Slow`]); and a substep whose
+//! vertices are predicted well within the limit ([`REFUSE_FROM`]) is not watched, so that a
+//! slow cloth pays nothing: a vertex flung past the limit there is slowed.
+//!
+//! Without self-collision a substep is one piece and nothing here runs.
+//!
+//! [`SELF_COLLISION_STEP_LIMIT`]: super::collisions::SELF_COLLISION_STEP_LIMIT
+
+use super::collisions::SELF_COLLISION_STEP_LIMIT;
+use super::step::{Advanced, Stage, StepLimit, StepPlan};
+use super::{Cloth, Rollback};
+use crate::error::Error;
+
+/// A piece aims at moving its fastest vertex at most this fraction of the step limit.
+pub const SPLIT_AIM: f64 = 0.8;
+
+/// At most `2^MAX_SPLIT_LEVEL` pieces a substep (32).
+pub const MAX_SPLIT_LEVEL: u32 = 5;
+
+/// A substep whose fastest free vertex is predicted to move less than this fraction of the
+/// limit is taken whole, unwatched (a vertex over the limit is slowed): it would have to
+/// speed up this many times over within one substep to need a split.
+pub const REFUSE_FROM: f64 = 0.25;
+
+impl Cloth {
+    /// One substep of size `h` whose pins and mesh colliders go from fraction `f0` of the
+    /// call's travel to `f1` (None: the call's end), split as self-collision's step limit needs
+    /// (module docs). Returns the pieces taken. Not atomic: on an error the caller restores
+    /// `snap` when `saved` says it holds the call's start; a call of one first-order step has
+    /// none until a split needs it (made here, before the first piece commits anything).
+    pub(super) fn take_substep(
+        &mut self,
+        h: f64,
+        f0: f64,
+        f1: Option<f64>,
+        snap: &mut Rollback,
+        saved: &mut bool,
+    ) -> Result<u32, Error> {
+        let thickness = self.config.model.self_collision_thickness;
+        let (watched, mut level) = match thickness > 0.0 {
+            true => self.predicted_split(h, SELF_COLLISION_STEP_LIMIT * thickness),
+            false => (false, 0),
+        };
+        let end = f1.unwrap_or(1.0);
+        let (mut done, mut taken) = (0u32, 0u32);
+        let mut memory = std::mem::take(&mut self.scratch.piece_memory);
+        let result = loop {
+            let pieces = 1u32 << level;
+            if done == pieces {
+                break Ok(taken);
+            }
+            if level > 0 && !*saved {
+                // The call's only step, split: nothing is committed yet, so this is its start.
+                if let Err(e) = snap.save(self) {
+                    break Err(e);
+                }
+                *saved = true;
+            }
+            let limit = match watched && level < MAX_SPLIT_LEVEL {
+                true => StepLimit::Refuse,
+                false => StepLimit::Slow,
+            };
+            // What self-collision remembers, for a refused piece or a failed unsaved call. (A
+            // retry from the same state would look at the same pairs, so for a refused piece
+            // this is defence: `a_refused_piece_leaves_no_trace` passes without it.)
+            let keep = thickness > 0.0 && (limit == StepLimit::Refuse || !*saved);
+            if keep {
+                self.self_collision.save_memory(&mut memory);
+            }
+            let at = |j: u32| f0 + (end - f0) * f64::from(j) / f64::from(pieces);
+            let (a, b) = (at(done), (done + 1 < pieces).then(|| at(done + 1)).or(f1));
+            let piece = h / f64::from(pieces);
+            let outcome = if self.config.integrator.is_extrapolated() {
+                self.extrapolated_advance(piece, a, b, limit)
+            } else {
+                let plan = StepPlan::new(self.config.integrator, piece, b, Stage::Whole);
+                self.advance(plan.limited(limit))
+            };
+            match outcome {
+                Ok(Advanced::Taken) => {
+                    done += 1;
+                    taken += 1;
+                }
+                Ok(Advanced::TooFar(ratio)) => {
+                    self.self_collision.swap_memory(&mut memory);
+                    let next = (level + more_levels(ratio)).min(MAX_SPLIT_LEVEL);
+                    done <<= next - level;
+                    level = next;
+                }
+                Err(e) => {
+                    if keep && !*saved {
+                        self.self_collision.swap_memory(&mut memory);
+                    }
+                    break Err(e);
+                }
+            }
+        };
+        self.scratch.piece_memory = memory;
+        result
+    }
+
+    /// Whether a substep of `h` is watched for the step limit `limit` (m), and the level of
+    /// pieces its free vertices' speeds ask for (0: whole).
+    fn predicted_split(&self, h: f64, limit: f64) -> (bool, u32) {
+        let fastest2 = self
+            .v
+            .iter()
+            .zip(&self.pinned)
+            .filter(|(_, &pinned)| !pinned)
+            .map(|(v, _)| v.norm_squared())
+            .fold(0.0, f64::max);
+        let ratio = fastest2.sqrt() * h / limit;
+        // A NaN speed is left to the step's check.
+        if ratio.is_nan() || ratio < REFUSE_FROM {
+            return (false, 0);
+        }
+        (
+            true,
+            if ratio > 1.0 {
+                more_levels(ratio).min(MAX_SPLIT_LEVEL)
+            } else {
+                0
+            },
+        )
+    }
+}
+
+/// How many levels (halvings) bring a piece that moves `ratio` times the limit to
+/// [`SPLIT_AIM`] of it or below (at least one).
+fn more_levels(ratio: f64) -> u32 {
+    let levels = (ratio / SPLIT_AIM).log2().ceil();
+    if levels.is_nan() || levels < 1.0 {
+        1
+    } else {
+        levels.min(f64::from(MAX_SPLIT_LEVEL)) as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Model;
+    use crate::{ClothConfig, GridSpec, Integrator, Vec3};
+
+    #[test]
+    fn a_piece_over_the_limit_is_split_to_the_aim() {
+        // 1.5 times the limit: halves (0.75 <= 0.8).
+        assert_eq!(more_levels(1.5), 1);
+        // 1.7: quarters (0.85 > 0.8 in halves).
+        assert_eq!(more_levels(1.7), 2);
+        assert_eq!(more_levels(6.0), 3);
+        // At least one level, never more than the cap, whatever the ratio.
+        assert_eq!(more_levels(1.0 + 1e-12), 1);
+        assert_eq!(more_levels(1e300), MAX_SPLIT_LEVEL);
+        assert_eq!(more_levels(f64::INFINITY), MAX_SPLIT_LEVEL);
+        assert_eq!(more_levels(f64::NAN), 1);
+    }
+
+    /// A 21 x 21 towel of the underwater preset with self-collision 4 mm, implicit Euler, its
+    /// top row pinned: its lower half folded up in front of the upper half, 6 mm off it (so
+    /// that self-collision has pairs in reach and remembers them), moving at `speed` m/s
+    /// towards it, and its rows beyond the fold stretched by `stretch` (their springs then pull
+    /// them back within a step).
+    fn folded(speed: f64, stretch: f64) -> Cloth {
+        let t = GridSpec {
+            width: 21,
+            height: 21,
+            spacing: 0.01,
+            total_mass: 0.04,
+        }
+        .build()
+        .expect("a grid");
+        let model = Model {
+            self_collision_thickness: 0.004,
+            self_collision_friction: 0.3,
+            ..Model::underwater()
+        };
+        let config = ClothConfig {
+            model,
+            integrator: Integrator::ImplicitEuler,
+            ..ClothConfig::default()
+        };
+        let mut c = Cloth::new(t, config).expect("a cloth");
+        c.set_pinned(&(0..21).collect::<Vec<u32>>()).expect("pins");
+        let (mut x, mut v) = (c.positions().to_vec(), vec![Vec3::zeros(); c.vertex_count()]);
+        for (i, (x, v)) in x.iter_mut().zip(&mut v).enumerate() {
+            let row = (i / 21) as f64;
+            if row > 10.0 {
+                // Row 10 + k goes to row 10 - k * stretch, in front.
+                let k = row - 10.0;
+                *x = Vec3::new(x.x, -0.01 * (10.0 - k * stretch), 0.006);
+                *v = Vec3::new(0.0, 0.0, -speed);
+            }
+        }
+        c.set_positions(&x).expect("positions");
+        c.set_velocities(&v).expect("velocities");
+        c
+    }
+
+    /// Everything a call leaves: positions, velocities and the snapshot's bytes (histories,
+    /// self-collision's memory).
+    fn state(c: &Cloth) -> (Vec<Vec3>, Vec<Vec3>, Vec<u8>) {
+        let bytes = c.save_snapshot().expect("a snapshot");
+        (c.positions().to_vec(), c.velocities().to_vec(), bytes)
+    }
+
+    /// A substep its vertices' speeds say is too long (0.3 m/s for 1/30 s: 5 times the 2 mm
+    /// limit) is taken in 8 pieces: the same bits as a call asking for 8 substeps, and the
+    /// statistics say 8.
+    #[test]
+    fn a_split_substep_is_the_substeps_it_was_split_into() {
+        let (mut split, mut asked) = (folded(0.3, 1.0), folded(0.3, 1.0));
+        let limit = SELF_COLLISION_STEP_LIMIT * 0.004;
+        assert_eq!(split.predicted_split(1.0 / 30.0, limit), (true, 3));
+        for _ in 0..3 {
+            split.step_substeps(1.0 / 30.0, 1).expect("the split call");
+            asked.step_substeps(1.0 / 30.0, 8).expect("the asked call");
+            assert_eq!(split.step_stats().substeps, asked.step_stats().substeps);
+        }
+        assert!(split.step_stats().substeps >= 8);
+        let (pairs, _) = split.self_collision.pairs();
+        assert!(!pairs.is_empty(), "self-collision remembers pairs");
+        assert!(state(&split) == state(&asked));
+    }
+
+    /// A substep whose start speeds say it fits, but whose springs fling the cloth too far
+    /// within it (3.8 times the limit), is refused before anything is committed and taken in pieces: the same bits
+    /// as a call asking for that many substeps (so the refused attempt left no trace in the
+    /// histories or self-collision's memory).
+    #[test]
+    fn a_refused_piece_leaves_no_trace() {
+        let (mut split, mut asked) = (folded(0.02, 1.1), folded(0.02, 1.1));
+        let limit = SELF_COLLISION_STEP_LIMIT * 0.004;
+        assert_eq!(split.predicted_split(1.0 / 30.0, limit), (true, 0));
+        split.step_substeps(1.0 / 30.0, 1).expect("the split call");
+        let pieces = split.step_stats().substeps;
+        assert!(pieces > 1 && pieces.is_power_of_two(), "{pieces} pieces");
+        asked.step_substeps(1.0 / 30.0, pieces).expect("the asked call");
+        assert!(state(&split) == state(&asked));
+    }
+}
