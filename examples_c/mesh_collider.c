@@ -161,6 +161,12 @@ int main(void) {
         fc_cloth_step(by_spacing, 1.0 / 30.0) == FC_OK &&
         fc_cloth_get_step_stats(by_spacing, &pieces, NULL, NULL) == FC_OK)
         printf("split_pieces %u\n", pieces);
+    uint64_t split_substeps = 9, limit_pieces = 9, slowed = 9;
+    FcStatus limit_status = fc_cloth_get_step_limit_stats(by_spacing, &split_substeps, &limit_pieces, &slowed);
+    printf("limit_stats %d %llu %llu %llu\n", (int)limit_status, (unsigned long long)split_substeps,
+           (unsigned long long)limit_pieces, (unsigned long long)slowed);
+    printf("limit_stats_null %d %d\n", (int)fc_cloth_get_step_limit_stats(by_spacing, NULL, NULL, NULL),
+           (int)fc_cloth_get_step_limit_stats(NULL, &split_substeps, NULL, NULL));
     free(fling);
     fc_cloth_destroy(by_spacing);
     relative.self_collision_relative = 10.0;

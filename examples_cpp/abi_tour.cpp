@@ -110,6 +110,9 @@ int main(int argc, char** argv) try {
     // What the continuous collision check did: nothing left passing through.
     const fraccloth::CollisionStats hits = cloth.collision_stats();
     require(hits.unresolved == 0 && hits.passages >= hits.zone_steps, "collision stats");
+    // Self-collision's step limit: this cloth has none, so nothing was split or slowed.
+    const fraccloth::StepLimitStats limit = cloth.step_limit_stats();
+    require(limit.split_substeps == 0 && limit.pieces == 0 && limit.slowed == 0, "step limit stats");
     cloth.remove_collider(capsule);
 
     cloth.write_obj(dir + "/tour.obj");

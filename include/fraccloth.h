@@ -778,6 +778,24 @@ FcStatus fc_cloth_get_collision_stats(const FcCloth *cloth,
                                       uint64_t *mesh_carried);
 
 /**
+ * Reads what self-collision's step limit did since the cloth was made (steps that a refused
+ * call undid included). No free vertex moves more than half the self-collision thickness in a
+ * substep: `split_substeps`, the substeps taken in pieces instead (2 to 32 equal ones) and
+ * `pieces`, how many; `slowed`, free vertices slowed to the limit, summed over steps, the last
+ * resort when 32 pieces are not enough or a substep predicted slow is not (not 0: some motion
+ * was held back, e.g. a fixed step too long to be stable that self-collision held instead of
+ * refusing; the automatic step, `FC_MAX_SUBSTEP_AUTO`, takes steps that need none). All 0
+ * without self-collision. Any output may be NULL.
+ *
+ * # Safety
+ * `cloth` NULL or live; outputs NULL or writable.
+ */
+FcStatus fc_cloth_get_step_limit_stats(const FcCloth *cloth,
+                                       uint64_t *split_substeps,
+                                       uint64_t *pieces,
+                                       uint64_t *slowed);
+
+/**
  * Whether an implicit step whose solver stops at `solver_max_iterations` above
  * `solver_tolerance` is accepted (`accept` non-zero: the step returns `FC_OK`; read
  * `fc_cloth_get_solver_stats`) or refused (0, the default: `FC_ERROR_NOT_CONVERGED`, the

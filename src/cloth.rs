@@ -23,6 +23,7 @@ use step::{Rollback, StepScratch};
 
 pub use auto_step::{safety, StepStats, AUTO, MAX_RETRIES, SAFETY, SAFETY_SYMPLECTIC};
 pub use snapshot::SNAPSHOT_VERSION;
+pub use split::StepLimitStats;
 
 use crate::collide::{MeshCollider, SelfCollision};
 use crate::error::{check_finite_vec, check_non_negative, check_positive, Error};
@@ -178,6 +179,8 @@ pub struct Cloth {
     /// Cloth vertices the mesh colliders carried (kept from passing through them), summed
     /// over the steps since the cloth was made.
     mesh_carried: u64,
+    /// What self-collision's step limit did since the cloth was made (`split.rs`).
+    limit_stats: StepLimitStats,
     /// The half-derivative memories the model's terms and pair elements read.
     histories: Histories,
     time: f64,
@@ -261,6 +264,7 @@ impl Cloth {
             self_collision,
             mesh_from: 0.0,
             mesh_carried: 0,
+            limit_stats: StepLimitStats::default(),
             histories: Histories::new(&config.model, config.scheme, &topology)?,
             time: 0.0,
             steps: 0,

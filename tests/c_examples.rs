@@ -207,6 +207,18 @@ fn mesh_collider_example_keeps_the_towel_outside_the_box() {
     // taken in 16ths), at most 32, counted in the step statistics.
     let pieces: u32 = field(&out, "split_pieces")[0].parse().unwrap();
     assert!((8..=32).contains(&pieces), "{pieces} pieces");
+    // The step limit's own statistics: one substep split, into those pieces, none slowed
+    // (a piece is never slowed before 32: it is split again).
+    let limit = field(&out, "limit_stats");
+    assert_eq!(limit[0], (FcStatus::FC_OK as i32).to_string());
+    assert_eq!(limit[1..], ["1".to_string(), pieces.to_string(), "0".to_string()]);
+    assert_eq!(
+        field(&out, "limit_stats_null"),
+        vec![
+            (FcStatus::FC_OK as i32).to_string(),
+            (FcStatus::FC_ERROR_NULL_ARGUMENT as i32).to_string()
+        ]
+    );
     assert_eq!(
         status("relative_thick"),
         FcStatus::FC_ERROR_INVALID_ARGUMENT as i32

@@ -115,6 +115,14 @@ struct CollisionStats {
     uint64_t mesh_carried = 0;  ///< cloth vertices a mesh collider carried, summed over steps
 };
 
+/// What self-collision's step limit did since the cloth was made
+/// (`fc_cloth_get_step_limit_stats`).
+struct StepLimitStats {
+    uint64_t split_substeps = 0;  ///< substeps taken in pieces (no vertex past half the thickness)
+    uint64_t pieces = 0;          ///< the pieces they were taken in
+    uint64_t slowed = 0;          ///< free vertices slowed to the limit (not 0: motion held back)
+};
+
 /// One simulated cloth. Move-only; the handle is freed by the destructor.
 class Cloth {
 public:
@@ -186,6 +194,11 @@ public:
         CollisionStats s;
         check(fc_cloth_get_collision_stats(handle_, &s.zone_steps, &s.passages, &s.zone_moved,
                                            &s.unresolved, &s.mesh_carried));
+        return s;
+    }
+    StepLimitStats step_limit_stats() const {
+        StepLimitStats s;
+        check(fc_cloth_get_step_limit_stats(handle_, &s.split_substeps, &s.pieces, &s.slowed));
         return s;
     }
     /// Accept (true) or refuse (false, the default) implicit steps whose solver did not converge.

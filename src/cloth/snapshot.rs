@@ -562,6 +562,7 @@ impl Cloth {
         std::mem::swap(&mut self.pin_target, &mut targets);
         let unconverged = std::mem::replace(&mut self.config.accept_unconverged, true);
         let (solver, stats, carried) = (self.solver_stats, self.step_stats, self.mesh_carried);
+        let limit_stats = self.limit_stats;
         // The mesh colliders as loaded (their lists and trees empty: small to copy), so that
         // the step's refresh of them is not kept.
         let meshes = self.mesh_slots.clone();
@@ -573,6 +574,7 @@ impl Cloth {
         snap.targets = targets;
         self.config.accept_unconverged = unconverged;
         (self.solver_stats, self.step_stats, self.mesh_carried) = (solver, stats, carried);
+        self.limit_stats = limit_stats;
         self.rollback = snap;
         done.map(|_| ())
     }

@@ -34,7 +34,26 @@ pub const MAX_SPLIT_LEVEL: u32 = 5;
 /// speed up this many times over within one substep to need a split.
 pub const REFUSE_FROM: f64 = 0.25;
 
+/// What self-collision's step limit did since a cloth was made (steps a refused call undid
+/// included).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StepLimitStats {
+    /// Substeps taken in pieces.
+    pub split_substeps: u64,
+    /// The pieces those substeps were taken in.
+    pub pieces: u64,
+    /// Free vertices slowed to the limit, summed over steps: the last resort, in a substep
+    /// already in 32 pieces or one predicted well within the limit (under a quarter of it). Not 0 means some motion was held back: a step too long for the
+    /// cloth's speed (an unstable fixed step, say) that no host asked to refuse.
+    pub slowed: u64,
+}
+
 impl Cloth {
+    /// What self-collision's step limit did since the cloth was made ([`StepLimitStats`]).
+    pub fn step_limit_stats(&self) -> StepLimitStats {
+        self.limit_stats
+    }
+
     /// One substep of size `h` whose pins and mesh colliders go from fraction `f0` of the
     /// call's travel to `f1` (None: the call's end), split as self-collision's step limit needs
     /// (module docs). Returns the pieces taken. Not atomic: on an error the caller restores
@@ -59,6 +78,11 @@ impl Cloth {
         let result = loop {
             let pieces = 1u32 << level;
             if done == pieces {
+                if taken > 1 {
+                    let stats = &mut self.limit_stats;
+                    stats.split_substeps += 1;
+                    stats.pieces += u64::from(taken);
+                }
                 break Ok(taken);
             }
             if level > 0 && !*saved {
@@ -233,6 +257,25 @@ mod tests {
         let (pairs, _) = split.self_collision.pairs();
         assert!(!pairs.is_empty(), "self-collision remembers pairs");
         assert!(state(&split) == state(&asked));
+        // Three substeps split, into the pieces counted, none slowed; the asked call split none.
+        let stats = split.step_limit_stats();
+        assert_eq!((stats.split_substeps, stats.slowed), (3, 0));
+        assert!(stats.pieces >= 24);
+        assert_eq!(asked.step_limit_stats(), StepLimitStats::default());
+    }
+
+    /// A substep from rest is predicted within the limit and not watched: a vertex its springs
+    /// fling past the limit within it is slowed, and counted (the motion held back).
+    #[test]
+    fn a_substep_predicted_slow_is_slowed_and_counted() {
+        let mut c = folded(0.0, 1.5);
+        let limit = SELF_COLLISION_STEP_LIMIT * 0.004;
+        assert_eq!(c.predicted_split(1.0 / 30.0, limit), (false, 0));
+        c.step_substeps(1.0 / 30.0, 1).expect("the call");
+        let stats = c.step_limit_stats();
+        assert_eq!((stats.split_substeps, stats.pieces), (0, 0));
+        assert!(stats.slowed > 0, "{stats:?}");
+        assert_eq!(c.step_stats().substeps, 1);
     }
 
     /// A substep whose start speeds say it fits, but whose springs fling the cloth too far

@@ -294,7 +294,10 @@ impl Cloth {
         let friction = self.friction(h) | self.contact_friction(h);
         let limited = match self.limit_collision_step(plan.limit) {
             super::collisions::Limited::Over(ratio) => return Ok(Advanced::TooFar(ratio)),
-            super::collisions::Limited::Slowed(count) => count > 0,
+            super::collisions::Limited::Slowed(count) => {
+                self.limit_stats.slowed += count as u64;
+                count > 0
+            }
         };
         self.pins(h);
         let carried = self.carry_through_meshes(h, plan.fraction);

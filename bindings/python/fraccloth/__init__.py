@@ -28,6 +28,7 @@ __all__ = [
     "SolverStats",
     "StepStats",
     "CollisionStats",
+    "StepLimitStats",
     "MAX_SUBSTEP_AUTO",
     "PRESET_FRACTIONAL_PAPER",
     "PRESET_REGULAR_VISCOUS_NORMAL",
@@ -172,6 +173,7 @@ _SIGNATURES = {
     "fc_cloth_get_solver_stats": (_c.c_int, [_P, _U32P, _D3]),
     "fc_cloth_get_step_stats": (_c.c_int, [_P, _U32P, _U32P, _D3]),
     "fc_cloth_get_collision_stats": (_c.c_int, [_P, _U64P, _U64P, _U64P, _U64P, _U64P]),
+    "fc_cloth_get_step_limit_stats": (_c.c_int, [_P, _U64P, _U64P, _U64P]),
     "fc_cloth_set_solver_accept_unconverged": (_c.c_int, [_P, _c.c_int32]),
     "fc_cloth_snapshot_size": (_c.c_size_t, [_P]),
     "fc_cloth_save_snapshot": (_c.c_int, [_P, _P, _c.c_size_t, _c.POINTER(_c.c_size_t)]),
@@ -357,6 +359,17 @@ class CollisionStats(NamedTuple):
     zone_moved: int
     unresolved: int
     mesh_carried: int
+
+
+class StepLimitStats(NamedTuple):
+    """What self-collision's step limit (no free vertex moves more than half the thickness in a
+    substep) did since the cloth was made: ``split_substeps`` (substeps taken in pieces instead),
+    ``pieces`` (how many), ``slowed`` (free vertices slowed to the limit, summed over steps; not 0
+    means some motion was held back, e.g. an unstable fixed step held instead of refused)."""
+
+    split_substeps: int
+    pieces: int
+    slowed: int
 
 
 class SolverStats(NamedTuple):
@@ -587,6 +600,12 @@ class Cloth:
         out = [ctypes.c_uint64() for _ in range(5)]
         _check(library.fc_cloth_get_collision_stats(self._h, *(ctypes.byref(o) for o in out)))
         return CollisionStats(*(o.value for o in out))
+
+    def step_limit_stats(self) -> StepLimitStats:
+        """What self-collision's step limit did since the cloth was made."""
+        out = [ctypes.c_uint64() for _ in range(3)]
+        _check(library.fc_cloth_get_step_limit_stats(self._h, *(ctypes.byref(o) for o in out)))
+        return StepLimitStats(*(o.value for o in out))
 
     def set_solver_accept_unconverged(self, accept: bool) -> None:
         """Accept (True) or refuse (False, the default) implicit steps that stop at the

@@ -337,6 +337,32 @@ def test_triangle_mesh_collider_and_self_collision():
             cloth.set_mesh_collider(mesh, box[:7])
 
 
+def test_a_fixed_substep_too_long_for_self_collision_is_split_and_counted():
+    """A cloth flung at 0.5 m/s with self-collision 6 mm, one 1/30 s substep a call: the substep
+    is taken in pieces (at least the 8 its speed predicts), and both statistics say so; a cloth
+    without self-collision splits nothing."""
+    desc = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
+    desc.width, desc.height, desc.spacing = 31, 21, 0.02
+    desc.max_substep = 0.0
+    plain = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
+    plain.width, plain.height, plain.spacing, plain.max_substep = 31, 21, 0.02, 0.0
+    desc.self_collision_thickness = 0.006
+    for d, split in ((desc, True), (plain, False)):
+        with fraccloth.Cloth.grid(d) as cloth:
+            assert cloth.step_limit_stats() == fraccloth.StepLimitStats(0, 0, 0)
+            v = np.zeros((cloth.vertex_count, 3))
+            v[:, 2] = 0.5
+            cloth.velocities = v
+            cloth.step(1.0 / 30.0)
+            pieces = cloth.step_stats().substeps
+            stats = cloth.step_limit_stats()
+            if split:
+                assert 8 <= pieces <= 32
+                assert stats.split_substeps == 1 and stats.pieces == pieces
+            else:
+                assert pieces == 1 and stats == fraccloth.StepLimitStats(0, 0, 0)
+
+
 def test_a_description_prints_its_fields():
     desc = fraccloth.preset_desc(fraccloth.PRESET_UNDERWATER)
     text = repr(desc)
