@@ -19,7 +19,8 @@
 //! past the thickness but within the list's reach (no step brings a pair more than a thickness
 //! closer, so it went through). A pair apart and off the face (past an edge's end, or edges
 //! near parallel) forgets its side: it may go round the border of a fold. Together with the step limit (no
-//! vertex moves more than half the thickness in a step, `Cloth::limit_collision_step`) no pair can cross
+//! vertex moves more than half the thickness in a step: a substep that would is split, or as a last
+//! resort its fast vertices slowed, `cloth/split.rs`, `Cloth::limit_collision_step`) no pair can cross
 //! unnoticed. The sides are the only state self-collision keeps (snapshots carry them).
 //! Neighbours left out of the list (edge pairs and vertex-triangle pairs nearer than the
 //! exclusion at rest) are watched by the [`Guard`], whose pairs the impact zones check when
