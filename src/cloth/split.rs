@@ -279,9 +279,10 @@ mod tests {
     }
 
     /// A substep whose start speeds say it fits, but whose springs fling the cloth too far
-    /// within it (3.8 times the limit), is refused before anything is committed and taken in pieces: the same bits
-    /// as a call asking for that many substeps (so the refused attempt left no trace in the
-    /// histories or self-collision's memory).
+    /// within it (3.8 times the limit, read once by a throwaway print: it was split into 8),
+    /// is refused before anything is committed and taken in pieces: the same bits as a call
+    /// asking for that many substeps (so the refused attempt left no trace in the histories
+    /// or self-collision's memory).
     #[test]
     fn a_refused_piece_leaves_no_trace() {
         let (mut split, mut asked) = (folded(0.02, 1.1), folded(0.02, 1.1));
