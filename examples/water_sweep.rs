@@ -15,7 +15,8 @@
 //! springs damp), `history=` (history drag per area, N s^1/2/m^3; the SOE history is kept),
 //! `self=` (self-collision thickness in spacings, friction 0.3; 0.4 is the tests' 4 mm at 1 cm).
 //! The last columns: the substeps a step call took on average (self-collision splits a
-//! substep its step limit refuses) and the bake's wall-clock seconds.
+//! substep its step limit refuses), the free vertices its limit slowed (summed over steps: the
+//! motion held back) and the bake's wall-clock seconds.
 
 use fraccloth::{Integrator, Model, Vec3};
 use fraccloth_tools::look::measure;
@@ -106,7 +107,7 @@ fn main() {
         model.water.skin_drag_memory,
         model.spring_damping
     );
-    println!("freq Hz | half-waves | travel m/s | mid | bottom | zigzag | hang m | max speed m/s | substeps a call | s | status");
+    println!("freq Hz | half-waves | travel m/s | mid | bottom | zigzag | hang m | max speed m/s | substeps a call | slowed | s | status");
     for f in freqs {
         let spec = SceneSpec {
             width: w,
@@ -191,13 +192,14 @@ fn main() {
             Ok(look) => {
                 let d = &look.descriptors;
                 println!(
-                    "{f} | {:.2} | {} | {:.3} | {:.3} | {} | {:.3} | {vmax:.3} | {per_call:.2} | {wall:.1} | {status}",
+                    "{f} | {:.2} | {} | {:.3} | {:.3} | {} | {:.3} | {vmax:.3} | {per_call:.2} | {} | {wall:.1} | {status}",
                     d.half_waves,
                     d.travel_speed.map_or("-".into(), |c| format!("{c:.3}")),
                     d.mid_ratio,
                     d.bottom_ratio,
                     d.zigzag.map_or("-".into(), |z| format!("{z:.2}")),
-                    d.hang_depth
+                    d.hang_depth,
+                    scene.cloth.step_limit_stats().slowed
                 );
             }
             Err(e) => println!("{f} | not measured: {e} | {status}"),

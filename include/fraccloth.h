@@ -782,10 +782,11 @@ FcStatus fc_cloth_get_collision_stats(const FcCloth *cloth,
  * call undid included). No free vertex moves more than half the self-collision thickness in a
  * substep: `split_substeps`, the substeps taken in pieces instead (2 to 32 equal ones) and
  * `pieces`, how many; `slowed`, free vertices slowed to the limit, summed over steps, the last
- * resort when 32 pieces are not enough or a substep predicted slow is not (not 0: some motion
- * was held back, e.g. a fixed step too long to be stable that self-collision held instead of
- * refusing; the automatic step, `FC_MAX_SUBSTEP_AUTO`, takes steps that need none). All 0
- * without self-collision. Any output may be NULL.
+ * resort when 32 pieces are not enough (not 0: some motion was held back, e.g. a vertex flung
+ * faster than 32 pieces can follow). A fixed substep too long to be stable is not refused
+ * with self-collision but held in pieces (it jitters: the automatic step,
+ * `FC_MAX_SUBSTEP_AUTO`, takes stable ones). All 0 without self-collision. Any output may be
+ * NULL.
  *
  * # Safety
  * `cloth` NULL or live; outputs NULL or writable.

@@ -10,9 +10,16 @@
 //! always `h / 2^level`, so those taken stay on the grid of the finer ones.
 //!
 //! **Where it stops.** At [`MAX_SPLIT_LEVEL`] (32 pieces) a vertex still too fast is slowed to
-//! the limit, as before the split existed ([`StepLimit::Slow`]); and a substep whose
-//! vertices are predicted well within the limit ([`REFUSE_FROM`]) is not watched, so that a
-//! slow cloth pays nothing: a vertex flung past the limit there is slowed.
+//! the limit, as before the split existed ([`StepLimit::Slow`]); that is the only slowing.
+//!
+//! **What a slow cloth pays.** Nothing but the prediction's pass over the speeds. A substep
+//! whose vertices are predicted well within the limit ([`REFUSE_FROM`]) is not *watched*: self-
+//! collision's memory is not copied before it. Such a substep is still refused when a vertex
+//! is flung past the limit within it (the first step from rest, whose speeds predict nothing);
+//! its retry then starts from whatever look the refused attempt made at the same start
+//! positions (pairs found there, by a reach the longer attempt may have made wider), so its
+//! bits may differ from asking for that many substeps, not its validity. A call of one
+//! first-order substep copies the memory anyway (it has no other rollback) and keeps its bits.
 //!
 //! Without self-collision a substep is one piece and nothing here runs.
 //!
@@ -30,8 +37,9 @@ pub const SPLIT_AIM: f64 = 0.8;
 pub const MAX_SPLIT_LEVEL: u32 = 5;
 
 /// A substep whose fastest free vertex is predicted to move less than this fraction of the
-/// limit is taken whole, unwatched (a vertex over the limit is slowed): it would have to
-/// speed up this many times over within one substep to need a split.
+/// limit is taken whole and not watched (self-collision's memory is not copied before it): it
+/// would have to speed up this many times over within one substep to need a split. If it
+/// does, it is refused and split all the same.
 pub const REFUSE_FROM: f64 = 0.25;
 
 /// What self-collision's step limit did since a cloth was made (steps a refused call undid
@@ -43,7 +51,7 @@ pub struct StepLimitStats {
     /// The pieces those substeps were taken in.
     pub pieces: u64,
     /// Free vertices slowed to the limit, summed over steps: the last resort, in a substep
-    /// already in 32 pieces or one predicted well within the limit (under a quarter of it). Not 0 means some motion was held back: a step too long for the
+    /// already in 32 pieces. Not 0 means some motion was held back: a step too long for the
     /// cloth's speed (an unstable fixed step, say) that no host asked to refuse.
     pub slowed: u64,
 }
@@ -92,14 +100,15 @@ impl Cloth {
                 }
                 *saved = true;
             }
-            let limit = match watched && level < MAX_SPLIT_LEVEL {
+            let limit = match level < MAX_SPLIT_LEVEL {
                 true => StepLimit::Refuse,
                 false => StepLimit::Slow,
             };
-            // What self-collision remembers, for a refused piece or a failed unsaved call. (A
-            // retry from the same state would look at the same pairs, so for a refused piece
-            // this is defence: `a_refused_piece_leaves_no_trace` passes without it.)
-            let keep = thickness > 0.0 && (limit == StepLimit::Refuse || !*saved);
+            // What self-collision remembers, for a refused piece of a watched substep or a
+            // failed unsaved call. (A retry from the same state would look at the same pairs,
+            // so for a refused piece this is defence: `a_refused_piece_leaves_no_trace` passes
+            // without it; an unwatched substep goes without, module docs.)
+            let keep = thickness > 0.0 && (watched || !*saved);
             if keep {
                 self.self_collision.save_memory(&mut memory);
             }
@@ -118,7 +127,9 @@ impl Cloth {
                     taken += 1;
                 }
                 Ok(Advanced::TooFar(ratio)) => {
-                    self.self_collision.swap_memory(&mut memory);
+                    if keep {
+                        self.self_collision.swap_memory(&mut memory);
+                    }
                     let next = (level + more_levels(ratio)).min(MAX_SPLIT_LEVEL);
                     done <<= next - level;
                     level = next;
@@ -264,18 +275,30 @@ mod tests {
         assert_eq!(asked.step_limit_stats(), StepLimitStats::default());
     }
 
-    /// A substep from rest is predicted within the limit and not watched: a vertex its springs
-    /// fling past the limit within it is slowed, and counted (the motion held back).
+    /// A substep from rest is predicted within the limit and not watched, yet its springs fling
+    /// vertices past the limit within it: it is refused and split all the same, nothing slowed
+    /// (before stop 65 such a vertex was slowed). A call of that one substep keeps its bits
+    /// (the same as asking for that many substeps); a call of two, whose first substep is
+    /// unwatched and goes without a copy of self-collision's memory, splits it too.
     #[test]
-    fn a_substep_predicted_slow_is_slowed_and_counted() {
-        let mut c = folded(0.0, 1.5);
+    fn a_substep_predicted_slow_but_flung_is_split_not_slowed() {
+        let (mut c, mut asked) = (folded(0.0, 1.1), folded(0.0, 1.1));
         let limit = SELF_COLLISION_STEP_LIMIT * 0.004;
         assert_eq!(c.predicted_split(1.0 / 30.0, limit), (false, 0));
         c.step_substeps(1.0 / 30.0, 1).expect("the call");
         let stats = c.step_limit_stats();
-        assert_eq!((stats.split_substeps, stats.pieces), (0, 0));
-        assert!(stats.slowed > 0, "{stats:?}");
-        assert_eq!(c.step_stats().substeps, 1);
+        assert_eq!((stats.split_substeps, stats.slowed), (1, 0), "{stats:?}");
+        let pieces = c.step_stats().substeps;
+        assert!(pieces > 1 && pieces.is_power_of_two(), "{pieces} pieces");
+        assert_eq!(stats.pieces, u64::from(pieces));
+        asked.step_substeps(1.0 / 30.0, pieces).expect("the asked call");
+        assert!(state(&c) == state(&asked));
+
+        let mut two = folded(0.0, 1.1);
+        two.step_substeps(2.0 / 30.0, 2).expect("the call of two");
+        let stats = two.step_limit_stats();
+        assert!(stats.split_substeps >= 1 && stats.slowed == 0, "{stats:?}");
+        assert!(two.step_stats().substeps > 2);
     }
 
     /// A substep whose start speeds say it fits, but whose springs fling the cloth too far
