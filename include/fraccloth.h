@@ -16,7 +16,7 @@
 
 #define FC_VERSION_MAJOR 0
 #define FC_VERSION_MINOR 9
-#define FC_VERSION_PATCH 28
+#define FC_VERSION_PATCH 29
 /* Equals fc_version() of the library this header belongs to. */
 #define FC_VERSION (FC_VERSION_MAJOR * 1000000 + FC_VERSION_MINOR * 1000 + FC_VERSION_PATCH)
 
@@ -407,8 +407,10 @@ typedef struct {
    * taken in 2, 4, ... up to 32 equal pieces instead (`fc_cloth_get_step_stats` counts
    * them), so a fixed step keeps its motion (implicit Euler at one 1/30 s substep a frame
    * on the 4 cm, 0.5 Hz swing at 4 mm: 3.6 half-waves, 2.6 substeps a call); past 32 the
-   * fastest vertices are slowed to it. A fixed substep too long to be stable may so be
-   * held in short pieces instead of refused. At most about 1.5 times the mesh's mean edge length: a larger one would list too many
+   * fastest vertices are slowed to it. A split substep's pieces are also no longer than
+   * the automatic step's stable substep, so a fixed substep too long to be stable for
+   * symplectic Euler is taken in stable pieces (up to 32 times 32) instead of refused.
+   * At most about 1.5 times the mesh's mean edge length: a larger one would list too many
    * neighbour pairs and is refused (`FC_ERROR_INVALID_ARGUMENT`, the message says how large
    * a one the mesh takes). See docs/collisions.md.
    */
@@ -783,10 +785,9 @@ FcStatus fc_cloth_get_collision_stats(const FcCloth *cloth,
  * substep: `split_substeps`, the substeps taken in pieces instead (2 to 32 equal ones) and
  * `pieces`, how many; `slowed`, free vertices slowed to the limit, summed over steps, the last
  * resort when 32 pieces are not enough (not 0: some motion was held back, e.g. a vertex flung
- * faster than 32 pieces can follow). A fixed substep too long to be stable is not refused
- * with self-collision but held in pieces (it jitters: the automatic step,
- * `FC_MAX_SUBSTEP_AUTO`, takes stable ones). All 0 without self-collision. Any output may be
- * NULL.
+ * faster than 32 pieces can follow). At a fixed step a split substep's pieces are no longer
+ * than the automatic step's stable substep, so a step too long to be stable is taken in
+ * stable pieces rather than refused. All 0 without self-collision. Any output may be NULL.
  *
  * # Safety
  * `cloth` NULL or live; outputs NULL or writable.

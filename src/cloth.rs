@@ -181,6 +181,9 @@ pub struct Cloth {
     mesh_carried: u64,
     /// What self-collision's step limit did since the cloth was made (`split.rs`).
     limit_stats: StepLimitStats,
+    /// Whether the call under way is the automatic step's (its substeps are stable already:
+    /// `split.rs` sizes a split substep's pieces for stability only at a host's fixed step).
+    auto_call: bool,
     /// The half-derivative memories the model's terms and pair elements read.
     histories: Histories,
     time: f64,
@@ -265,6 +268,7 @@ impl Cloth {
             mesh_from: 0.0,
             mesh_carried: 0,
             limit_stats: StepLimitStats::default(),
+            auto_call: false,
             histories: Histories::new(&config.model, config.scheme, &topology)?,
             time: 0.0,
             steps: 0,

@@ -148,7 +148,10 @@ impl Cloth {
         let mut retries = 0;
         loop {
             let substeps = n as u32;
-            match self.step_substeps(dt, substeps) {
+            self.auto_call = true;
+            let stepped = self.step_substeps(dt, substeps);
+            self.auto_call = false;
+            match stepped {
                 Ok(()) => {
                     if tracks {
                         let t = &self.topology;

@@ -9,7 +9,14 @@
 //! rest of the substep is taken in as many more pieces as its overshoot says. Pieces are
 //! always `h / 2^level`, so those taken stay on the grid of the finer ones.
 //!
-//! **Where it stops.** At [`MAX_SPLIT_LEVEL`] (32 pieces) a vertex still too fast is slowed to
+//! **Stable pieces.** At a host's fixed step (not the automatic step's own calls) a split
+//! substep's pieces are also no longer than the automatic step's stable substep
+//! (`Cloth::stable_level`): an explicit integrator's fixed step too long to be stable, split
+//! for the limit, is then split into stable pieces instead of jittering at the limit's scale.
+//! A substep the limit does not split is taken as the host asked.
+//!
+//! **Where it stops.** At [`MAX_SPLIT_LEVEL`] (32 pieces; 32 times the stable pieces at a
+//! host's fixed step) a vertex still too fast is slowed to
 //! the limit, as before the split existed ([`StepLimit::Slow`]); that is the only slowing.
 //!
 //! **What a slow cloth pays.** Nothing but the prediction's pass over the speeds. A substep
@@ -33,7 +40,8 @@ use crate::error::Error;
 /// A piece aims at moving its fastest vertex at most this fraction of the step limit.
 pub const SPLIT_AIM: f64 = 0.8;
 
-/// At most `2^MAX_SPLIT_LEVEL` pieces a substep (32).
+/// At most `2^MAX_SPLIT_LEVEL` pieces a substep (32) for the limit; at a host's fixed step,
+/// that many times the stable pieces (`Cloth::stable_level`, itself at most this level).
 pub const MAX_SPLIT_LEVEL: u32 = 5;
 
 /// A substep whose fastest free vertex is predicted to move less than this fraction of the
@@ -80,6 +88,14 @@ impl Cloth {
             true => self.predicted_split(h, SELF_COLLISION_STEP_LIMIT * thickness),
             false => (false, 0),
         };
+        // The level a split substep's pieces are at least at, to be stable (found once, when
+        // the substep first splits).
+        let mut stable: Option<u32> = None;
+        // The limit splits up to `MAX_SPLIT_LEVEL` levels beyond those.
+        let top = |stable: Option<u32>| MAX_SPLIT_LEVEL + stable.unwrap_or(0);
+        if level > 0 {
+            level = level.max(*stable.get_or_insert_with(|| self.stable_level(h)));
+        }
         let end = f1.unwrap_or(1.0);
         let (mut done, mut taken) = (0u32, 0u32);
         let mut memory = std::mem::take(&mut self.scratch.piece_memory);
@@ -100,7 +116,7 @@ impl Cloth {
                 }
                 *saved = true;
             }
-            let limit = match level < MAX_SPLIT_LEVEL {
+            let limit = match level < top(stable) {
                 true => StepLimit::Refuse,
                 false => StepLimit::Slow,
             };
@@ -130,7 +146,8 @@ impl Cloth {
                     if keep {
                         self.self_collision.swap_memory(&mut memory);
                     }
-                    let next = (level + more_levels(ratio)).min(MAX_SPLIT_LEVEL);
+                    let floor = *stable.get_or_insert_with(|| self.stable_level(h));
+                    let next = (level + more_levels(ratio)).max(floor).min(top(stable));
                     done <<= next - level;
                     level = next;
                 }
@@ -144,6 +161,22 @@ impl Cloth {
         };
         self.scratch.piece_memory = memory;
         result
+    }
+
+    /// The fewest levels of pieces that bring a substep of `h` within the automatic step's
+    /// stable substep (`Cloth::auto_substep`): a split substep's pieces are no longer, so that
+    /// a host's fixed step too long to be stable, split for the limit, is split into stable
+    /// pieces instead of jittering at the limit's scale. 0 for implicit Euler (no stability
+    /// bound) and in the automatic step's own calls (its substeps are stable already).
+    fn stable_level(&self, h: f64) -> u32 {
+        if self.auto_call || self.config.integrator.is_implicit() {
+            return 0;
+        }
+        let stable = self.auto_substep(h);
+        if stable.is_nan() || stable <= 0.0 || stable >= h {
+            return 0;
+        }
+        ((h / stable).log2().ceil() as u32).min(MAX_SPLIT_LEVEL)
     }
 
     /// Whether a substep of `h` is watched for the step limit `limit` (m), and the level of
@@ -273,6 +306,46 @@ mod tests {
         assert_eq!((stats.split_substeps, stats.slowed), (3, 0));
         assert!(stats.pieces >= 24);
         assert_eq!(asked.step_limit_stats(), StepLimitStats::default());
+    }
+
+    /// Symplectic Euler at a host's fixed 1/30 s, far past its stable substep: a substep its
+    /// speeds split (4 pieces for the limit) is taken in pieces no longer than the automatic
+    /// step's stable one instead (32 here), the same bits as asking for that many substeps;
+    /// without the floor its pieces were unstable and the cloth jittered at the limit's scale.
+    #[test]
+    fn a_split_substep_is_cut_into_stable_pieces_at_a_fixed_step() {
+        // The towel of `folded` unfolded, symplectic Euler, its free vertices moving at
+        // 0.1 m/s across it (3.3 mm in 1/30 s: 4 pieces for the 2 mm limit).
+        let flung = || {
+            let mut c = folded(0.0, 1.0);
+            let t = c.topology().clone();
+            let mut config = c.config.clone();
+            config.integrator = Integrator::SymplecticEuler;
+            c = Cloth::new(t, config).expect("a cloth");
+            c.set_pinned(&(0..21).collect::<Vec<u32>>()).expect("pins");
+            let v: Vec<Vec3> = (0..c.vertex_count())
+                .map(|i| Vec3::new(0.0, 0.0, if i < 21 { 0.0 } else { 0.1 }))
+                .collect();
+            c.set_velocities(&v).expect("velocities");
+            c
+        };
+        let (mut split, mut asked) = (flung(), flung());
+        let h = 1.0 / 30.0;
+        let limit = SELF_COLLISION_STEP_LIMIT * 0.004;
+        assert_eq!(split.predicted_split(h, limit), (true, 2));
+        let floor = split.stable_level(h);
+        assert!(
+            split.auto_substep(h) * 16.0 < h,
+            "1/30 s is far past the stable substep"
+        );
+        assert_eq!(floor, MAX_SPLIT_LEVEL);
+        split.step_substeps(h, 1).expect("the split call");
+        assert_eq!(split.step_stats().substeps, 1 << floor);
+        asked.step_substeps(h, 1 << floor).expect("the asked call");
+        assert!(state(&split) == state(&asked));
+        // The automatic step's own calls are stable already: no floor.
+        split.auto_call = true;
+        assert_eq!(split.stable_level(h), 0);
     }
 
     /// A substep from rest is predicted within the limit and not watched, yet its springs fling

@@ -617,10 +617,9 @@ pub unsafe extern "C" fn fc_cloth_get_collision_stats(
 /// substep: `split_substeps`, the substeps taken in pieces instead (2 to 32 equal ones) and
 /// `pieces`, how many; `slowed`, free vertices slowed to the limit, summed over steps, the last
 /// resort when 32 pieces are not enough (not 0: some motion was held back, e.g. a vertex flung
-/// faster than 32 pieces can follow). A fixed substep too long to be stable is not refused
-/// with self-collision but held in pieces (it jitters: the automatic step,
-/// `FC_MAX_SUBSTEP_AUTO`, takes stable ones). All 0 without self-collision. Any output may be
-/// NULL.
+/// faster than 32 pieces can follow). At a fixed step a split substep's pieces are no longer
+/// than the automatic step's stable substep, so a step too long to be stable is taken in
+/// stable pieces rather than refused. All 0 without self-collision. Any output may be NULL.
 ///
 /// # Safety
 /// `cloth` NULL or live; outputs NULL or writable.
