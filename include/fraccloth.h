@@ -407,9 +407,10 @@ typedef struct {
    * taken in 2, 4, ... up to 32 equal pieces instead (`fc_cloth_get_step_stats` counts
    * them), so a fixed step keeps its motion (implicit Euler at one 1/30 s substep a frame
    * on the 4 cm, 0.5 Hz swing at 4 mm: 3.6 half-waves, 2.6 substeps a call); past 32 the
-   * fastest vertices are slowed to it. A split substep's pieces are also no longer than
-   * the automatic step's stable substep, so a fixed substep too long to be stable for
-   * symplectic Euler is taken in stable pieces (up to 32 times 32) instead of refused.
+   * fastest vertices are slowed to it. At a fixed step a split substep's pieces are also no
+   * longer than the automatic step's stable substep (and the limit splits up to 32 times
+   * further), so a fixed substep too long to be stable for symplectic Euler is taken in
+   * stable pieces instead of refused.
    * At most about 1.5 times the mesh's mean edge length: a larger one would list too many
    * neighbour pairs and is refused (`FC_ERROR_INVALID_ARGUMENT`, the message says how large
    * a one the mesh takes). See docs/collisions.md.
@@ -782,12 +783,14 @@ FcStatus fc_cloth_get_collision_stats(const FcCloth *cloth,
 /**
  * Reads what self-collision's step limit did since the cloth was made (steps that a refused
  * call undid included). No free vertex moves more than half the self-collision thickness in a
- * substep: `split_substeps`, the substeps taken in pieces instead (2 to 32 equal ones) and
- * `pieces`, how many; `slowed`, free vertices slowed to the limit, summed over steps, the last
- * resort when 32 pieces are not enough (not 0: some motion was held back, e.g. a vertex flung
- * faster than 32 pieces can follow). At a fixed step a split substep's pieces are no longer
- * than the automatic step's stable substep, so a step too long to be stable is taken in
- * stable pieces rather than refused. All 0 without self-collision. Any output may be NULL.
+ * substep: `split_substeps`, the substeps taken in pieces instead (2 to 32 equal ones; at a
+ * fixed step up to 32 times the pieces the substep needs to be stable, since a split
+ * substep's pieces are no longer than the automatic step's stable substep, so a step too long
+ * to be stable is taken in stable pieces rather than refused) and `pieces`, how many;
+ * `slowed`, free vertices slowed to the limit, summed over steps, the last resort when a
+ * substep split as far as it goes is not enough (not 0: some motion was held back, e.g. a
+ * vertex flung faster than the pieces can follow). All 0 without self-collision. Any output
+ * may be NULL.
  *
  * # Safety
  * `cloth` NULL or live; outputs NULL or writable.

@@ -73,8 +73,10 @@ pub struct Model {
     /// (`collide/self_collision.rs`). A cloth refuses one past about 1.5 of its mean edge
     /// lengths (`collide::self_collision::PAIRS_PER_VERTEX`). No free vertex moves more than
     /// half of it in a substep: a substep in which one would is taken in 2, 4, ... up to 32
-    /// equal pieces instead (`cloth/split.rs`; [`crate::Cloth::step_stats`] counts them), and
-    /// past 32 the fastest vertices are slowed (docs/collisions.md, stop 64).
+    /// equal pieces instead (`cloth/split.rs`; [`crate::Cloth::step_stats`] counts them; at a
+    /// host's fixed step no longer than the automatic step's stable substep, and up to 32
+    /// times that many), and past that the fastest vertices are slowed (docs/collisions.md,
+    /// stops 64 and 65).
     pub self_collision_thickness: f64,
     /// Self-collision thickness in the cloth's spacings (dimensionless, >= 0; 0 adds nothing):
     /// adds `self_collision_relative * spacing` m to [`Model::self_collision_thickness`] when

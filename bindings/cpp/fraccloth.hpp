@@ -120,7 +120,7 @@ struct CollisionStats {
 struct StepLimitStats {
     uint64_t split_substeps = 0;  ///< substeps taken in pieces (no vertex past half the thickness)
     uint64_t pieces = 0;          ///< the pieces they were taken in
-    uint64_t slowed = 0;          ///< free vertices slowed to the limit, past 32 pieces (not 0: motion held back)
+    uint64_t slowed = 0;          ///< free vertices slowed to the limit, split as far as it goes (not 0: motion held back)
 };
 
 /// One simulated cloth. Move-only; the handle is freed by the destructor.

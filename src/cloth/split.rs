@@ -59,7 +59,8 @@ pub struct StepLimitStats {
     /// The pieces those substeps were taken in.
     pub pieces: u64,
     /// Free vertices slowed to the limit, summed over steps: the last resort, in a substep
-    /// already in 32 pieces. Not 0 means some motion was held back: a step too long for the
+    /// already split as far as it goes (32 pieces; at a host's fixed step 32 times the
+    /// pieces it needs to be stable). Not 0 means some motion was held back: a step too long for the
     /// cloth's speed (an unstable fixed step, say) that no host asked to refuse.
     pub slowed: u64,
 }

@@ -614,12 +614,14 @@ pub unsafe extern "C" fn fc_cloth_get_collision_stats(
 
 /// Reads what self-collision's step limit did since the cloth was made (steps that a refused
 /// call undid included). No free vertex moves more than half the self-collision thickness in a
-/// substep: `split_substeps`, the substeps taken in pieces instead (2 to 32 equal ones) and
-/// `pieces`, how many; `slowed`, free vertices slowed to the limit, summed over steps, the last
-/// resort when 32 pieces are not enough (not 0: some motion was held back, e.g. a vertex flung
-/// faster than 32 pieces can follow). At a fixed step a split substep's pieces are no longer
-/// than the automatic step's stable substep, so a step too long to be stable is taken in
-/// stable pieces rather than refused. All 0 without self-collision. Any output may be NULL.
+/// substep: `split_substeps`, the substeps taken in pieces instead (2 to 32 equal ones; at a
+/// fixed step up to 32 times the pieces the substep needs to be stable, since a split
+/// substep's pieces are no longer than the automatic step's stable substep, so a step too long
+/// to be stable is taken in stable pieces rather than refused) and `pieces`, how many;
+/// `slowed`, free vertices slowed to the limit, summed over steps, the last resort when a
+/// substep split as far as it goes is not enough (not 0: some motion was held back, e.g. a
+/// vertex flung faster than the pieces can follow). All 0 without self-collision. Any output
+/// may be NULL.
 ///
 /// # Safety
 /// `cloth` NULL or live; outputs NULL or writable.

@@ -215,9 +215,10 @@ pub struct FcClothDesc {
     /// taken in 2, 4, ... up to 32 equal pieces instead (`fc_cloth_get_step_stats` counts
     /// them), so a fixed step keeps its motion (implicit Euler at one 1/30 s substep a frame
     /// on the 4 cm, 0.5 Hz swing at 4 mm: 3.6 half-waves, 2.6 substeps a call); past 32 the
-    /// fastest vertices are slowed to it. A split substep's pieces are also no longer than
-    /// the automatic step's stable substep, so a fixed substep too long to be stable for
-    /// symplectic Euler is taken in stable pieces (up to 32 times 32) instead of refused.
+    /// fastest vertices are slowed to it. At a fixed step a split substep's pieces are also no
+    /// longer than the automatic step's stable substep (and the limit splits up to 32 times
+    /// further), so a fixed substep too long to be stable for symplectic Euler is taken in
+    /// stable pieces instead of refused.
     /// At most about 1.5 times the mesh's mean edge length: a larger one would list too many
     /// neighbour pairs and is refused (`FC_ERROR_INVALID_ARGUMENT`, the message says how large
     /// a one the mesh takes). See docs/collisions.md.

@@ -365,7 +365,7 @@ class StepLimitStats(NamedTuple):
     """What self-collision's step limit (no free vertex moves more than half the thickness in a
     substep) did since the cloth was made: ``split_substeps`` (substeps taken in pieces instead),
     ``pieces`` (how many), ``slowed`` (free vertices slowed to the limit, summed over steps: the
-    last resort, past 32 pieces; not 0 means some motion was held back)."""
+    last resort, in a substep split as far as it goes; not 0 means some motion was held back)."""
 
     split_substeps: int
     pieces: int
