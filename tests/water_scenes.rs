@@ -204,8 +204,9 @@ fn self_collision_keeps_the_shot_at_one_substep_a_frame() {
 /// automatic step's (`src/cloth/split.rs`), so the bake is the automatic step's: half-waves and
 /// depth within 3 %, and no vertex at any frame faster than 1.3 times the automatic step's
 /// fastest. Measured (stop 65): 3.56 / 3.56 half-waves, mid 0.336 / 0.336, fastest 0.150 /
-/// 0.150 m/s at 31.8 pieces a call; before the pieces were sized for stability the fastest was
-/// 0.314 m/s (pieces of 16 unstable ones jittered at the limit's scale) and vertices were slowed.
+/// 0.150 m/s at 31.8 pieces a call. With pieces sized for the limit alone the fastest was 0.314
+/// m/s (`water_sweep integrator=symplectic freq=0.5 self=0.4 dt=0.0333333333`, 22.4 pieces a
+/// call), and 0.345 m/s with 61 vertices slowed in 0.9.28.
 #[test]
 fn an_unstable_fixed_step_with_self_collision_is_taken_in_stable_pieces() {
     let model = Model {
