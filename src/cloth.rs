@@ -192,6 +192,9 @@ pub struct Cloth {
     rollback: Rollback,
     /// The whole step of an extrapolated integrator, beside its two half steps.
     probe: Rollback,
+    /// An extrapolated step's start, kept while its half steps may be refused for
+    /// self-collision's step limit (`cloth/extrapolate.rs`).
+    probe_start: Rollback,
     solver_stats: SolverStats,
     /// What the last call to `step` did.
     step_stats: StepStats,
@@ -275,6 +278,7 @@ impl Cloth {
             scratch: StepScratch::default(),
             rollback: Rollback::default(),
             probe: Rollback::default(),
+            probe_start: Rollback::default(),
             solver_stats: SolverStats::default(),
             step_stats: StepStats::default(),
             motion: motion::MotionRate::default(),

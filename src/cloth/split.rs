@@ -407,6 +407,45 @@ mod tests {
         assert!(two.step_stats().substeps > 2);
     }
 
+    /// An extrapolated integrator's substep too far for the limit is refused before anything is
+    /// committed and taken in pieces: the same bits as a call asking for that many substeps,
+    /// none slowed (implicit: 8 and 4 pieces; symplectic: 32, its stable pieces). The refused
+    /// second half's restore is exercised by `tests/water_scenes.rs`
+    /// (`an_extrapolated_fixed_step_with_self_collision_slows_no_half_step`: 7 in its bake,
+    /// counted once by a throwaway print).
+    #[test]
+    fn an_extrapolated_split_substep_is_the_substeps_it_was_split_into() {
+        for (integrator, speed, stretch) in [
+            (Integrator::ExtrapolatedImplicit, 0.05, 1.05),
+            (Integrator::ExtrapolatedImplicit, 0.1, 1.0),
+            (Integrator::ExtrapolatedSymplectic, 0.02, 1.1),
+        ] {
+            let make = || {
+                let c = folded(speed, stretch);
+                let t = c.topology().clone();
+                let (x, v) = (c.positions().to_vec(), c.velocities().to_vec());
+                let mut config = c.config.clone();
+                config.integrator = integrator;
+                let mut c = Cloth::new(t, config).expect("a cloth");
+                c.set_pinned(&(0..21).collect::<Vec<u32>>()).expect("pins");
+                c.set_positions(&x).expect("positions");
+                c.set_velocities(&v).expect("velocities");
+                c
+            };
+            let (mut split, mut asked) = (make(), make());
+            let h = 1.0 / 30.0;
+            split.step_substeps(h, 1).expect("the split call");
+            let pieces = split.step_stats().substeps;
+            assert!(
+                pieces > 1 && pieces.is_power_of_two(),
+                "{integrator:?}: {pieces} pieces"
+            );
+            assert_eq!(split.step_limit_stats().slowed, 0, "{integrator:?}");
+            asked.step_substeps(h, pieces).expect("the asked call");
+            assert!(state(&split) == state(&asked), "{integrator:?}");
+        }
+    }
+
     /// A substep whose start speeds say it fits, but whose springs fling the cloth too far
     /// within it (3.8 times the limit, read once by a throwaway print: it was split into 8),
     /// is refused before anything is committed and taken in pieces: the same bits as a call

@@ -501,22 +501,27 @@ impl MeshCollider {
             .inflated(reach)
         }));
         // Each tree refit when it holds as many items, else built (a build refused by the
-        // allocator last time is made again).
+        // allocator last time is made again), split on the pool for a large mesh (the same
+        // tree: `bvh.rs`).
+        let parallel = |n: usize| crate::parallel::worth_it(n);
         if self.tri_bvh.len() == self.tri_boxes.len() {
             self.tri_bvh.refit(&self.tri_boxes);
         } else {
-            self.tri_bvh = Bvh::try_build(&self.tri_boxes).map_err(|_| self.no_room())?;
+            self.tri_bvh = Bvh::try_build_on(&self.tri_boxes, parallel(self.tri_boxes.len()))
+                .map_err(|_| self.no_room())?;
         }
         if self.vert_bvh.len() == self.vert_boxes.len() {
             self.vert_bvh.refit(&self.vert_boxes);
         } else {
-            self.vert_bvh = Bvh::try_build(&self.vert_boxes).map_err(|_| self.no_room())?;
+            self.vert_bvh = Bvh::try_build_on(&self.vert_boxes, parallel(self.vert_boxes.len()))
+                .map_err(|_| self.no_room())?;
         }
         // The active edges may change as the mesh deforms: rebuilt, unless the same count.
         if self.edge_bvh.len() == self.edge_boxes.len() && !self.edge_bvh.is_empty() {
             self.edge_bvh.refit(&self.edge_boxes);
         } else {
-            self.edge_bvh = Bvh::try_build(&self.edge_boxes).map_err(|_| self.no_room())?;
+            self.edge_bvh = Bvh::try_build_on(&self.edge_boxes, parallel(self.edge_boxes.len()))
+                .map_err(|_| self.no_room())?;
         }
         self.fresh_at = reach;
         self.cache.stale = true;

@@ -733,7 +733,10 @@ impl SelfCollision {
         if self.tri_bvh.len() == triangles.len() {
             self.tri_bvh.refit(&self.tree_boxes);
         } else {
-            self.tri_bvh = Bvh::try_build(&self.tree_boxes).map_err(|_| oom("the triangles' tree"))?;
+            // Split on the pool where the step uses it (the same tree: `bvh.rs`).
+            let parallel = crate::parallel::worth_it(x.len());
+            self.tri_bvh =
+                Bvh::try_build_on(&self.tree_boxes, parallel).map_err(|_| oom("the triangles' tree"))?;
             self.rest_in_order.clear();
         }
         if self.rest_in_order.len() != triangles.len() {
