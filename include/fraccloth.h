@@ -16,7 +16,7 @@
 
 #define FC_VERSION_MAJOR 0
 #define FC_VERSION_MINOR 9
-#define FC_VERSION_PATCH 29
+#define FC_VERSION_PATCH 30
 /* Equals fc_version() of the library this header belongs to. */
 #define FC_VERSION (FC_VERSION_MAJOR * 1000000 + FC_VERSION_MINOR * 1000 + FC_VERSION_PATCH)
 
@@ -400,13 +400,16 @@ typedef struct {
    */
   double added_mass_coefficient;
   /**
-   * Self-collision: the distance the cloth keeps from itself, m (0 = off, the default).
+   * Self-collision: the distance the cloth keeps from itself, m (0 = off, the default, and
+   * off in `FC_PRESET_UNDERWATER` too: turn it on for a scene that folds, a drop, a drape, a
+   * brisk swing; a cloth that never comes near itself still pays about 1.15x the step).
    * Points nearer than 2.2 times this at rest (neighbours) are not tested: a few millimetres
    * for a cloth of 1-2 cm spacing.
    * No vertex moves more than half of it in one substep: a substep in which one would is
    * taken in 2, 4, ... up to 32 equal pieces instead (`fc_cloth_get_step_stats` counts
-   * them), so a fixed step keeps its motion (implicit Euler at one 1/30 s substep a frame
-   * on the 4 cm, 0.5 Hz swing at 4 mm: 3.6 half-waves, 2.6 substeps a call); past 32 the
+   * them; an extrapolated integrator's half steps alike), so a fixed step keeps its motion
+   * (implicit Euler at one 1/30 s substep a frame on the 4 cm, 0.5 Hz swing at 4 mm: 3.6
+   * half-waves, 2.6 substeps a call); past 32 the
    * fastest vertices are slowed to it. At a fixed step a split substep's pieces are also no
    * longer than the automatic step's stable substep (and the limit splits up to 32 times
    * further), so a fixed substep too long to be stable for symplectic Euler is taken in

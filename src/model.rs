@@ -69,11 +69,12 @@ pub struct Model {
     /// Distance from a collider surface below which the repulsion acts, m.
     pub collision_margin: f64,
     /// Self-collision: the distance the cloth keeps from itself, m (0 = off, and costs
-    /// nothing). Pairs nearer than 2.2 times this at rest (neighbours) are not tested
+    /// nothing; off in [`Model::underwater`] too, docs/design-departures.md). Pairs nearer than 2.2 times this at rest (neighbours) are not tested
     /// (`collide/self_collision.rs`). A cloth refuses one past about 1.5 of its mean edge
     /// lengths (`collide::self_collision::PAIRS_PER_VERTEX`). No free vertex moves more than
     /// half of it in a substep: a substep in which one would is taken in 2, 4, ... up to 32
-    /// equal pieces instead (`cloth/split.rs`; [`crate::Cloth::step_stats`] counts them; at a
+    /// equal pieces instead (`cloth/split.rs`, an extrapolated integrator's half steps alike;
+    /// [`crate::Cloth::step_stats`] counts them; at a
     /// host's fixed step no longer than the automatic step's stable substep, and up to 32
     /// times that many), and past that the fastest vertices are slowed (docs/collisions.md,
     /// stops 64 and 65).

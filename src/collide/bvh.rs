@@ -134,6 +134,13 @@ impl Aabb {
         d.norm_squared()
     }
 
+    /// Squared distance between the nearest points of this box and `o` (0 when they overlap):
+    /// no point of one is nearer any point of the other.
+    pub fn gap2(&self, o: &Aabb) -> f64 {
+        let d = (self.min - o.max).sup(&Vec3::zeros()).sup(&(o.min - self.max));
+        d.norm_squared()
+    }
+
     /// How far apart this box and `o` are along the axis they are furthest apart on (0 when
     /// they overlap): either must move at least this far, in any direction, before they
     /// overlap.
