@@ -184,6 +184,13 @@ pub struct Cloth {
     /// Whether the call under way is the automatic step's (its substeps are stable already:
     /// `split.rs` sizes a split substep's pieces for stability only at a host's fixed step).
     auto_call: bool,
+    /// The substep under way and its level of pieces, while `split.rs` takes it: the step
+    /// limit's proof (`collisions.rs`) is trusted only for a piece stable by itself.
+    limit_piece: Option<(f64, u32)>,
+    /// Substeps to wait before trying whole a substep the speeds would split, and the wait
+    /// after the next failure (`split.rs`).
+    whole_wait: u32,
+    whole_backoff: u32,
     /// The half-derivative memories the model's terms and pair elements read.
     histories: Histories,
     time: f64,
@@ -272,6 +279,9 @@ impl Cloth {
             mesh_carried: 0,
             limit_stats: StepLimitStats::default(),
             auto_call: false,
+            limit_piece: None,
+            whole_wait: 0,
+            whole_backoff: 0,
             histories: Histories::new(&config.model, config.scheme, &topology)?,
             time: 0.0,
             steps: 0,

@@ -72,7 +72,9 @@ pub struct Model {
     /// nothing; off in [`Model::underwater`] too, docs/design-departures.md). Pairs nearer than 2.2 times this at rest (neighbours) are not tested
     /// (`collide/self_collision.rs`). A cloth refuses one past about 1.5 of its mean edge
     /// lengths (`collide::self_collision::PAIRS_PER_VERTEX`). No free vertex moves more than
-    /// half of it in a substep: a substep in which one would is taken in 2, 4, ... up to 32
+    /// half of it in a substep (unless the proof of `collide/unfolded.rs` shows no pair within
+    /// reach at any instant of it: then the substep is taken whole, stop 66): a substep in
+    /// which one would is taken in 2, 4, ... up to 32
     /// equal pieces instead (`cloth/split.rs`, an extrapolated integrator's half steps alike;
     /// [`crate::Cloth::step_stats`] counts them; at a
     /// host's fixed step no longer than the automatic step's stable substep, and up to 32

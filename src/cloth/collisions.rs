@@ -392,6 +392,25 @@ impl Cloth {
         self.self_collision.relearn_sides(&self.scratch.zone_stopped);
     }
 
+    /// Whether the proposed step is proved to bring no pair of self-collision's within its
+    /// reach at any instant (`Unfolded::out_of_reach_throughout`), and stable by itself.
+    fn limit_needless(&mut self) -> bool {
+        let Some((h, level)) = self.limit_piece else {
+            return false;
+        };
+        if level < self.stable_level(h) {
+            return false;
+        }
+        let mut end = std::mem::take(&mut self.scratch.step_end);
+        self.step_end_into(&mut end);
+        let thickness = self.config.model.self_collision_thickness;
+        let proved =
+            self.self_collision
+                .out_of_reach_throughout(&self.x, &end, &self.topology.triangles, thickness);
+        self.scratch.step_end = end;
+        proved
+    }
+
     /// Self-collision's step limit ([`SELF_COLLISION_STEP_LIMIT`]) on the proposed step: a
     /// free vertex that would move farther (a cloth pinched between two colliders, or flung
     /// faster than its thickness a step, would pass through itself) either refuses the step,
@@ -415,6 +434,15 @@ impl Cloth {
         ) {
             return Limited::Slowed(0);
         }
+        // A cloth proved out of its own reach throughout the step needs no limit (a step the
+        // driver may take whole: `split.rs`). Only where the step is stable as it is: an
+        // explicit integrator's fixed step too long to be stable is still split into stable
+        // pieces (stop 65), not refused.
+        if self.limit_needless() {
+            self.limit_stats.proved_whole += 1;
+            return Limited::Slowed(0);
+        }
+        let s = &mut self.scratch;
         // How far free vertex `i` would move, when over the limit (squared first: the square
         // root only for a vertex over it; a NaN displacement is left to the step's check).
         let over = |x_new: &[Vec3], i: usize| {

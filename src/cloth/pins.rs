@@ -245,6 +245,21 @@ impl Cloth {
 
     /// Pinned particles onto their goals (moving with their step velocity); soft pins pulled
     /// the fraction of their weight of the way there.
+    /// The positions the proposed step ends at once [`Cloth::pins`] has run, into `out`.
+    pub(super) fn step_end_into(&self, out: &mut Vec<Vec3>) {
+        let s = &self.scratch;
+        out.clear();
+        out.extend_from_slice(&s.x_new);
+        for &i in &self.pin_list {
+            let i = i as usize;
+            let goal = s.pins.goal[i];
+            out[i] = match self.pinned[i] {
+                true => goal,
+                false => s.x_new[i] + self.pin_weight[i] * (goal - s.x_new[i]),
+            };
+        }
+    }
+
     pub(super) fn pins(&mut self, h: f64) {
         let s = &mut self.scratch;
         let goal = &s.pins.goal;

@@ -15,6 +15,13 @@
 //! for the limit, is then split into stable pieces instead of jittering at the limit's scale.
 //! A substep the limit does not split is taken as the host asked.
 //!
+//! **Proved whole.** A piece over the limit is taken as it is when the proof of
+//! `collide/unfolded.rs` shows that no pair comes within self-collision's reach at any instant
+//! of it (`Cloth::limit_needless`; only a piece stable by itself): an unfolded cloth at a long
+//! fixed step keeps its one substep. So a substep its speeds would split is first tried whole
+//! when the last look found the cloth out of its own reach, unless a try failed lately
+//! ([`WHOLE_BACKOFF`]).
+//!
 //! **Where it stops.** At [`MAX_SPLIT_LEVEL`] (32 pieces; 32 times the stable pieces at a
 //! host's fixed step) a vertex still too fast is slowed to
 //! the limit, as before the split existed ([`StepLimit::Slow`]); that is the only slowing.
@@ -44,6 +51,10 @@ pub const SPLIT_AIM: f64 = 0.8;
 /// that many times the stable pieces (`Cloth::stable_level`, itself at most this level).
 pub const MAX_SPLIT_LEVEL: u32 = 5;
 
+/// At most this many substeps split at once, after a failed try to take one whole, before the
+/// next try (`Cloth::take_substep`).
+pub const WHOLE_BACKOFF: u32 = 16;
+
 /// A substep whose fastest free vertex is predicted to move less than this fraction of the
 /// limit is taken whole and not watched (self-collision's memory is not copied before it): it
 /// would have to speed up this many times over within one substep to need a split. If it
@@ -58,6 +69,10 @@ pub struct StepLimitStats {
     pub split_substeps: u64,
     /// The pieces those substeps were taken in.
     pub pieces: u64,
+    /// Steps in which a free vertex moved farther than the limit, taken all the same because
+    /// the proof of `collide/unfolded.rs` showed no pair could come within self-collision's
+    /// reach at any instant of them (an unfolded cloth at a long fixed step).
+    pub proved_whole: u64,
     /// Free vertices slowed to the limit, summed over steps: the last resort, in a substep
     /// already split as far as it goes (32 pieces; at a host's fixed step 32 times the
     /// pieces it needs to be stable). Not 0 means some motion was held back: a step too long for the
@@ -94,8 +109,21 @@ impl Cloth {
         let mut stable: Option<u32> = None;
         // The limit splits up to `MAX_SPLIT_LEVEL` levels beyond those.
         let top = |stable: Option<u32>| MAX_SPLIT_LEVEL + stable.unwrap_or(0);
+        // A substep the speeds would split is tried whole first when the last look found the
+        // cloth out of its own reach (the proof may then show it so throughout the substep,
+        // and the limit is not needed: `Cloth::limit_needless`), unless a try failed lately:
+        // after a failure 1, 2, 4, ... up to `WHOLE_BACKOFF` substeps are split at once before
+        // the next try.
+        let mut whole = false;
         if level > 0 {
-            level = level.max(*stable.get_or_insert_with(|| self.stable_level(h)));
+            let floor = *stable.get_or_insert_with(|| self.stable_level(h));
+            if floor == 0 && self.self_collision.last_look_proved() && self.whole_wait == 0 {
+                whole = true;
+                level = 0;
+            } else {
+                self.whole_wait = self.whole_wait.saturating_sub(1);
+                level = level.max(floor);
+            }
         }
         let end = f1.unwrap_or(1.0);
         let (mut done, mut taken) = (0u32, 0u32);
@@ -103,6 +131,10 @@ impl Cloth {
         let result = loop {
             let pieces = 1u32 << level;
             if done == pieces {
+                if whole {
+                    // Taken whole: try again at the next one.
+                    self.whole_backoff = 0;
+                }
                 if taken > 1 {
                     let stats = &mut self.limit_stats;
                     stats.split_substeps += 1;
@@ -132,12 +164,14 @@ impl Cloth {
             let at = |j: u32| f0 + (end - f0) * f64::from(j) / f64::from(pieces);
             let (a, b) = (at(done), (done + 1 < pieces).then(|| at(done + 1)).or(f1));
             let piece = h / f64::from(pieces);
+            self.limit_piece = Some((h, level));
             let outcome = if self.config.integrator.is_extrapolated() {
                 self.extrapolated_advance(piece, a, b, limit)
             } else {
                 let plan = StepPlan::new(self.config.integrator, piece, b, Stage::Whole);
                 self.advance(plan.limited(limit))
             };
+            self.limit_piece = None;
             match outcome {
                 Ok(Advanced::Taken) => {
                     done += 1;
@@ -146,6 +180,10 @@ impl Cloth {
                 Ok(Advanced::TooFar(ratio)) => {
                     if keep {
                         self.self_collision.swap_memory(&mut memory);
+                    }
+                    if std::mem::take(&mut whole) {
+                        self.whole_backoff = (2 * self.whole_backoff).clamp(1, WHOLE_BACKOFF);
+                        self.whole_wait = self.whole_backoff;
                     }
                     let floor = *stable.get_or_insert_with(|| self.stable_level(h));
                     let next = (level + more_levels(ratio)).max(floor).min(top(stable));
@@ -177,7 +215,7 @@ impl Cloth {
     /// a host's fixed step too long to be stable, split for the limit, is split into stable
     /// pieces instead of jittering at the limit's scale. 0 for implicit Euler (no stability
     /// bound) and in the automatic step's own calls (its substeps are stable already).
-    fn stable_level(&self, h: f64) -> u32 {
+    pub(super) fn stable_level(&self, h: f64) -> u32 {
         if self.auto_call || self.config.integrator.is_implicit() {
             return 0;
         }

@@ -132,6 +132,8 @@ pub(super) struct StepScratch {
     pub v_new: crate::aligned::AlignedVec3,
     /// The pins' goals and paths (`pins.rs`).
     pub pins: PinPaths,
+    /// Where a step over self-collision's limit would end, pins included (`collisions.rs`).
+    pub step_end: Vec<Vec3>,
     /// The pair elements' own passes: the rates their memories record (`forces::elements`).
     pub elements: ElementScratch,
     /// Forces of the whole-cloth passes before the force pass (pair elements with a pass of

@@ -17,7 +17,8 @@
 //! it entered the list and keeps it for as long as it stays; a vertex pushed through a
 //! triangle in one step is pushed back, not on through, and so is one found on the other side
 //! past the thickness but within the list's reach (no step brings a pair more than a thickness
-//! closer, so it went through). A pair apart and off the face (past an edge's end, or edges
+//! closer, so it went through; a longer step is taken only where the proof of `unfolded.rs`
+//! shows no pair within reach at any instant of it). A pair apart and off the face (past an edge's end, or edges
 //! near parallel) forgets its side: it may go round the border of a fold. Together with the step limit (no
 //! vertex moves more than half the thickness in a step: a substep that would is split, or as a last
 //! resort its fast vertices slowed, `cloth/split.rs`, `Cloth::limit_collision_step`) no pair can cross
@@ -132,6 +133,8 @@ pub struct SelfCollision {
     rest_nodes: Vec<Aabb>,
     /// Looks the proof settled whole, testing nothing (for benchmarks).
     pub certified_looks: u64,
+    /// Whether the last look was settled whole by the proof.
+    last_proved: bool,
     /// A look's working lists, kept for the next look: the parts' finds, the walk's tasks,
     /// and a copy of the remembered pairs (their sides, read while the new lists are made).
     found: Vec<Found>,
@@ -687,6 +690,7 @@ impl SelfCollision {
     ) -> Result<(), Error> {
         let oom = |what: &str| Error::out_of_memory(format!("self-collision: {what} cannot be allocated"));
         self.looks += 1;
+        self.last_proved = false;
         // Looked at afresh by the next step unless this look completes.
         self.looked_at.clear();
         self.looked_at
@@ -726,6 +730,7 @@ impl SelfCollision {
         if below == f64::INFINITY && self.owners.orphans().is_empty() {
             // Every pair: nothing in reach, nothing to remember.
             self.certified_looks += 1;
+            self.last_proved = true;
             self.vertex_triangle.clear();
             self.edge_edge.clear();
             self.looked_at.extend_from_slice(x);
@@ -935,6 +940,31 @@ impl SelfCollision {
         std::mem::swap(&mut self.vertex_triangle, &mut saved.vertex_triangle);
         std::mem::swap(&mut self.edge_edge, &mut saved.edge_edge);
         std::mem::swap(&mut self.looked_at, &mut saved.looked_at);
+    }
+
+    /// Whether the last look was settled whole by the proof (the cloth out of its own reach):
+    /// then [`SelfCollision::out_of_reach_throughout`] may well prove the next step too.
+    pub(crate) fn last_look_proved(&self) -> bool {
+        self.last_proved
+    }
+
+    /// Whether no pair self-collision tests can come within its reach during a step that moves
+    /// each point on a straight line from `x0` to `x1` (the proof of `unfolded.rs` over the
+    /// step): its step limit is then not needed, however far the step moves a vertex. False
+    /// where the proof does not apply (a rest shape not a flat convex sheet, a lone vertex).
+    pub(crate) fn out_of_reach_throughout(
+        &mut self,
+        x0: &[Vec3],
+        x1: &[Vec3],
+        triangles: &[[u32; 3]],
+        thickness: f64,
+    ) -> bool {
+        if self.full_looks || !self.owners.orphans().is_empty() || thickness.is_nan() || thickness <= 0.0 {
+            return false;
+        }
+        let reach = thickness * (1.0 + SKIN);
+        self.unfolded
+            .out_of_reach_throughout(x0, x1, triangles, reach, EXCLUDED * thickness)
     }
 
     /// The remembered pairs (vertex-triangle, edge-edge).

@@ -42,6 +42,13 @@
 //! that does not stops the proof there; a level whose windows hold the whole sheet proves it
 //! for every distance.
 //!
+//! **A step.** The same bound holds at every instant of a step whose points move on straight
+//! lines from `x0` to `x1` when each triangle's summary covers both ends: the columns of
+//! `F(t) = (1 - t) F0 + t F1` lie in the boxes of both ends', and its least singular value is
+//! at least `min(s0, s1) - |F1 - F0| / 2`. Proved for every distance, no pair comes within
+//! reach during the step, however far its points move: self-collision's step limit is then
+//! not needed (`Unfolded::out_of_reach_throughout`, `cloth/collisions.rs`).
+//!
 //! Nothing is kept from one look to the next but the rest shape's numbers and the working
 //! lists (made when the cloth is set up, so a look allocates nothing).
 
@@ -206,6 +213,34 @@ impl Unfolded {
         reach: f64,
         excluded: f64,
     ) -> f64 {
+        self.certified_with(triangles, reach, excluded, |t, m| gradient(x, t, m))
+    }
+
+    /// Whether every pair of points at least `excluded` apart at rest (and at least the
+    /// distance [`Unfolded::set_first`] gave) is surely at least `reach` apart at every instant
+    /// of a step that moves each point on a straight line from `x0` to `x1` (module docs, "A
+    /// step"): then no such pair can meet within it, however long it is.
+    pub(super) fn out_of_reach_throughout(
+        &mut self,
+        x0: &[Vec3],
+        x1: &[Vec3],
+        triangles: &[[u32; 3]],
+        reach: f64,
+        excluded: f64,
+    ) -> bool {
+        self.sheet.is_some()
+            && self.certified_with(triangles, reach, excluded, |t, m| swept_gradient(x0, x1, t, m))
+                == f64::INFINITY
+    }
+
+    /// [`Unfolded::certified_below`] with each triangle's summary given by `span`.
+    fn certified_with(
+        &mut self,
+        triangles: &[[u32; 3]],
+        reach: f64,
+        excluded: f64,
+        span: impl Fn(&[u32; 3], &[f64; 4]) -> Option<Span>,
+    ) -> f64 {
         let Some(sheet) = &mut self.sheet else {
             return excluded;
         };
@@ -218,7 +253,7 @@ impl Unfolded {
         level0.cells.resize(level0.padded[0] * level0.padded[1], EMPTY);
         let stride = level0.padded[0];
         for ((t, m), c) in triangles.iter().zip(&sheet.inverse).zip(&sheet.cells) {
-            let Some(span) = gradient(x, t, m) else {
+            let Some(span) = span(t, m) else {
                 return excluded;
             };
             for row in c[2]..=c[3] {
@@ -346,15 +381,7 @@ fn coarsen(finer: &Level, coarser: &mut Level) {
 /// not finite.
 #[inline]
 fn gradient(x: &[Vec3], t: &[u32; 3], m: &[f64; 4]) -> Option<Span> {
-    let x0 = x.get(t[0] as usize)?;
-    let d1 = x.get(t[1] as usize)? - x0;
-    let d2 = x.get(t[2] as usize)? - x0;
-    let a = d1 * m[0] + d2 * m[2];
-    let b = d1 * m[1] + d2 * m[3];
-    let (aa, bb, ab) = (a.dot(&a), b.dot(&b), a.dot(&b));
-    let s2 = 0.5 * ((aa + bb) - ((aa - bb) * (aa - bb) + 4.0 * ab * ab).sqrt());
-    // Rounding of the root's argument: a relative 1e-12 of the trace taken off.
-    let s2 = s2 - 1e-12 * (aa + bb);
+    let (a, b, s2) = columns(x, t, m)?;
     let all = [a.x, a.y, a.z, b.x, b.y, b.z, s2];
     if !all.iter().all(|v| v.is_finite()) {
         return None;
@@ -363,6 +390,52 @@ fn gradient(x: &[Vec3], t: &[u32; 3], m: &[f64; 4]) -> Option<Span> {
     for k in 0..6 {
         span[k] = down(all[k]);
         span[6 + k] = up(all[k]);
+    }
+    span[12] = down(s2);
+    Some(span)
+}
+
+/// A triangle's deformation gradient's columns `a`, `b` at `x` (`m` its inverse rest edge
+/// matrix) and a bound under its least squared singular value.
+#[inline(always)]
+fn columns(x: &[Vec3], t: &[u32; 3], m: &[f64; 4]) -> Option<(Vec3, Vec3, f64)> {
+    let x0 = x.get(t[0] as usize)?;
+    let d1 = x.get(t[1] as usize)? - x0;
+    let d2 = x.get(t[2] as usize)? - x0;
+    let a = d1 * m[0] + d2 * m[2];
+    let b = d1 * m[1] + d2 * m[3];
+    let (aa, bb, ab) = (a.dot(&a), b.dot(&b), a.dot(&b));
+    let s2 = 0.5 * ((aa + bb) - ((aa - bb) * (aa - bb) + 4.0 * ab * ab).sqrt());
+    // Rounding of the root's argument: a relative 1e-12 of the trace taken off.
+    Some((a, b, s2 - 1e-12 * (aa + bb)))
+}
+
+/// A triangle's summary over a step from `x0` to `x1` along straight lines: its gradient is
+/// `F(t) = (1 - t) F0 + t F1`, whose columns lie in the boxes of both ends' and whose least
+/// singular value is at least `max(s0 - t D, s1 - (1 - t) D)` (Weyl; `D` the spectral norm of
+/// `F1 - F0`, bounded by its Frobenius norm), so at least `min(s0, s1) - D / 2`.
+fn swept_gradient(x0: &[Vec3], x1: &[Vec3], t: &[u32; 3], m: &[f64; 4]) -> Option<Span> {
+    let (a0, b0, s0) = columns(x0, t, m)?;
+    let (a1, b1, s1) = columns(x1, t, m)?;
+    let d = ((a1 - a0).norm_squared() + (b1 - b0).norm_squared()).sqrt();
+    let low = s0.max(0.0).sqrt().min(s1.max(0.0).sqrt()) - 0.5 * d;
+    // No bound left (an inverted or collapsed instant may lie within): a negative square,
+    // which fails any window holding the triangle. Rounded down by a relative 1e-12.
+    let s2 = if low > 0.0 {
+        low * low * (1.0 - 1e-12)
+    } else {
+        -1.0
+    };
+    let all = [
+        a0.x, a0.y, a0.z, b0.x, b0.y, b0.z, a1.x, a1.y, a1.z, b1.x, b1.y, b1.z, s2,
+    ];
+    if !all.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let mut span = EMPTY;
+    for k in 0..6 {
+        span[k] = down(all[k].min(all[6 + k]));
+        span[6 + k] = up(all[k].max(all[6 + k]));
     }
     span[12] = down(s2);
     Some(span)
@@ -715,6 +788,54 @@ mod tests {
         let mut bad = moved.clone();
         bad[40].y = f64::NAN;
         assert_eq!(u.certified_below(&bad, &triangles, 2.0 * t, e), e);
+    }
+
+    /// A step's proof (`out_of_reach_throughout`): a sheet carried 5 cm and turned (a rigid
+    /// step far longer than any step limit) is proved; one mirrored in its plane is not, though
+    /// both its ends are flat sheets each proved alone (the straight paths between them collapse
+    /// the sheet onto a line halfway: the bound of both ends' summaries alone would have passed
+    /// it); one folded over itself by the end of the step is not; a step shrinking the sheet
+    /// past the reach at its end is not, and one shrinking it less is.
+    #[test]
+    fn a_step_is_proved_only_when_no_instant_of_it_comes_within_reach() {
+        let (rest, triangles) = grid(31, 21, 0.01);
+        let (t, e) = (0.004, 0.0088);
+        let mut u = Unfolded::new(&rest, &triangles);
+        let reach = 2.0 * t;
+        let turn = nalgebra::Rotation3::from_euler_angles(0.02, -0.03, 0.05);
+        let carried: Vec<Vec3> = rest
+            .iter()
+            .map(|p| turn * p + Vec3::new(0.05, -0.01, 0.02))
+            .collect();
+        assert!(u.out_of_reach_throughout(&rest, &carried, &triangles, reach, e));
+        let mirrored: Vec<Vec3> = rest.iter().map(|p| Vec3::new(0.3 - p.x, p.y, p.z)).collect();
+        assert_eq!(u.certified_below(&mirrored, &triangles, reach, e), f64::INFINITY);
+        assert!(!u.out_of_reach_throughout(&rest, &mirrored, &triangles, reach, e));
+        // Folded back over itself round 3 mm beyond x = 0.15 m, the halves 6 mm apart.
+        let folded: Vec<Vec3> = rest
+            .iter()
+            .map(|p| {
+                let (x0, r) = (0.15, 0.003);
+                let s = p.x - x0;
+                if s <= 0.0 {
+                    *p
+                } else if s <= std::f64::consts::PI * r {
+                    let a = s / r;
+                    Vec3::new(x0 + r * a.sin(), p.y, r * (1.0 - a.cos()))
+                } else {
+                    Vec3::new(x0 - (s - std::f64::consts::PI * r), p.y, 2.0 * r)
+                }
+            })
+            .collect();
+        assert!(!u.out_of_reach_throughout(&rest, &folded, &triangles, reach, e));
+        let shrunk: Vec<Vec3> = rest.iter().map(|p| 0.85 * p).collect();
+        assert!(!u.out_of_reach_throughout(&rest, &shrunk, &triangles, reach, e));
+        let shrunk: Vec<Vec3> = rest.iter().map(|p| 0.97 * p).collect();
+        assert!(u.out_of_reach_throughout(&rest, &shrunk, &triangles, reach, e));
+        // A position that is not a number proves nothing.
+        let mut bad = carried.clone();
+        bad[40].y = f64::NAN;
+        assert!(!u.out_of_reach_throughout(&rest, &bad, &triangles, reach, e));
     }
 
     /// A sheet 40 cm long rolled into a spiral (radius 5 cm growing 6 mm a turn): points a

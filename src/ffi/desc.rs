@@ -215,11 +215,13 @@ pub struct FcClothDesc {
     /// for a cloth of 1-2 cm spacing.
     /// No vertex moves more than half of it in one substep: a substep in which one would is
     /// taken in 2, 4, ... up to 32 equal pieces instead (`fc_cloth_get_step_stats` counts
-    /// them; an extrapolated integrator's half steps alike), so a fixed step keeps its motion
-    /// (implicit Euler at one 1/30 s substep a frame on the 4 cm, 0.5 Hz swing at 4 mm: 3.6
-    /// half-waves, 2.6 substeps a call); past 32 the
-    /// fastest vertices are slowed to it. At a fixed step a split substep's pieces are also no
-    /// longer than the automatic step's stable substep (and the limit splits up to 32 times
+    /// them; an extrapolated integrator's half steps alike), so a fixed step keeps its motion;
+    /// past 32 the fastest vertices are slowed to it. A substep the library proves brings no
+    /// part of the cloth within this distance of another at any instant (an unfolded cloth)
+    /// is taken whole however far it moves: implicit Euler at one 1/30 s substep a frame on
+    /// the 4 cm, 0.5 Hz swing at 4 mm keeps 1.0 substeps a call and the shot without
+    /// self-collision (2.6 before 0.9.30). At a fixed step a split substep's pieces are also
+    /// no longer than the automatic step's stable substep (and the limit splits up to 32 times
     /// further), so a fixed substep too long to be stable for symplectic Euler is taken in
     /// stable pieces instead of refused.
     /// At most about 1.5 times the mesh's mean edge length: a larger one would list too many
