@@ -402,7 +402,7 @@ typedef struct {
   /**
    * Self-collision: the distance the cloth keeps from itself, m (0 = off, the default, and
    * off in `FC_PRESET_UNDERWATER` too: turn it on for a scene that folds, a drop, a drape, a
-   * brisk swing; a cloth that never comes near itself still pays about 1.15x the step).
+   * brisk swing; a cloth that never comes near itself still pays about 1.1-1.2x the step).
    * Points nearer than 2.2 times this at rest (neighbours) are not tested: a few millimetres
    * for a cloth of 1-2 cm spacing.
    * No vertex moves more than half of it in one substep: a substep in which one would is

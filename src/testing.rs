@@ -91,3 +91,18 @@ pub(crate) fn jittered_mesh(w: u32, h: u32) -> crate::Topology {
     .build()
     .expect("a triangle mesh")
 }
+
+/// Where point `p` of a flat sheet in the xy plane goes when the sheet beyond `x = x0` is folded
+/// back over itself round a half circle of radius `r`: the halves `2 r` apart.
+pub(crate) fn folded_over(p: &crate::math::Vec3, x0: f64, r: f64) -> crate::math::Vec3 {
+    use crate::math::Vec3;
+    let s = p.x - x0;
+    if s <= 0.0 {
+        *p
+    } else if s <= std::f64::consts::PI * r {
+        let a = s / r;
+        Vec3::new(x0 + r * a.sin(), p.y, r * (1.0 - a.cos()))
+    } else {
+        Vec3::new(x0 - (s - std::f64::consts::PI * r), p.y, 2.0 * r)
+    }
+}

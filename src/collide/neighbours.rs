@@ -101,6 +101,16 @@ impl Exclusions {
                 nearest.fetch_min(d.to_bits(), Relaxed);
             }
         };
+        // Whether a pair whose boxes are `gap` apart is excluded (its `exact` distance under the
+        // radius, measured only when the boxes are nearer than that); a pair left in lowers
+        // `least` to its boxes' distance or its exact one, both at most its distance.
+        let excludes = |gap: f64, exact: &dyn Fn() -> f64, least: &mut f64| {
+            let d = if gap >= radius { gap } else { exact() };
+            if d >= radius {
+                *least = least.min(d);
+            }
+            d < radius
+        };
         let grow = (cap - radius) + tree.half;
         let (vt_start, vt) = rows(rest.len(), parallel, room, |p, push| {
             let q = Aabb {
@@ -116,20 +126,11 @@ impl Exclusions {
                     push(t);
                     return;
                 }
-                // A triangle whose box is the radius away is not excluded, and no nearer than
-                // its box: that bounds the least (no exact distance needed).
                 let gap = Aabb::of(tri.iter().map(|&i| &rest[i as usize]))
                     .distance2(point)
                     .sqrt();
-                if gap >= radius {
-                    least = least.min(gap);
-                    return;
-                }
-                let d = vertex_triangle(rest, p, tri).0;
-                if d < radius {
+                if excludes(gap, &|| vertex_triangle(rest, p, tri).0, &mut least) {
                     push(t);
-                } else {
-                    least = least.min(d);
                 }
             });
             seen(least);
@@ -151,18 +152,10 @@ impl Exclusions {
                     push(f);
                     return;
                 }
-                // As for a vertex: boxes the radius apart bound the least.
                 let plain = |e: &[u32; 2]| Aabb::of(e.iter().map(|&i| &rest[i as usize]));
                 let gap = plain(edge).gap2(&plain(other)).sqrt();
-                if gap >= radius {
-                    least = least.min(gap);
-                    return;
-                }
-                let d = edge_edge(rest, edge, other).0;
-                if d < radius {
+                if excludes(gap, &|| edge_edge(rest, edge, other).0, &mut least) {
                     push(f);
-                } else {
-                    least = least.min(d);
                 }
             });
             seen(least);

@@ -1197,18 +1197,7 @@ mod tests {
         // Folded back over itself round a radius of 3 mm, the halves 6 mm apart.
         let folded: Vec<Vec3> = rest
             .iter()
-            .map(|p| {
-                let (x0, radius) = (0.2, 0.003);
-                let s = p.x - x0;
-                if s <= 0.0 {
-                    *p
-                } else if s <= std::f64::consts::PI * radius {
-                    let a = s / radius;
-                    Vec3::new(x0 + radius * a.sin(), p.y, radius * (1.0 - a.cos()))
-                } else {
-                    Vec3::new(x0 - (s - std::f64::consts::PI * radius), p.y, 2.0 * radius)
-                }
-            })
+            .map(|p| crate::testing::folded_over(p, 0.2, 0.003))
             .collect();
         let (thickness, reach) = (0.004, 0.008);
         let excluded = EXCLUDED * thickness;

@@ -814,18 +814,7 @@ mod tests {
         // Folded back over itself round 3 mm beyond x = 0.15 m, the halves 6 mm apart.
         let folded: Vec<Vec3> = rest
             .iter()
-            .map(|p| {
-                let (x0, r) = (0.15, 0.003);
-                let s = p.x - x0;
-                if s <= 0.0 {
-                    *p
-                } else if s <= std::f64::consts::PI * r {
-                    let a = s / r;
-                    Vec3::new(x0 + r * a.sin(), p.y, r * (1.0 - a.cos()))
-                } else {
-                    Vec3::new(x0 - (s - std::f64::consts::PI * r), p.y, 2.0 * r)
-                }
-            })
+            .map(|p| crate::testing::folded_over(p, 0.15, 0.003))
             .collect();
         assert!(!u.out_of_reach_throughout(&rest, &folded, &triangles, reach, e));
         let shrunk: Vec<Vec3> = rest.iter().map(|p| 0.85 * p).collect();
