@@ -243,8 +243,6 @@ impl Cloth {
         }
     }
 
-    /// Pinned particles onto their goals (moving with their step velocity); soft pins pulled
-    /// the fraction of their weight of the way there.
     /// The positions the proposed step ends at once [`Cloth::pins`] has run, into `out`.
     pub(super) fn step_end_into(&self, out: &mut Vec<Vec3>) {
         let s = &self.scratch;
@@ -260,6 +258,8 @@ impl Cloth {
         }
     }
 
+    /// Pinned particles onto their goals (moving with their step velocity); soft pins pulled
+    /// the fraction of their weight of the way there.
     pub(super) fn pins(&mut self, h: f64) {
         let s = &mut self.scratch;
         let goal = &s.pins.goal;
