@@ -170,3 +170,90 @@ fn a_grids_snapshot_is_refused_by_the_same_geometry_built_as_a_quad_mesh() {
         Vec3::new(m.positions()[7].x, m.positions()[7].y, 0.0)
     );
 }
+
+/// The 6 x 5 grid (in the plane z = 0, pinned along its top row) with one large triangle
+/// collider 5 cm behind it, stepped 10 ms at 1 ms.
+fn with_mesh_collider() -> (Cloth, u32) {
+    let mut c = cloth(Scheme::Off, Model::default(), Integrator::SymplecticEuler);
+    let tri = [
+        Vec3::new(-1.0, -1.0, -0.05),
+        Vec3::new(1.0, -1.0, -0.05),
+        Vec3::new(0.0, 1.0, -0.05),
+    ];
+    let id = c.add_mesh_collider(&tri, &[[0, 1, 2]], None).unwrap();
+    for _ in 0..10 {
+        c.step(1e-3).unwrap();
+    }
+    (c, id)
+}
+
+/// Where the one mesh collider's triangle list sits in a snapshot: its vertex and triangle
+/// counts (3 and 1) followed by the indices 0, 1, 2.
+fn mesh_triangle_at(snap: &[u8]) -> usize {
+    let mut pattern = Vec::new();
+    for w in [3u64, 1] {
+        pattern.extend_from_slice(&w.to_le_bytes());
+    }
+    for i in [0u32, 1, 2] {
+        pattern.extend_from_slice(&i.to_le_bytes());
+    }
+    let at = snap
+        .windows(pattern.len())
+        .position(|w| w == pattern.as_slice())
+        .expect("the mesh collider's triangle is in the snapshot");
+    at + 16
+}
+
+#[test]
+fn a_mesh_colliders_triangle_index_out_of_range_is_a_corrupted_snapshot() {
+    let (c, _) = with_mesh_collider();
+    let mut snap = c.save_snapshot().unwrap();
+    let at = mesh_triangle_at(&snap) + 8; // the third index
+    snap[at..at + 4].copy_from_slice(&7u32.to_le_bytes());
+    reseal(&mut snap);
+    let (mut b, _) = with_mesh_collider();
+    let before = b.save_snapshot().unwrap();
+    let err = b.load_snapshot(&snap).expect_err("a forged snapshot was accepted");
+    assert_eq!(
+        err.kind,
+        fraccloth::ErrorKind::InvalidArgument,
+        "a corrupted snapshot is an invalid argument: {}",
+        err.message
+    );
+    assert!(err.message.contains("snapshot"), "{}", err.message);
+    assert!(b.save_snapshot().unwrap() == before, "the cloth changed");
+}
+
+#[test]
+fn a_snapshot_whose_mesh_collider_move_cannot_be_stepped_is_refused() {
+    // The collider is told to sweep 1 m through the cloth over the next call: at 1 ms that
+    // carries the cloth at 1000 m/s, past max_speed, so the next 1 ms step is refused.
+    let (mut a, id) = with_mesh_collider();
+    let far = [
+        Vec3::new(-1.0, -1.0, 0.95),
+        Vec3::new(1.0, -1.0, 0.95),
+        Vec3::new(0.0, 1.0, 0.95),
+    ];
+    a.set_mesh_collider(id, &far, None).unwrap();
+    let snap = a.save_snapshot().unwrap();
+    let refused = a.clone().step(1e-3).expect_err("the sweep was stepped");
+    assert_eq!(refused.kind, fraccloth::ErrorKind::Unstable, "{}", refused.message);
+    // The load's trial step is that step: the snapshot is refused and the cloth unchanged.
+    let (mut b, _) = with_mesh_collider();
+    let before = b.save_snapshot().unwrap();
+    let err = b.load_snapshot(&snap).expect_err("a snapshot that cannot step was loaded");
+    assert_eq!(err.kind, fraccloth::ErrorKind::InvalidArgument, "{}", err.message);
+    assert!(b.save_snapshot().unwrap() == before, "the cloth changed");
+    b.step(1e-3).unwrap();
+    // Its collider told to stay, the same state loads and steps.
+    let mut calm = a.clone();
+    let tri = [
+        Vec3::new(-1.0, -1.0, -0.05),
+        Vec3::new(1.0, -1.0, -0.05),
+        Vec3::new(0.0, 1.0, -0.05),
+    ];
+    calm.set_mesh_collider(id, &tri, None).unwrap();
+    let mut d = with_mesh_collider().0;
+    d.load_snapshot(&calm.save_snapshot().unwrap()).unwrap();
+    d.step(1e-3).unwrap();
+}

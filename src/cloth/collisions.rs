@@ -576,8 +576,11 @@ impl Cloth {
                         return Err(bad("mesh collider friction"));
                     }
                     let margin = if version >= 6 { read_margin(r)? } else { None };
-                    let mut mesh = MeshCollider::new(&start, &tris, None)?;
-                    mesh.set(&target, given)?;
+                    // A mesh the snapshot holds that does not make a collider is corrupted
+                    // data (an invalid argument), whatever the error a host's call would get.
+                    let corrupt = |e: Error| bad(&format!("mesh collider ({})", e.message));
+                    let mut mesh = MeshCollider::new(&start, &tris, None).map_err(corrupt)?;
+                    mesh.set(&target, given).map_err(corrupt)?;
                     mesh.friction = friction;
                     mesh.margin = margin;
                     Some(mesh)

@@ -566,9 +566,16 @@ impl Cloth {
         // The mesh colliders as loaded (their lists and trees empty: small to copy), so that
         // the step's refresh of them is not kept.
         let meshes = self.mesh_slots.clone();
+        // The mesh colliders travel from where they are to where the host put them, as the
+        // next call's step moves them (from the start of the call).
+        let mesh_from = std::mem::replace(&mut self.mesh_from, 0.0);
         // Self-collision's limit slows a vertex here (`StepPlan::new`'s), never refuses.
-        let done = self.advance(StepPlan::new(self.config.integrator, h, None, Stage::Whole));
+        let done = self.begin_collider_motion(h).and_then(|()| {
+            self.advance(StepPlan::new(self.config.integrator, h, None, Stage::Whole))
+                .map(|_| ())
+        });
         self.mesh_slots = meshes;
+        self.mesh_from = mesh_from;
         snap.restore(self);
         std::mem::swap(&mut self.pin_target, &mut targets);
         snap.targets = targets;
@@ -576,7 +583,7 @@ impl Cloth {
         (self.solver_stats, self.step_stats, self.mesh_carried) = (solver, stats, carried);
         self.limit_stats = limit_stats;
         self.rollback = snap;
-        done.map(|_| ())
+        done
     }
 
     /// Size in bytes of [`Cloth::save_snapshot`]'s result now, counted without building it.
