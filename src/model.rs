@@ -73,13 +73,12 @@ pub struct Model {
     /// (`collide/self_collision.rs`). A cloth refuses one past about 1.5 of its mean edge
     /// lengths (`collide::self_collision::PAIRS_PER_VERTEX`). No free vertex moves more than
     /// half of it in a substep (unless the proof of `collide/unfolded.rs` shows no pair within
-    /// reach at any instant of it: then the substep is taken whole, stop 66): a substep in
+    /// reach at any instant of it: then the substep is taken whole): a substep in
     /// which one would is taken in 2, 4, ... up to 32
     /// equal pieces instead (`cloth/split.rs`, an extrapolated integrator's half steps alike;
     /// [`crate::Cloth::step_stats`] counts them; at a
     /// host's fixed step no longer than the automatic step's stable substep, and up to 32
-    /// times that many), and past that the fastest vertices are slowed (docs/collisions.md,
-    /// stops 64 and 65).
+    /// times that many), and past that the fastest vertices are slowed (docs/collisions.md).
     pub self_collision_thickness: f64,
     /// Self-collision thickness in the cloth's spacings (dimensionless, >= 0; 0 adds nothing):
     /// adds `self_collision_relative * spacing` m to [`Model::self_collision_thickness`] when
@@ -388,7 +387,7 @@ pub const UNDERWATER_FORM_DRAG: f64 = 1.0;
 /// frequency (without it the visible half-waves fell from 4.6 at 1 Hz to 3.8 at 2 Hz: a
 /// quadratic drag takes the same share of a wave's energy each cycle at any frequency).
 /// 1.2 cm until 0.9.26; 1 cm with the unsteady skin drag hangs the 2 Hz swing at 0.9 of its
-/// length with the half-waves still growing (`docs/underwater.md`, stop 62).
+/// length with the half-waves still growing (`docs/underwater.md`).
 pub const UNDERWATER_FORM_DRAG_SCALE: f64 = 0.010;
 /// Skin drag of the underwater preset, N s/m^3: laminar skin friction on both faces,
 /// `2 * 0.664 rho_w sqrt(nu / L) U^1.5` (`C_f = 1.328 / sqrt(Re)` per face, water

@@ -36,6 +36,7 @@ fn run_checked(cmd: &mut Command, what: &str) -> String {
 }
 
 #[test]
+#[ignore = "long: run by `cargo test --release -- --ignored` (CI's long step)"]
 fn c_programs_under_address_and_undefined_behavior_sanitizers() {
     let dir = scratch_dir("asan");
     for (source, args) in [
@@ -68,6 +69,7 @@ fn c_programs_under_address_and_undefined_behavior_sanitizers() {
 }
 
 #[test]
+#[ignore = "long: run by `cargo test --release -- --ignored` (CI's long step)"]
 fn c_programs_under_valgrind_memcheck() {
     if Command::new("valgrind").arg("--version").output().is_err() {
         assert!(

@@ -213,7 +213,9 @@ fn a_mesh_colliders_triangle_index_out_of_range_is_a_corrupted_snapshot() {
     reseal(&mut snap);
     let (mut b, _) = with_mesh_collider();
     let before = b.save_snapshot().unwrap();
-    let err = b.load_snapshot(&snap).expect_err("a forged snapshot was accepted");
+    let err = b
+        .load_snapshot(&snap)
+        .expect_err("a forged snapshot was accepted");
     assert_eq!(
         err.kind,
         fraccloth::ErrorKind::InvalidArgument,
@@ -237,11 +239,18 @@ fn a_snapshot_whose_mesh_collider_move_cannot_be_stepped_is_refused() {
     a.set_mesh_collider(id, &far, None).unwrap();
     let snap = a.save_snapshot().unwrap();
     let refused = a.clone().step(1e-3).expect_err("the sweep was stepped");
-    assert_eq!(refused.kind, fraccloth::ErrorKind::Unstable, "{}", refused.message);
+    assert_eq!(
+        refused.kind,
+        fraccloth::ErrorKind::Unstable,
+        "{}",
+        refused.message
+    );
     // The load's trial step is that step: the snapshot is refused and the cloth unchanged.
     let (mut b, _) = with_mesh_collider();
     let before = b.save_snapshot().unwrap();
-    let err = b.load_snapshot(&snap).expect_err("a snapshot that cannot step was loaded");
+    let err = b
+        .load_snapshot(&snap)
+        .expect_err("a snapshot that cannot step was loaded");
     assert_eq!(err.kind, fraccloth::ErrorKind::InvalidArgument, "{}", err.message);
     assert!(b.save_snapshot().unwrap() == before, "the cloth changed");
     b.step(1e-3).unwrap();

@@ -90,6 +90,7 @@ fn swing_of(
 }
 
 #[test]
+#[ignore = "long: run by `cargo test --release -- --ignored` (CI's long step)"]
 fn the_towel_hangs_and_its_bumps_shorten_from_a_quarter_to_two_hertz() {
     let rest_length = 0.4;
     let mut rows = vec![];
@@ -163,6 +164,7 @@ fn waves_travel_down_the_hanging_towel_at_the_closed_form_phase_speed() {
 }
 
 #[test]
+#[ignore = "long: run by `cargo test --release -- --ignored` (CI's long step)"]
 fn the_two_recommended_integrators_give_the_same_shot_at_half_a_hertz() {
     let explicit = swing(0.5, 0.04, Integrator::SymplecticEuler, 5e-4);
     let implicit = swing(0.5, 0.04, Integrator::ImplicitEuler, 1.0 / 30.0);
@@ -182,6 +184,7 @@ fn the_two_recommended_integrators_give_the_same_shot_at_half_a_hertz() {
 /// against 0.295, 1.01 substeps a call. Before stop 66 those substeps were split (2.57 a call:
 /// 3.62 half-waves, mid 0.318); before stop 64 their fast vertices were slowed (2.04, 0.193).
 #[test]
+#[ignore = "long: run by `cargo test --release -- --ignored` (CI's long step)"]
 fn self_collision_keeps_the_shot_at_one_substep_a_frame() {
     let dt = 1.0 / 30.0;
     let (without, once) = swing_of(0.5, 0.04, Integrator::ImplicitEuler, dt, 0.0, None);
@@ -244,6 +247,7 @@ fn an_unstable_fixed_step_with_self_collision_is_taken_in_stable_pieces() {
 /// automatic step's 0.150 (`water_sweep integrator=symplectic2 freq=0.5 self=0.4
 /// dt=0.0333333333`); measured since, 0 slowed and 0.150 m/s, 3.56 half-waves, mid 0.336.
 #[test]
+#[ignore = "long: run by `cargo test --release -- --ignored` (CI's long step)"]
 fn an_extrapolated_fixed_step_with_self_collision_slows_no_half_step() {
     fixed_step_with_self_collision_is_the_automatic_steps(Integrator::ExtrapolatedSymplectic);
 }
@@ -306,6 +310,7 @@ fn fixed_step_with_self_collision_is_the_automatic_steps(integrator: Integrator)
 /// of symplectic Euler's swing: measured 0.108 against 0.220 since the preset's form drag is
 /// smoothed over 1 cm (0.165 against 0.217 over 1.2 cm, before 0.9.26; docs/underwater.md).
 #[test]
+#[ignore = "long: run by `cargo test --release -- --ignored` (CI's long step)"]
 fn the_two_recommended_integrators_give_the_same_shot_at_one_hertz_at_the_automatic_step() {
     let (symplectic, implicit) = symplectic_and_implicit_at_the_automatic_step(1.0);
     assert!((implicit.half_waves / symplectic.half_waves - 1.0).abs() < 0.15);
@@ -318,6 +323,7 @@ fn the_two_recommended_integrators_give_the_same_shot_at_one_hertz_at_the_automa
 /// 6.89 against 6.02 (5.61 with the floor at symplectic Euler's step), depth 0.157 against
 /// 0.124 (the first-order damping that remains: 0.129 at a 0.5 ms step).
 #[test]
+#[ignore = "long: run by `cargo test --release -- --ignored` (CI's long step)"]
 fn the_two_recommended_integrators_give_the_same_half_waves_at_two_hertz_at_the_automatic_step() {
     let (symplectic, implicit) = symplectic_and_implicit_at_the_automatic_step(2.0);
     assert!((implicit.half_waves / symplectic.half_waves - 1.0).abs() < 0.15);
@@ -329,6 +335,7 @@ fn the_two_recommended_integrators_give_the_same_half_waves_at_two_hertz_at_the_
 /// a count cut at the first row under 10 % reads them a half-wave apart (3.82 against 4.79),
 /// the look meter's weighed count within 15 % (6.04 against 5.95: docs/look.md).
 #[test]
+#[ignore = "long: run by `cargo test --release -- --ignored` (CI's long step)"]
 fn the_two_recommended_integrators_give_the_same_half_waves_at_one_and_a_half_hertz() {
     let (symplectic, implicit) = symplectic_and_implicit_at_the_automatic_step(1.5);
     let (a, b) = (
@@ -435,6 +442,7 @@ fn motion_in_the_cloths_own_plane_dies_out() {
 /// (`Model::bend_reference_spacing`). Before they were, the 2 cm curtain carried 3.85
 /// half-waves against 4.69 (`docs/underwater.md`).
 #[test]
+#[ignore = "long: run by `cargo test --release -- --ignored` (CI's long step)"]
 fn the_curtain_carries_the_same_waves_at_two_resolutions() {
     let curtain = |width: u32, height: u32, dt: f64| {
         let spec = SceneSpec {

@@ -45,7 +45,7 @@ pub const AUTO: f64 = -1.0;
 
 /// Fraction of the estimated bound the automatic step takes with explicit Euler and the
 /// implicit integrators (measured: `docs/stability.md`; the smallest measured bound over the
-/// estimate was 1.22 when the factor was chosen, 1.24 since stop 43, so the step stays at 0.66
+/// estimate was 1.22 when the factor was chosen, 1.24 now, so the step stays at 0.66
 /// of the measured bound or below).
 pub const SAFETY: f64 = 0.8;
 
@@ -65,7 +65,7 @@ pub fn safety(integrator: Integrator) -> f64 {
 /// Implicit Euler's accuracy bound: `omega h` at most this, `omega` the motion's frequency as
 /// `motion.rs` reads it (frame-rate accelerations against velocities: on the 4 cm swing of
 /// 61 x 41 it reads 2-3.5 times the drive's frequency, the cloth's ripples included). Measured
-/// there in 12 s bakes (docs/underwater.md, stop 58): at 1 Hz implicit Euler's free edge swung
+/// there in 12 s bakes (docs/underwater.md): at 1 Hz implicit Euler's free edge swung
 /// 0.090 of the drive at its stable step against symplectic Euler's 0.217, and 0.171 with this
 /// bound (25 substeps a frame), the depth of the motion within 12 % of symplectic Euler's from
 /// 0.25 to 1.5 Hz; a bound of 0.025 took 17 substeps a frame at 1 Hz and gave 0.149.
@@ -73,7 +73,7 @@ pub const ACCURACY: f64 = 0.016;
 
 /// The shortest substep the accuracy bound may ask of implicit Euler, as a fraction of the step
 /// symplectic Euler takes on the same cloth. Measured on the 61 x 41 swing, 12 s bakes
-/// (docs/underwater.md, stop 59): at 2 Hz the bound asks for less than symplectic Euler's step.
+/// (docs/underwater.md): at 2 Hz the bound asks for less than symplectic Euler's step.
 /// With the floor at 1 (symplectic Euler's step) implicit Euler read 5.61 half-waves against
 /// symplectic Euler's 6.89 (-19 %); at 0.7, 6.02 (-13 %) for 42 substeps a frame instead of 30;
 /// at 0.5, 6.06 for 52.

@@ -437,7 +437,7 @@ impl Cloth {
         // A cloth proved out of its own reach throughout the step needs no limit (a step the
         // driver may take whole: `split.rs`). Only where the step is stable as it is: an
         // explicit integrator's fixed step too long to be stable is still split into stable
-        // pieces (stop 65), not refused.
+        // pieces, not refused.
         if self.limit_needless() {
             self.limit_stats.proved_whole += 1;
             return Limited::Slowed(0);
@@ -497,6 +497,7 @@ fn any_past(x_new: &[f64], x: &[f64], pinned: &[bool], limit2: f64) -> bool {
 
 /// What collisions keep across a snapshot: the mesh colliders by id and self-collision's
 /// remembered pairs.
+#[derive(Default)]
 pub(super) struct CollisionState {
     pub meshes: Vec<Option<MeshCollider>>,
     pub vertex_triangle: Vec<Pair>,

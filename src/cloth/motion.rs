@@ -5,7 +5,7 @@
 //! step, so the amplitude decays at `omega^2 h / 2` a second, `pi omega h` a period. At the
 //! step its stability allows (a frame, or a few substeps) that is a large fraction of what the
 //! water takes: measured at 1 Hz (4 cm, 61 x 41, underwater preset), implicit Euler's shot gave
-//! 2.5-2.8 half-waves at 10-33 ms steps against 4.76 converged (docs/underwater.md, stop 58;
+//! 2.5-2.8 half-waves at 10-33 ms steps against 4.76 converged (docs/underwater.md;
 //! counted as the look meter counted them before 0.9.23).
 //!
 //! The frequency is read from the cloth as it moves, once per call: the free particles'

@@ -43,6 +43,7 @@ use super::step::{Stage, StepPlan};
 use super::{check_weight, checked_collider, Cloth, Histories};
 use crate::bytes::{ByteReader, ByteWriter};
 use crate::cloth::MAX_COORDINATE;
+use crate::collide::self_collision::Pair;
 use crate::collide::MeshCollider;
 use crate::error::{check_finite_vec, Error};
 use crate::forces::{Capsule, Collider, Plane, Sphere};
@@ -168,6 +169,58 @@ fn swap_contents<T>(a: &mut Vec<T>, b: &mut Vec<T>) {
     }
 }
 
+/// Self-collision's remembered pairs as a snapshot holds them: vertex-triangle, edge-edge.
+type SelfPairs = (Vec<Pair>, Vec<Pair>);
+
+/// The analytic colliders' slots: shape, friction and (version 6) their own margin.
+fn read_collider_slots(
+    r: &mut ByteReader<'_>,
+    version: u32,
+) -> Result<Vec<Option<super::ColliderSlot>>, Error> {
+    let slots = r.len(None, 1)?;
+    let mut collider_slots = Vec::with_capacity(slots);
+    for _ in 0..slots {
+        collider_slots.push(match r.u8()? {
+            0 => None,
+            1 => {
+                let c = checked_collider(read_collider(r)?)?;
+                let friction = r.f64()?;
+                if !(friction.is_finite() && friction >= 0.0) {
+                    return Err(Error::invalid("snapshot: bad collider friction"));
+                }
+                let margin = if version >= 6 {
+                    super::collisions::read_margin(r)?
+                } else {
+                    None
+                };
+                Some(super::ColliderSlot {
+                    shape: c,
+                    friction,
+                    margin,
+                })
+            }
+            k => return Err(Error::invalid(format!("snapshot: bad collider slot tag {k}"))),
+        });
+    }
+    Ok(collider_slots)
+}
+
+/// The motion averages (version 7; unseen before).
+fn read_motion(r: &mut ByteReader<'_>, version: u32) -> Result<super::motion::MotionRate, Error> {
+    let motion = if version >= 7 {
+        super::motion::MotionRate {
+            accel2: r.f64()?,
+            vel2: r.f64()?,
+        }
+    } else {
+        super::motion::MotionRate::default()
+    };
+    if !motion.is_sound() {
+        return Err(Error::invalid("snapshot: bad motion averages"));
+    }
+    Ok(motion)
+}
+
 /// A decoded snapshot's state, before it is a cloth's (or a cloth's, after it was replaced):
 /// what [`Cloth::swap_state`] exchanges.
 struct LoadedState {
@@ -250,6 +303,16 @@ impl Cloth {
     /// Restores a state saved by [`Cloth::save_snapshot`] from a cloth of the same topology and
     /// history configuration. All or nothing: on any error the cloth is unchanged.
     pub fn load_snapshot(&mut self, bytes: &[u8]) -> Result<(), Error> {
+        let (mut r, version) = self.open_snapshot(bytes)?;
+        // Decode everything into fresh values; commit only when all of it is sound.
+        let (state, pairs) = self.decode_state(&mut r, version, bytes.len())?;
+        self.check_loaded(&state)?;
+        self.commit_loaded(state, pairs)
+    }
+
+    /// Checks a snapshot's magic, version, length, checksum, topology and history
+    /// configuration: a reader placed after them, and the format version.
+    fn open_snapshot<'a>(&self, bytes: &'a [u8]) -> Result<(ByteReader<'a>, u32), Error> {
         if bytes.len() < HEADER + 4 || &bytes[..8] != MAGIC {
             return Err(Error::invalid(
                 "not a fraccloth snapshot (bad magic or too short)",
@@ -272,22 +335,20 @@ impl Cloth {
                 payload.saturating_add((HEADER + 4) as u64)
             )));
         }
-        let body = &bytes[..bytes.len() - 4];
-        let stored = u32::from_le_bytes([
-            bytes[bytes.len() - 4],
-            bytes[bytes.len() - 3],
-            bytes[bytes.len() - 2],
-            bytes[bytes.len() - 1],
-        ]);
+        let (body, crc) = bytes.split_at(bytes.len() - 4);
+        let stored = u32::from_le_bytes([crc[0], crc[1], crc[2], crc[3]]);
         if crc32fast::hash(body) != stored {
             return Err(Error::invalid(
                 "snapshot checksum does not match: the data is corrupted",
             ));
         }
-        let n = self.vertex_count();
         let t = &self.topology;
         let counts = [r.u64()?, r.u64()?, r.u64()?];
-        let want = [n as u64, t.springs.len() as u64, t.triangles.len() as u64];
+        let want = [
+            t.vertex_count() as u64,
+            t.springs.len() as u64,
+            t.triangles.len() as u64,
+        ];
         if counts != want || r.u64()? != topology_fingerprint(self) {
             return Err(Error::invalid(format!(
                 "snapshot is of another cloth ({} vertices, {} springs, {} triangles; this one has {}, {}, {}, or different rest shape)",
@@ -299,7 +360,18 @@ impl Cloth {
                 "snapshot was saved with another history scheme or history settings",
             ));
         }
-        // Decode everything into fresh values; commit only when all of it is sound.
+        Ok((r, version))
+    }
+
+    /// Decodes the state after the header (of a snapshot `len` bytes long), checking what
+    /// decides how the rest is read, up to the trailer.
+    fn decode_state(
+        &self,
+        r: &mut ByteReader<'_>,
+        version: u32,
+        len: usize,
+    ) -> Result<(LoadedState, SelfPairs), Error> {
+        let n = self.vertex_count();
         let time = r.f64()?;
         let steps = r.u64()?;
         let current = r.vec3()?;
@@ -317,45 +389,17 @@ impl Cloth {
             pin_list.push(r.u32()?);
         }
         r.vec3s_into(Some(n), &mut targets)?;
-        let slots = r.len(None, 1)?;
-        let mut collider_slots = Vec::with_capacity(slots);
-        for _ in 0..slots {
-            collider_slots.push(match r.u8()? {
-                0 => None,
-                1 => {
-                    let c = checked_collider(read_collider(&mut r)?)?;
-                    let friction = r.f64()?;
-                    if !(friction.is_finite() && friction >= 0.0) {
-                        return Err(Error::invalid("snapshot: bad collider friction"));
-                    }
-                    let margin = if version >= 6 {
-                        super::collisions::read_margin(&mut r)?
-                    } else {
-                        None
-                    };
-                    Some(super::ColliderSlot {
-                        shape: c,
-                        friction,
-                        margin,
-                    })
-                }
-                k => return Err(Error::invalid(format!("snapshot: bad collider slot tag {k}"))),
-            });
-        }
+        let collider_slots = read_collider_slots(r, version)?;
         crate::memory::ensure_available(
-            2 * self.histories.bytes(&self.topology) + bytes.len() as u64,
+            2 * self.histories.bytes(&self.topology) + len as u64,
             "loading a snapshot",
         )?;
         let mut histories = self.histories.clone();
-        histories.read_state(&mut r)?;
+        histories.read_state(r)?;
         let collisions = if version >= 5 {
-            self.read_collision_state(&mut r, version)?
+            self.read_collision_state(r, version)?
         } else {
-            super::collisions::CollisionState {
-                meshes: Vec::new(),
-                vertex_triangle: Vec::new(),
-                edge_edge: Vec::new(),
-            }
+            super::collisions::CollisionState::default()
         };
         let clash = collisions
             .meshes
@@ -367,91 +411,12 @@ impl Cloth {
                 "snapshot: collider id {id} is both a mesh and a shape"
             )));
         }
-        let motion = if version >= 7 {
-            super::motion::MotionRate {
-                accel2: r.f64()?,
-                vel2: r.f64()?,
-            }
-        } else {
-            super::motion::MotionRate::default()
-        };
-        if !motion.is_sound() {
-            return Err(Error::invalid("snapshot: bad motion averages"));
-        }
-        let mut skin_mean = Vec::new();
-        if version >= 8 {
-            r.vec3s_into(None, &mut skin_mean)?;
-            if !(skin_mean.is_empty() || skin_mean.len() == n) {
-                return Err(Error::invalid(format!(
-                    "snapshot: {} skin drag means for {n} vertices",
-                    skin_mean.len()
-                )));
-            }
-            skin_mean
-                .iter()
-                .try_for_each(|p| check_finite_vec("skin drag mean", p))?;
-        }
-        // This cloth's model decides whether the mean is kept: one saved without it starts
-        // from the loaded flow, one saved with it is dropped by a cloth without.
-        if !self.config.model.water.unsteady_skin() {
-            skin_mean.clear();
-        } else if skin_mean.is_empty() {
-            skin_mean
-                .try_reserve_exact(n)
-                .map_err(|_| Error::out_of_memory("loading a snapshot: no room for the skin drag's mean"))?;
-            skin_mean.extend(v.iter().map(|vk| vk - current));
-        }
+        let motion = read_motion(r, version)?;
+        let skin_mean = self.read_skin_mean(r, version, &v, current)?;
         if r.remaining() != 4 {
             return Err(Error::invalid("snapshot has trailing data"));
         }
-        if !(time.is_finite() && time >= 0.0) {
-            return Err(Error::invalid(format!("snapshot: bad time {time}")));
-        }
-        check_finite_vec("snapshot current", &current)?;
-        super::check_solver(&solver)?;
-        for (what, vs) in [("position", &x), ("velocity", &v), ("pin target", &targets)] {
-            vs.iter().try_for_each(|p| check_finite_vec(what, p))?;
-            if let Some(i) = vs.iter().position(|p| p.amax() >= MAX_COORDINATE) {
-                return Err(Error::invalid(format!(
-                    "snapshot: {what} of vertex {i} is beyond the float range the ABI hands out"
-                )));
-            }
-        }
-        let limit = self.config.max_speed;
-        if let Some(i) = v.iter().position(|p| p.norm() > limit) {
-            return Err(Error::invalid(format!(
-                "snapshot: vertex {i} moves at {:.3e} m/s, above this cloth's max_speed {limit} m/s",
-                v[i].norm()
-            )));
-        }
-        histories.check_state(time)?;
-        for (i, &w) in weights.iter().enumerate() {
-            check_weight(i, w)?;
-        }
-        let mut seen = vec![false; n];
-        for &i in &pin_list {
-            let i = i as usize;
-            if i >= n || seen[i] || weights[i] == 0.0 {
-                return Err(Error::invalid(
-                    "snapshot: pin list does not match the pin weights",
-                ));
-            }
-            seen[i] = true;
-        }
-        if weights.iter().filter(|&&w| w > 0.0).count() != pin_list.len() {
-            return Err(Error::invalid(
-                "snapshot: pin list does not match the pin weights",
-            ));
-        }
-        // The loaded state goes into this cloth, in its own buffers where it can (its scratch
-        // and lists keep their room: the steps after a load allocate nothing); a trial step on
-        // a copy says whether it can step (`trial_step`), and the state it replaced comes back
-        // when it cannot.
-        // Self-collision's memory as it is (its pairs and where it last looked), to come back
-        // whole when the load is refused.
-        let mut old_memory = crate::collide::self_collision::SavedMemory::default();
-        self.self_collision.save_memory(&mut old_memory);
-        let mut state = LoadedState {
+        let state = LoadedState {
             time,
             steps,
             current,
@@ -467,9 +432,97 @@ impl Cloth {
             motion,
             skin_mean,
         };
+        Ok((state, (collisions.vertex_triangle, collisions.edge_edge)))
+    }
+
+    /// The unsteady skin drag's running mean (version 8), as this cloth's model keeps it: one
+    /// saved without it starts from the loaded flow (velocities `v` in the water's `current`),
+    /// one saved with it is dropped by a cloth without.
+    fn read_skin_mean(
+        &self,
+        r: &mut ByteReader<'_>,
+        version: u32,
+        v: &[Vec3],
+        current: Vec3,
+    ) -> Result<Vec<Vec3>, Error> {
+        let n = self.vertex_count();
+        let mut skin_mean = Vec::new();
+        if version >= 8 {
+            r.vec3s_into(None, &mut skin_mean)?;
+            if !(skin_mean.is_empty() || skin_mean.len() == n) {
+                return Err(Error::invalid(format!(
+                    "snapshot: {} skin drag means for {n} vertices",
+                    skin_mean.len()
+                )));
+            }
+            skin_mean
+                .iter()
+                .try_for_each(|p| check_finite_vec("skin drag mean", p))?;
+        }
+        if !self.config.model.water.unsteady_skin() {
+            skin_mean.clear();
+        } else if skin_mean.is_empty() {
+            skin_mean
+                .try_reserve_exact(n)
+                .map_err(|_| Error::out_of_memory("loading a snapshot: no room for the skin drag's mean"))?;
+            skin_mean.extend(v.iter().map(|vk| vk - current));
+        }
+        Ok(skin_mean)
+    }
+
+    /// Checks every decoded value that the reading did not: time, current, solver settings,
+    /// finite positions, velocities and targets within the float range and the speed limit,
+    /// the histories, the pin weights and their list.
+    fn check_loaded(&self, s: &LoadedState) -> Result<(), Error> {
+        let (n, time) = (self.vertex_count(), s.time);
+        if !(time.is_finite() && time >= 0.0) {
+            return Err(Error::invalid(format!("snapshot: bad time {time}")));
+        }
+        check_finite_vec("snapshot current", &s.current)?;
+        super::check_solver(&s.solver)?;
+        for (what, vs) in [("position", &s.x), ("velocity", &s.v), ("pin target", &s.targets)] {
+            vs.iter().try_for_each(|p| check_finite_vec(what, p))?;
+            if let Some(i) = vs.iter().position(|p| p.amax() >= MAX_COORDINATE) {
+                return Err(Error::invalid(format!(
+                    "snapshot: {what} of vertex {i} is beyond the float range the ABI hands out"
+                )));
+            }
+        }
+        let limit = self.config.max_speed;
+        if let Some(i) = s.v.iter().position(|p| p.norm() > limit) {
+            return Err(Error::invalid(format!(
+                "snapshot: vertex {i} moves at {:.3e} m/s, above this cloth's max_speed {limit} m/s",
+                s.v[i].norm()
+            )));
+        }
+        s.histories.check_state(time)?;
+        for (i, &w) in s.weights.iter().enumerate() {
+            check_weight(i, w)?;
+        }
+        let mismatch = || Error::invalid("snapshot: pin list does not match the pin weights");
+        let mut seen = vec![false; n];
+        for &i in &s.pin_list {
+            let i = i as usize;
+            if i >= n || seen[i] || s.weights[i] == 0.0 {
+                return Err(mismatch());
+            }
+            seen[i] = true;
+        }
+        if s.weights.iter().filter(|&&w| w > 0.0).count() != s.pin_list.len() {
+            return Err(mismatch());
+        }
+        Ok(())
+    }
+
+    /// The loaded state goes into this cloth, in its own buffers where it can (its scratch
+    /// and lists keep their room: the steps after a load allocate nothing); a trial step says
+    /// whether it can step (`trial_step`), and the state it replaced comes back, with
+    /// self-collision's memory (its pairs and where it last looked), when it cannot.
+    fn commit_loaded(&mut self, mut state: LoadedState, pairs: SelfPairs) -> Result<(), Error> {
+        let mut old_memory = crate::collide::self_collision::SavedMemory::default();
+        self.self_collision.save_memory(&mut old_memory);
         self.swap_state(&mut state);
-        self.self_collision
-            .set_pairs(collisions.vertex_triangle, collisions.edge_edge);
+        self.self_collision.set_pairs(pairs.0, pairs.1);
         if let Err(e) = self.trial_step() {
             self.swap_state(&mut state);
             self.self_collision.swap_memory(&mut old_memory);
@@ -547,8 +600,8 @@ impl Cloth {
     /// put back as it was (the rollback a refused call uses, the mesh colliders as loaded, and
     /// the pins' targets, the solve's acceptance, the statistics and the count of vertices
     /// carried through meshes), so that a large cloth is not copied whole: at a million
-    /// particles the copy was most of a load's time (fresh pages to zero; `docs/benchmarks.md`,
-    /// stop 56).
+    /// particles the copy was most of a load's time (fresh pages to zero;
+    /// `docs/benchmarks.md`).
     fn trial_in_place(&mut self, h: f64) -> Result<(), Error> {
         let mut snap = std::mem::take(&mut self.rollback);
         if let Err(e) = snap.save(self) {

@@ -421,7 +421,7 @@ mod tests {
 
     /// A substep from rest is predicted within the limit and not watched, yet its springs fling
     /// vertices past the limit within it: it is refused and split all the same, nothing slowed
-    /// (before stop 65 such a vertex was slowed). A call of that one substep keeps its bits
+    /// (not slowed). A call of that one substep keeps its bits
     /// (the same as asking for that many substeps); a call of two, whose first substep is
     /// unwatched and goes without a copy of self-collision's memory, splits it too.
     #[test]

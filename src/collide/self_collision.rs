@@ -55,14 +55,14 @@ pub const EXCLUDED: f64 = 2.2;
 /// How far past the exclusion, in exclusions, the least rest distance of a tested pair is
 /// looked for (the proof of `unfolded.rs` starts there): a 1 cm grid at 4 mm has its first at
 /// 10 mm, 1.14 exclusions, where the proof needs the cloth's deformation to keep 80 % of a
-/// rest distance instead of 91 % at the exclusion (stop 66).
+/// rest distance instead of 91 % at the exclusion.
 const NEAREST_CAP: f64 = 1.25;
 /// The proof's cells are at least this many times that least distance a side: pairs from it to
 /// a cell's side are proved over windows of 2 cells, the next band (to 2 sides) over windows
 /// of 3, where the bound needs only 64 % of the distance kept. (At 1, the cells of a 1 cm grid
 /// 10 mm, every pair from 10 mm was in the band of windows of 3 cells and the 0.5 Hz swing's
 /// bent shapes failed it: 1.10 of 1.21 looks a frame proved over 12 s, against 1.21 of 1.21 at
-/// 1.25 and 1.16 at 1.5; `collision_cost 1 0 12`, stop 66.)
+/// 1.25 and 1.16 at 1.5; `collision_cost 1 0 12`.)
 const CELL_OVER_FIRST: f64 = 1.25;
 /// At most this many pairs a vertex, on average, in the lists worked out from the rest shape
 /// (the neighbours left out and the rest-near pairs listed). A 61 x 61 grid of 1 cm spacing
@@ -706,11 +706,34 @@ impl SelfCollision {
                 return Ok(());
             }
         }
-        // Pairs nearer than this at rest are surely out of reach (`unfolded.rs`). A proof that
-        // proved nothing is not tried again for the next looks, twice as many each time it
-        // fails in a row up to `PROOF_BACKOFF` (a cloth bent at every look pays for it once in
-        // that many), and at once after one that did.
-        let below = if self.full_looks {
+        let below = self.proof_below(x, triangles, reach, excluded_within);
+        if below == f64::INFINITY && self.owners.orphans().is_empty() {
+            // Every pair: nothing in reach, nothing to remember.
+            self.certified_looks += 1;
+            self.last_proved = true;
+            self.vertex_triangle.clear();
+            self.edge_edge.clear();
+            self.looked_at.extend_from_slice(x);
+            return Ok(());
+        }
+        self.make_boxes(x, triangles, reach)?;
+        if below > excluded_within && self.rest_nodes.is_empty() {
+            self.make_rest_nodes(rest, triangles)?;
+        }
+        self.copy_old_pairs()?;
+        let parts = self.search_pairs(x, triangles, reach, below, excluded_within)?;
+        self.gather_found(parts)?;
+        self.looked_at.extend_from_slice(x);
+        Ok(())
+    }
+
+    /// The distance at rest below which the unfolded proof (`unfolded.rs`) shows every pair
+    /// out of reach at `x` (`excluded_within` when it proves nothing or is not tried). A
+    /// proof that proved nothing is not tried again for the next looks, twice as many each
+    /// time it fails in a row up to `PROOF_BACKOFF` (a cloth bent at every look pays for it
+    /// once in that many), and at once after one that did.
+    fn proof_below(&mut self, x: &[Vec3], triangles: &[[u32; 3]], reach: f64, excluded_within: f64) -> f64 {
+        if self.full_looks {
             excluded_within
         } else if self.proof_wait > 0 {
             self.proof_wait -= 1;
@@ -726,16 +749,14 @@ impl SelfCollision {
                 self.proof_wait = self.proof_backoff;
             }
             below
-        };
-        if below == f64::INFINITY && self.owners.orphans().is_empty() {
-            // Every pair: nothing in reach, nothing to remember.
-            self.certified_looks += 1;
-            self.last_proved = true;
-            self.vertex_triangle.clear();
-            self.edge_edge.clear();
-            self.looked_at.extend_from_slice(x);
-            return Ok(());
         }
+    }
+
+    /// The boxes of a look at `x`: the triangles' grown by `reach` (a vertex's candidates), by
+    /// half of it (the tree's) and the edges' by half of it; the tree refitted (or built), and
+    /// the rest boxes in its order.
+    fn make_boxes(&mut self, x: &[Vec3], triangles: &[[u32; 3]], reach: f64) -> Result<(), Error> {
+        let oom = |what: &str| Error::out_of_memory(format!("self-collision: {what} cannot be allocated"));
         // A vertex is a candidate for a triangle within `reach` of the triangle's box, two
         // edges for each other when their boxes grown by half the reach overlap. The
         // triangles' tree holds their boxes grown by half the reach: a vertex (an edge) of one
@@ -777,25 +798,33 @@ impl SelfCollision {
                 .map_err(|_| oom("the rest boxes in the tree's order"))?;
             self.tri_bvh.in_order_into(rest_boxes, &mut self.rest_in_order);
         }
-        if below > excluded_within && self.rest_nodes.is_empty() {
-            // The plain rest boxes, in the tree's order, gathered by its nodes (the tree's
-            // boxes at most twice its items' count).
-            let (mut boxes, mut plain) = (Vec::new(), Vec::new());
-            boxes
-                .try_reserve_exact(triangles.len())
-                .and_then(|()| plain.try_reserve_exact(triangles.len()))
-                .and_then(|()| self.rest_nodes.try_reserve_exact(2 * triangles.len()))
-                .map_err(|_| oom("the rest boxes of the tree's nodes"))?;
-            boxes.extend(
-                triangles
-                    .iter()
-                    .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize]))),
-            );
-            self.tri_bvh.in_order_into(&boxes, &mut plain);
-            self.tri_bvh.node_boxes_into(&plain, &mut self.rest_nodes);
-        }
-        // The remembered pairs copied aside (the new lists are made where they are), each
-        // list keeping its room from look to look.
+        Ok(())
+    }
+
+    /// The plain rest boxes, in the tree's order, gathered by its nodes (the tree's boxes at
+    /// most twice its items' count): what the proved walk skips by.
+    fn make_rest_nodes(&mut self, rest: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), Error> {
+        let oom = |what: &str| Error::out_of_memory(format!("self-collision: {what} cannot be allocated"));
+        let (mut boxes, mut plain) = (Vec::new(), Vec::new());
+        boxes
+            .try_reserve_exact(triangles.len())
+            .and_then(|()| plain.try_reserve_exact(triangles.len()))
+            .and_then(|()| self.rest_nodes.try_reserve_exact(2 * triangles.len()))
+            .map_err(|_| oom("the rest boxes of the tree's nodes"))?;
+        boxes.extend(
+            triangles
+                .iter()
+                .map(|t| Aabb::of(t.iter().map(|&i| &rest[i as usize]))),
+        );
+        self.tri_bvh.in_order_into(&boxes, &mut plain);
+        self.tri_bvh.node_boxes_into(&plain, &mut self.rest_nodes);
+        Ok(())
+    }
+
+    /// The remembered pairs copied aside (the new lists are made where they are), each list
+    /// keeping its room from look to look.
+    fn copy_old_pairs(&mut self) -> Result<(), Error> {
+        let oom = |what: &str| Error::out_of_memory(format!("self-collision: {what} cannot be allocated"));
         self.old_vt.clear();
         self.old_ee.clear();
         self.old_vt
@@ -804,6 +833,22 @@ impl SelfCollision {
             .map_err(|_| oom("a copy of the pairs"))?;
         self.old_vt.extend_from_slice(&self.vertex_triangle);
         self.old_ee.extend_from_slice(&self.edge_edge);
+        Ok(())
+    }
+
+    /// Finds the pairs within `reach` at `x` into the parts of `found`: the triangles' tree
+    /// walked against itself (each overlapping pair of boxes once), in tasks for the pool on
+    /// a large cloth; triangles near each other at rest left out of it, their pairs listed
+    /// (`NearPairs`) and tested in chunks; the vertices in no triangle one query each.
+    fn search_pairs(
+        &mut self,
+        x: &[Vec3],
+        triangles: &[[u32; 3]],
+        reach: f64,
+        below: f64,
+        excluded_within: f64,
+    ) -> Result<usize, Error> {
+        let oom = |what: &str| Error::out_of_memory(format!("self-collision: {what} cannot be allocated"));
         let search = Search {
             x,
             triangles,
@@ -816,9 +861,6 @@ impl SelfCollision {
             old_vt: &self.old_vt,
             old_ee: &self.old_ee,
         };
-        // The triangles' tree walked against itself (each overlapping pair of boxes once), in
-        // tasks for the pool on a large cloth; triangles near each other at rest are left out
-        // of it, their pairs listed (`NearPairs`) and tested in chunks.
         use rayon::prelude::*;
         // On the pool only where the step itself runs there: handing a look from the host's
         // thread to the pool cost more than the second thread saved at 61 x 41 (Intel Xeon,
@@ -897,9 +939,15 @@ impl SelfCollision {
         if found.iter().any(|f| f.failed) {
             return Err(oom("the pairs a look found"));
         }
-        // Room for the gathered lists before they are emptied, so a refusal leaves the
-        // remembered pairs as they were.
+        Ok(parts)
+    }
+
+    /// The first `parts` parts' pairs gathered into the remembered lists, sorted; room for them asked
+    /// before the lists are emptied, so a refusal leaves the remembered pairs as they were.
+    fn gather_found(&mut self, parts: usize) -> Result<(), Error> {
+        let oom = |what: &str| Error::out_of_memory(format!("self-collision: {what} cannot be allocated"));
         let (vt, ee) = (&mut self.vertex_triangle, &mut self.edge_edge);
+        let found = &self.found[..parts];
         let (vt_len, ee_len) = (
             found.iter().map(|f| f.vt.len()).sum::<usize>(),
             found.iter().map(|f| f.ee.len()).sum::<usize>(),
@@ -915,7 +963,6 @@ impl SelfCollision {
         }
         vt.sort_unstable();
         ee.sort_unstable();
-        self.looked_at.extend_from_slice(x);
         Ok(())
     }
 
@@ -1158,7 +1205,7 @@ mod tests {
     /// on a sheet waved gently (the proof covers every pair: nothing tested), rolled into a
     /// spiral whose turns lie 6 mm apart (the proof covers the short distances; the pairs a
     /// turn apart are found), creased by a radian along a diagonal (nothing in reach: proved
-    /// whole since the proof starts at the nearest tested pair, 10 mm, stop 66; at the 8.8 mm
+    /// whole since the proof starts at the nearest tested pair, 10 mm; at the 8.8 mm
     /// exclusion it was not), folded back over itself
     /// round 3 mm (nothing proved), and the folded sheet with its lone vertex (never proved
     /// whole).

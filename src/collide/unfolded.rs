@@ -34,7 +34,7 @@
 //! of side `c` along each axis, so it lies in some window of `k x k` cells whenever
 //! `d < (k - 1) c`. For windows of 2 (the finest level only), 3 and 4 cells of each level in
 //! turn, the least `g` over every window bounds every pair in its band of distances: the
-//! pairs from the exclusion radius up (nearer pairs are neighbours, never tested; since stop 66
+//! pairs from the exclusion radius up (nearer pairs are neighbours, never tested; in fact
 //! from the nearest tested pair's rest distance, found once, when self-collision says it:
 //! 10 mm on a 1 cm grid at 4 mm, where the exclusion is 8.8 mm and the bound at it needed 91 %
 //! of a rest distance kept instead of 80 %) are certain

@@ -17,7 +17,7 @@
 //! rows of sums at a time take their patch terms (`w`, [`PATCH_ROWS_VERTICES`]) while in
 //! cache, and each cell row whose two vertex rows' `w` are there takes its gradients at once.
 //! So the sums never leave the cache, and positions, forces and `w` are read once a step
-//! where the passes apart read them twice (stop 56, below). On the pool the rows are cut into
+//! where the passes apart read them twice. On the pool the rows are cut into
 //! bands, one task each; the cell rows that read another band's `w` (above a band's first
 //! row, and its last) wait for a small pass after every band's walk ([`edges`]). A cell row
 //! two bands need is computed by both, with the same values: the bits do not depend on the
@@ -25,13 +25,13 @@
 //! determinism hashes run the underwater preset on 1, 2 and 8 threads). This replaces, for
 //! grids, the chunks and wavefront that other meshes take (`inertia.rs`).
 //!
-//! Measured (AMD EPYC, `docs/benchmarks.md`, stop 49, alternated with the scatter's build), ns
+//! Measured (AMD EPYC, `docs/benchmarks.md`, alternated with the scatter's build), ns
 //! a particle-step of the underwater preset: 61 x 41 58-60 against 64-66; 201 x 201 on one
 //! thread 63-64 against 71-74, on two 33-35 against 41; 1001 x 1001 on two threads 48-49
 //! against 54-55 (1.77-1.84 times one thread's 87-88). The scatter's chain of stores and
 //! reloads (a vertex is a corner of six faces, three of them consecutive) was the cost on one
-//! thread; the chunks' borders and wavefront on two. Stop 56 walked each band once (above):
-//! see `docs/benchmarks.md` for its figures.
+//! thread; the chunks' borders and wavefront on two. Walking each band once (above) saves
+//! more: see `docs/benchmarks.md` for the figures.
 
 use super::inertia::{patch_range, PatchOut};
 use crate::math::Vec3;

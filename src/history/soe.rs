@@ -63,8 +63,7 @@ fn phi(z: f64) -> (f64, f64) {
 
 /// Bytes of modes from which a cloth's SOE history defers every other fold
 /// ([`SumOfExponentials::with_deferred_fold`]): where the modes no longer fit the caches and
-/// the step streams them from memory. Measured with `step_cycles fractional` (docs/benchmarks.md,
-/// stop 52).
+/// the step streams them from memory. Measured with `step_cycles fractional` (docs/benchmarks.md).
 pub const DEFER_FROM_BYTES: usize = 16 << 20;
 
 /// Environment variable that turns the deferred fold on (`1`) or off (`0`) at every size (read

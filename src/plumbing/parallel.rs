@@ -27,14 +27,14 @@ pub const TILE: usize = 256;
 const _: () = assert!(CHUNK % TILE == 0);
 
 /// Fewest particles for which a step uses more than one thread on a CPU not made by AMD (an
-/// Intel Xeon): the threshold chosen at stop 15 with `cargo run --release --example
+/// Intel Xeon): the threshold chosen with `cargo run --release --example
 /// throughput` (docs/benchmarks.md), not yet measured lower on an Intel Xeon. The largest of
 /// the thresholds, so a cloth of this many particles uses the pool on every CPU unless
 /// [`MIN_PARALLEL_VARIABLE`] says otherwise.
 pub const MIN_PARALLEL: usize = 16_000;
 
 /// Fewest particles for which a step uses more than one thread on an AMD CPU: on the AMD EPYC
-/// measured (Zen 4, `step_cycles`, docs/benchmarks.md, stop 45) two threads gain 1.22-1.27x at
+/// measured (Zen 4, `step_cycles`, docs/benchmarks.md) two threads gain 1.22-1.27x at
 /// 6 400 particles (80 x 80) and break even at about 5 000.
 pub const MIN_PARALLEL_AMD: usize = 6_400;
 

@@ -50,6 +50,32 @@ const DEGENERATE_AREA: f64 = 1e-10;
 impl MeshSpec<'_> {
     /// Checks the mesh and builds the topology.
     pub fn build(&self) -> Result<Topology, Error> {
+        self.check()?;
+        let k = self.face_size;
+        let faces: Vec<&[u32]> = self.indices.chunks_exact(k).collect();
+        let x = self.positions;
+        let (area, triangles) = self.lumped_areas(&faces)?;
+        if let Some(v) = area.iter().position(|&a| a == 0.0) {
+            return Err(Error::invalid(format!(
+                "vertex {v} is used by no face (it would have no mass)"
+            )));
+        }
+        let total_area: f64 = area.iter().sum();
+        let density = match self.mass {
+            MeshMass::ArealDensity(d) => d,
+            MeshMass::Total(m) => m / total_area,
+        };
+        let masses = area.iter().map(|a| a * density).collect();
+        let springs = springs_of(x, &faces, k)?;
+        let mut t = Topology::new(x.to_vec(), masses, springs, triangles, None);
+        // The same lumping as the masses: each face gives area / corners to each corner.
+        t.areas = area;
+        Ok(t)
+    }
+
+    /// The face size, counts, room, finite positions and mass: what is checked before the
+    /// faces are read.
+    fn check(&self) -> Result<(), Error> {
         let n = self.positions.len();
         let k = self.face_size;
         if k != 3 && k != 4 {
@@ -88,8 +114,14 @@ impl MeshSpec<'_> {
             }
             _ => {}
         }
-        let faces: Vec<&[u32]> = self.indices.chunks_exact(k).collect();
-        let x = self.positions;
+        Ok(())
+    }
+
+    /// Each vertex's lumped area (each face gives area / corners to each corner) and the
+    /// triangles (a quad split along its first diagonal); a face with an index out of range, a
+    /// repeated corner or no area is refused.
+    fn lumped_areas(&self, faces: &[&[u32]]) -> Result<(Vec<f64>, Vec<[u32; 3]>), Error> {
+        let (n, k, x) = (self.positions.len(), self.face_size, self.positions);
         let mut area = vec![0.0; n];
         let mut triangles = Vec::with_capacity(faces.len() * (k - 2));
         for (f, face) in faces.iter().enumerate() {
@@ -133,83 +165,76 @@ impl MeshSpec<'_> {
                 area[v as usize] += face_area / k as f64;
             }
         }
-        if let Some(v) = area.iter().position(|&a| a == 0.0) {
+        Ok((area, triangles))
+    }
+}
+
+/// The springs of a manifold mesh of `k`-cornered faces at rest positions `x`: a stretch
+/// spring on every edge, a bend spring across every edge two faces share (between the
+/// opposite corners of triangles; between each end's other neighbours in quads) and, in
+/// quads, shear springs on both diagonals; each spring once.
+fn springs_of(x: &[Vec3], faces: &[&[u32]], k: usize) -> Result<Vec<Spring>, Error> {
+    // Edges: (min, max) -> the faces using it and, per face, the corner position of the edge.
+    let mut edges: HashMap<(u32, u32), Vec<(usize, usize)>> = HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        for a in 0..k {
+            let (p, q) = (face[a], face[(a + 1) % k]);
+            edges.entry((p.min(q), p.max(q))).or_default().push((f, a));
+        }
+    }
+    let mut edge_list: Vec<_> = edges.into_iter().collect();
+    edge_list.sort_unstable_by_key(|(e, _)| *e);
+    let mut springs = Vec::new();
+    let mut push = |i: u32, j: u32, kind: SpringKind| {
+        if i != j {
+            let (i, j) = (i.min(j), i.max(j));
+            springs.push(Spring {
+                i,
+                j,
+                rest: (x[j as usize] - x[i as usize]).norm(),
+                kind,
+            });
+        }
+    };
+    for ((p, q), users) in &edge_list {
+        if users.len() > 2 {
+            let list: Vec<usize> = users.iter().map(|u| u.0).collect();
             return Err(Error::invalid(format!(
-                "vertex {v} is used by no face (it would have no mass)"
+                "edge ({p}, {q}) is shared by {} faces {list:?}: the mesh is not manifold",
+                users.len()
             )));
         }
-        let total_area: f64 = area.iter().sum();
-        let density = match self.mass {
-            MeshMass::ArealDensity(d) => d,
-            MeshMass::Total(m) => m / total_area,
-        };
-        let masses = area.iter().map(|a| a * density).collect();
-
-        // Edges: (min, max) -> the faces using it and, per face, the corner position of the edge.
-        let mut edges: HashMap<(u32, u32), Vec<(usize, usize)>> = HashMap::new();
-        for (f, face) in faces.iter().enumerate() {
-            for a in 0..k {
-                let (p, q) = (face[a], face[(a + 1) % k]);
-                edges.entry((p.min(q), p.max(q))).or_default().push((f, a));
-            }
-        }
-        let mut edge_list: Vec<_> = edges.into_iter().collect();
-        edge_list.sort_unstable_by_key(|(e, _)| *e);
-        let mut springs = Vec::new();
-        let mut push = |i: u32, j: u32, kind: SpringKind| {
-            if i != j {
-                let (i, j) = (i.min(j), i.max(j));
-                springs.push(Spring {
-                    i,
-                    j,
-                    rest: (x[j as usize] - x[i as usize]).norm(),
-                    kind,
-                });
-            }
-        };
-        for ((p, q), users) in &edge_list {
-            if users.len() > 2 {
-                let list: Vec<usize> = users.iter().map(|u| u.0).collect();
-                return Err(Error::invalid(format!(
-                    "edge ({p}, {q}) is shared by {} faces {list:?}: the mesh is not manifold",
-                    users.len()
-                )));
-            }
-            push(*p, *q, SpringKind::Stretch);
-            if let [(f, a), (g, b)] = users[..] {
-                let (ff, gg) = (faces[f], faces[g]);
-                if k == 3 {
-                    push(ff[(a + 2) % 3], gg[(b + 2) % 3], SpringKind::Bend);
-                } else {
-                    // At each end of the shared edge, the end's other neighbour in each face.
-                    for end in [*p, *q] {
-                        let other = |face: &[u32], c: usize| {
-                            // c: corner index of the edge start; the edge is (c, c+1).
-                            if face[c] == end {
-                                face[(c + 3) % 4]
-                            } else {
-                                face[(c + 2) % 4]
-                            }
-                        };
-                        push(other(ff, a), other(gg, b), SpringKind::Bend);
-                    }
+        push(*p, *q, SpringKind::Stretch);
+        if let [(f, a), (g, b)] = users[..] {
+            let (ff, gg) = (faces[f], faces[g]);
+            if k == 3 {
+                push(ff[(a + 2) % 3], gg[(b + 2) % 3], SpringKind::Bend);
+            } else {
+                // At each end of the shared edge, the end's other neighbour in each face.
+                for end in [*p, *q] {
+                    let other = |face: &[u32], c: usize| {
+                        // c: corner index of the edge start; the edge is (c, c+1).
+                        if face[c] == end {
+                            face[(c + 3) % 4]
+                        } else {
+                            face[(c + 2) % 4]
+                        }
+                    };
+                    push(other(ff, a), other(gg, b), SpringKind::Bend);
                 }
             }
         }
-        if k == 4 {
-            for face in &faces {
-                push(face[0], face[2], SpringKind::Shear);
-                push(face[1], face[3], SpringKind::Shear);
-            }
-        }
-        // A spring listed twice (e.g. a quad diagonal that is also a bend) is kept once.
-        springs.sort_by_key(|s| (s.i, s.j, s.kind as u8));
-        springs.dedup_by(|a, b| a.i == b.i && a.j == b.j && a.kind == b.kind);
-        let mut t = Topology::new(x.to_vec(), masses, springs, triangles, None);
-        // The same lumping as the masses: each face gives area / corners to each corner.
-        t.areas = area;
-        Ok(t)
     }
+    if k == 4 {
+        for face in faces {
+            push(face[0], face[2], SpringKind::Shear);
+            push(face[1], face[3], SpringKind::Shear);
+        }
+    }
+    // A spring listed twice (e.g. a quad diagonal that is also a bend) is kept once.
+    springs.sort_by_key(|s| (s.i, s.j, s.kind as u8));
+    springs.dedup_by(|a, b| a.i == b.i && a.j == b.j && a.kind == b.kind);
+    Ok(springs)
 }
 
 #[cfg(test)]

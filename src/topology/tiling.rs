@@ -53,7 +53,7 @@ const INPUT_TILES: usize = 2;
 /// one largest offset of every component, so the windows slide once every eight offsets'
 /// particles: an eighth of a copy of each array a particle. A grid 1001 wide (bend springs two
 /// rows long, 2 002 particles) slid every 2 048 particles before and spent 3 ns of its 49 a
-/// particle-step of the fractional model in the copies (`perf`, stop 56); holding 8 offsets
+/// particle-step of the fractional model in the copies (`perf`); holding 8 offsets
 /// instead of 1 or 4, 45-47 ns against 48-51 (`docs/benchmarks.md`). Only the windows' parts
 /// near the tile are read, so the longer windows do not crowd the cache.
 const SLIDE_OFFSETS: usize = 8;
