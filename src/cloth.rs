@@ -15,6 +15,7 @@ mod pins;
 mod prepass;
 mod snapshot;
 mod split;
+mod state;
 mod step;
 
 use histories::Histories;
@@ -155,8 +156,8 @@ pub(crate) struct ColliderSlot {
 pub struct Cloth {
     topology: Topology,
     config: ClothConfig,
-    x: crate::aligned::AlignedVec3,
-    v: crate::aligned::AlignedVec3,
+    /// Positions, velocities, time, steps and the memories (`state.rs`).
+    state: state::State,
     /// Fully pinned (weight 1): the solver treats these as prescribed.
     pinned: Vec<bool>,
     /// Pin weight of every vertex in [0, 1]; 0 = free.
@@ -191,10 +192,6 @@ pub struct Cloth {
     /// after the next failure (`split.rs`).
     whole_wait: u32,
     whole_backoff: u32,
-    /// The half-derivative memories the model's terms and pair elements read.
-    histories: Histories,
-    time: f64,
-    steps: u64,
     scratch: StepScratch,
     rollback: Rollback,
     /// The whole step of an extrapolated integrator, beside its two half steps.
@@ -205,12 +202,6 @@ pub struct Cloth {
     solver_stats: SolverStats,
     /// What the last call to `step` did.
     step_stats: StepStats,
-    /// The motion's frequency, averaged over calls: implicit Euler's accuracy bound on the
-    /// automatic step (`cloth/motion.rs`).
-    motion: motion::MotionRate,
-    /// The running mean of the velocity relative to the water that the unsteady skin drag
-    /// acts against (`Water::skin_drag_unsteady`), m/s; empty when the model has none.
-    skin_mean: Vec<Vec3>,
     /// Where the step runs (`plumbing/parallel.rs`).
     threads: Threads,
 }
@@ -264,12 +255,10 @@ impl Cloth {
             config.model.self_collision_thickness,
         )?;
         Ok(Self {
-            v: crate::aligned::AlignedVec3::zeros(n),
             pinned: vec![false; n],
             pin_weight: vec![0.0; n],
             pin_list: Vec::new(),
             pin_target: topology.rest_positions.clone(),
-            x: crate::aligned::AlignedVec3::from_slice(&topology.rest_positions),
             collider_slots: Vec::new(),
             colliders: Vec::new(),
             friction: Vec::new(),
@@ -282,22 +271,22 @@ impl Cloth {
             limit_piece: None,
             whole_wait: 0,
             whole_backoff: 0,
-            histories: Histories::new(&config.model, config.scheme, &topology)?,
-            time: 0.0,
-            steps: 0,
             scratch: StepScratch::default(),
             rollback: Rollback::default(),
             probe: Rollback::default(),
             probe_start: Rollback::default(),
             solver_stats: SolverStats::default(),
             step_stats: StepStats::default(),
-            motion: motion::MotionRate::default(),
             // At rest in the water's current: a flow that has always been there.
-            skin_mean: if config.model.water.unsteady_skin() {
-                vec![-config.model.current; n]
-            } else {
-                Vec::new()
-            },
+            state: state::State::at_rest(
+                &topology.rest_positions,
+                Histories::new(&config.model, config.scheme, &topology)?,
+                if config.model.water.unsteady_skin() {
+                    vec![-config.model.current; n]
+                } else {
+                    Vec::new()
+                },
+            ),
             threads: Threads::default(),
             topology,
             config,
@@ -305,7 +294,7 @@ impl Cloth {
     }
 
     pub fn vertex_count(&self) -> usize {
-        self.x.len()
+        self.state.x.len()
     }
 
     /// Changes the cloth's coefficients, integrator, speed limit, substep and solver settings
@@ -331,7 +320,7 @@ impl Cloth {
         forces::coarse_water::check(&self.topology, &config.model)?;
         // The unsteady skin drag turned on starts from the flow as it is (no sudden start),
         // its room asked for before anything changes.
-        let new_mean = if config.model.water.unsteady_skin() && self.skin_mean.is_empty() {
+        let new_mean = if config.model.water.unsteady_skin() && self.state.skin_mean.is_empty() {
             Some(self.flow_mean(config.model.current)?)
         } else {
             None
@@ -348,10 +337,10 @@ impl Cloth {
             self.self_collision.look_again();
         }
         if let Some(mean) = new_mean {
-            self.skin_mean = mean;
+            self.state.skin_mean = mean;
         } else if !config.model.water.unsteady_skin() {
             // Turned off: its mean is dropped.
-            self.skin_mean = Vec::new();
+            self.state.skin_mean = Vec::new();
         }
         self.config = config;
         Ok(())
@@ -361,9 +350,9 @@ impl Cloth {
     /// running mean starts (a flow that has always been there). Out of memory, an error.
     fn flow_mean(&self, current: Vec3) -> Result<Vec<Vec3>, Error> {
         let mut mean = Vec::new();
-        mean.try_reserve_exact(self.v.len())
+        mean.try_reserve_exact(self.state.v.len())
             .map_err(|_| Error::out_of_memory("the skin drag's running mean cannot be allocated"))?;
-        mean.extend(self.v.iter().map(|v| v - current));
+        mean.extend(self.state.v.iter().map(|v| v - current));
         Ok(mean)
     }
 
@@ -380,7 +369,7 @@ impl Cloth {
     }
     /// Positions, m.
     pub fn positions(&self) -> &[Vec3] {
-        &self.x
+        &self.state.x
     }
     /// Writes the unit vertex normal of every vertex at the current positions into `out` (one
     /// per vertex): the area-weighted sum of its triangles' normals, on the side the triangles
@@ -407,25 +396,32 @@ impl Cloth {
             .try_reserve_exact(t.triangles.len())
             .map_err(|_| Error::out_of_memory(format!("no memory for {} face normals", t.triangles.len())))?;
         faces.resize(t.triangles.len(), Vec3::zeros());
-        forces::vertex_normals_with(&self.x, &t.triangles, &t.vertex_triangles, false, faces, out);
+        forces::vertex_normals_with(
+            &self.state.x,
+            &t.triangles,
+            &t.vertex_triangles,
+            false,
+            faces,
+            out,
+        );
         Ok(())
     }
 
     /// Velocities, m/s.
     pub fn velocities(&self) -> &[Vec3] {
-        &self.v
+        &self.state.v
     }
     /// Simulated time, s.
     pub fn time(&self) -> f64 {
-        self.time
+        self.state.time
     }
     /// Steps taken.
     pub fn step_count(&self) -> u64 {
-        self.steps
+        self.state.steps
     }
     /// The half-derivative history state.
     pub fn history(&self) -> &History {
-        self.histories.get(forces::Memory::Particles)
+        self.state.histories.get(forces::Memory::Particles)
     }
     fn check_index(&self, i: u32) -> Result<usize, Error> {
         let n = self.vertex_count();
@@ -441,7 +437,7 @@ impl Cloth {
     /// Teleports every vertex (velocities and history are kept); pins move with it.
     pub fn set_positions(&mut self, x: &[Vec3]) -> Result<(), Error> {
         self.check_all(x, "position")?;
-        self.x.copy_from_slice(x);
+        self.state.x.copy_from_slice(x);
         for &i in &self.pin_list {
             self.pin_target[i as usize] = x[i as usize];
         }
@@ -453,7 +449,7 @@ impl Cloth {
     /// Sets every velocity (m/s).
     pub fn set_velocities(&mut self, v: &[Vec3]) -> Result<(), Error> {
         self.check_all(v, "velocity")?;
-        self.v.copy_from_slice(v);
+        self.state.v.copy_from_slice(v);
         Ok(())
     }
 
@@ -778,19 +774,19 @@ impl Cloth {
     pub fn energy(&self) -> f64 {
         let m = &self.config.model;
         let t = &self.topology;
-        let n = self.x.len();
+        let n = self.state.x.len();
         let (mut normals, mut projected) = (vec![Vec3::zeros(); n], vec![1.0; n]);
         if m.water.normal_water() {
-            forces::patch_normals(&self.x, t, &mut normals, &mut projected);
+            forces::patch_normals(&self.state.x, t, &mut normals, &mut projected);
         }
         let mut e = 0.0;
-        for (i, (x, v)) in self.x.iter().zip(&self.v).enumerate() {
+        for (i, (x, v)) in self.state.x.iter().zip(&self.state.v).enumerate() {
             let inertia = forces::Inertia::of(m, t.masses[i], t.areas[i], normals[i], projected[i]);
             e += inertia.kinetic_energy(v) - forces::body_force(m, t.masses[i]).dot(x);
         }
         let w = &m.water;
         if w.coarse_added_mass > 0.0 {
-            let s = |i: usize| projected[i] * normals[i].dot(&self.v[i]);
+            let s = |i: usize| projected[i] * normals[i].dot(&self.state.v[i]);
             match &self.scratch.coarse {
                 Some(c) if c.built_for(w.coarse_added_mass, w.coarse_length, &self.pinned) => {
                     e += c.kinetic_energy(s);
@@ -810,7 +806,7 @@ impl Cloth {
         }
         for s in &t.springs {
             let k = m.stiffness(s.kind, t.spacing);
-            let d = (self.x[s.i as usize] - self.x[s.j as usize]).norm() - s.rest;
+            let d = (self.state.x[s.i as usize] - self.state.x[s.j as usize]).norm() - s.rest;
             e += 0.5 * k * d * d;
         }
         e

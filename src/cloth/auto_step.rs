@@ -137,7 +137,7 @@ impl Cloth {
         if tracks {
             let start = &mut self.scratch.motion_v;
             start.clear();
-            start.extend_from_slice(&self.v);
+            start.extend_from_slice(&self.state.v);
         }
         let limit = f64::from(super::MAX_SUBSTEPS);
         let mut n = if h > 0.0 {
@@ -155,8 +155,8 @@ impl Cloth {
                 Ok(()) => {
                     if tracks {
                         let t = &self.topology;
-                        let (start, end) = (&self.scratch.motion_v, &self.v);
-                        self.motion.update(&t.masses, &self.pinned, start, end, dt);
+                        let (start, end) = (&self.scratch.motion_v, &self.state.v);
+                        self.state.motion.update(&t.masses, &self.pinned, start, end, dt);
                     }
                     self.step_stats = StepStats {
                         // Self-collision may have split some (`split.rs`).
@@ -198,7 +198,7 @@ impl Cloth {
             }
         }
         let mut h = safety(self.config.integrator) * h;
-        let omega = self.motion.omega();
+        let omega = self.state.motion.omega();
         if self.tracks_motion() && omega > 0.0 {
             h = h.min((ACCURACY / omega).max(ACCURACY_FLOOR * SAFETY_SYMPLECTIC * floor));
         }
@@ -213,7 +213,7 @@ impl Cloth {
     /// The motion's averaged frequency the automatic step reads, rad/s (0: none yet, or not
     /// tracked: implicit Euler at the automatic step only).
     pub fn motion_frequency(&self) -> f64 {
-        self.motion.omega()
+        self.state.motion.omega()
     }
 
     /// Whether the springs or drags damp on D^{1/2} (their damping depends on the step).
@@ -244,7 +244,7 @@ impl Cloth {
         let (ma, rho_w, cd) = (m.water.added_mass, m.water_density, m.water.form_drag);
         let rate = damping_rate(m);
         let mut floor = f64::INFINITY;
-        for i in 0..self.x.len() {
+        for i in 0..self.state.x.len() {
             if self.pinned[i] {
                 continue;
             }
@@ -262,7 +262,7 @@ impl Cloth {
                 shortest = shortest.min(s.rest);
             }
             let area = t.areas[i];
-            let rel = self.v[i] - m.current;
+            let rel = self.state.v[i] - m.current;
             let speed = rel.norm();
             // Drags' rates at the velocity the particle has now (each in its own direction;
             // the largest is what limits).
@@ -298,7 +298,7 @@ impl Cloth {
         // Pins travel at most one rest length of their springs per substep.
         for &p in &self.pin_list {
             let p = p as usize;
-            let travel = (self.pin_target[p] - self.x[p]).norm();
+            let travel = (self.pin_target[p] - self.state.x[p]).norm();
             let shortest = t
                 .vertex_springs
                 .row(p)

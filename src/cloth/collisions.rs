@@ -143,7 +143,7 @@ impl Cloth {
             let (margin, skin) = Self::mesh_reach(model_margin, mesh);
             mesh.refresh(margin + skin)?;
             mesh.contacts(
-                &self.x,
+                &self.state.x,
                 &self.topology.triangles,
                 0.0,
                 margin,
@@ -151,12 +151,12 @@ impl Cloth {
                 MESH_MAX_DEPTH_MARGINS * margin,
                 &mut s.start_contacts,
             )
-            .map_err(|why| Self::too_many_candidates(id, mesh, margin, self.x.len(), why))?;
+            .map_err(|why| Self::too_many_candidates(id, mesh, margin, self.state.x.len(), why))?;
         }
         if s.start_contacts.is_empty() {
             return Ok(());
         }
-        s.contact_weight.resize(self.x.len(), 0.0);
+        s.contact_weight.resize(self.state.x.len(), 0.0);
         for e in &s.start_contacts {
             let sum: f64 = e.terms().map(|(_, c)| c.abs()).sum();
             for (j, c) in e.terms() {
@@ -199,7 +199,7 @@ impl Cloth {
             // A step outside a call (a snapshot's trial step) finds the boxes made here.
             mesh.refresh(margin + skin)?;
             mesh.contacts(
-                &self.x,
+                &self.state.x,
                 &self.topology.triangles,
                 f,
                 margin,
@@ -207,12 +207,12 @@ impl Cloth {
                 MESH_MAX_DEPTH_MARGINS * margin,
                 &mut s.contacts,
             )
-            .map_err(|why| Self::too_many_candidates(id, mesh, margin, self.x.len(), why))?;
+            .map_err(|why| Self::too_many_candidates(id, mesh, margin, self.state.x.len(), why))?;
         }
         let mesh_contacts = s.contacts.len();
         if m.self_collision_thickness > 0.0 {
             self.self_collision.contacts(
-                &self.x,
+                &self.state.x,
                 &self.topology.rest_positions,
                 &self.topology.triangles,
                 m.self_collision_thickness,
@@ -238,7 +238,7 @@ impl Cloth {
             );
         }
         if s.prior_forces.is_empty() {
-            s.prior_forces.resize(self.x.len(), Vec3::zeros());
+            s.prior_forces.resize(self.state.x.len(), Vec3::zeros());
         }
         contact::add_forces(
             &s.contacts,
@@ -285,7 +285,7 @@ impl Cloth {
             s.mesh_passages.clear();
             for mesh in self.mesh_slots.iter().flatten() {
                 mesh.passages(
-                    &self.x,
+                    &self.state.x,
                     &s.x_new,
                     &self.topology.triangles,
                     f0,
@@ -301,7 +301,7 @@ impl Cloth {
                 for &i in &p.cloth {
                     let i = i as usize;
                     if !self.pinned[i] {
-                        s.x_new[i] = self.x[i] + p.carry;
+                        s.x_new[i] = self.state.x[i] + p.carry;
                         s.v_new[i] = p.carry / h;
                         s.carried.push(i as u32);
                     }
@@ -326,8 +326,12 @@ impl Cloth {
             return Ok(0);
         }
         let tolerance = PASSAGE_TOLERANCE * thickness;
-        self.self_collision
-            .watch_guard(&self.x, &self.scratch.x_new, &self.topology.triangles, tolerance);
+        self.self_collision.watch_guard(
+            &self.state.x,
+            &self.scratch.x_new,
+            &self.topology.triangles,
+            tolerance,
+        );
         let sc = &self.self_collision;
         let (guard, guard_vertices) = sc.guarded();
         if guard.is_empty()
@@ -358,7 +362,7 @@ impl Cloth {
             &*kinematic
         };
         let input = ZoneInput {
-            x0: &self.x,
+            x0: &self.state.x,
             masses: &self.topology.masses,
             kinematic,
             triangles: &self.topology.triangles,
@@ -379,7 +383,7 @@ impl Cloth {
         })?;
         for &i in zone_moved.iter() {
             let i = i as usize;
-            v_new[i] = (x_new[i] - self.x[i]) / h;
+            v_new[i] = (x_new[i] - self.state.x[i]) / h;
         }
         self.self_collision.zones.add(&report);
         Ok(report.moved)
@@ -404,9 +408,12 @@ impl Cloth {
         let mut end = std::mem::take(&mut self.scratch.step_end);
         self.step_end_into(&mut end);
         let thickness = self.config.model.self_collision_thickness;
-        let proved =
-            self.self_collision
-                .out_of_reach_throughout(&self.x, &end, &self.topology.triangles, thickness);
+        let proved = self.self_collision.out_of_reach_throughout(
+            &self.state.x,
+            &end,
+            &self.topology.triangles,
+            thickness,
+        );
         self.scratch.step_end = end;
         proved
     }
@@ -428,7 +435,7 @@ impl Cloth {
         // loop below would limit).
         if !any_past_widest(
             bytemuck::cast_slice(&s.x_new),
-            bytemuck::cast_slice(&self.x),
+            bytemuck::cast_slice(&self.state.x),
             &self.pinned,
             limit * limit * (1.0 - 1e-12),
         ) {
@@ -446,13 +453,13 @@ impl Cloth {
         // How far free vertex `i` would move, when over the limit (squared first: the square
         // root only for a vertex over it; a NaN displacement is left to the step's check).
         let over = |x_new: &[Vec3], i: usize| {
-            let len2 = (x_new[i] - self.x[i]).norm_squared();
+            let len2 = (x_new[i] - self.state.x[i]).norm_squared();
             (!self.pinned[i] && len2 > limit * limit && !len2.is_nan())
                 .then(|| len2.sqrt())
                 .filter(|&len| len > limit)
         };
         if mode == StepLimit::Refuse {
-            let farthest = (0..self.x.len())
+            let farthest = (0..self.state.x.len())
                 .filter_map(|i| over(&s.x_new, i))
                 .fold(0.0, f64::max);
             return match farthest > limit {
@@ -461,10 +468,10 @@ impl Cloth {
             };
         }
         let mut limited = 0;
-        for i in 0..self.x.len() {
+        for i in 0..self.state.x.len() {
             let Some(len) = over(&s.x_new, i) else { continue };
             let scale = limit / len;
-            s.x_new[i] = self.x[i] + scale * (s.x_new[i] - self.x[i]);
+            s.x_new[i] = self.state.x[i] + scale * (s.x_new[i] - self.state.x[i]);
             s.v_new[i] *= scale;
             limited += 1;
         }

@@ -53,7 +53,7 @@ impl Cloth {
         f1: Option<f64>,
         limit: StepLimit,
     ) -> Result<Advanced, Error> {
-        let steps = self.steps;
+        let steps = self.state.steps;
         probe.save(self)?;
         // A refused second half needs the start back: one more copy of the state, with
         // self-collision only (61 x 41 symplectic2 at a fixed 1/30 s, self-collision 4 mm, 32
@@ -86,25 +86,26 @@ impl Cloth {
             start.restore(self);
             return Ok(Advanced::TooFar(ratio));
         }
-        for (x, whole) in self.x.iter_mut().zip(&probe.x) {
-            *x = 2.0 * *x - whole;
-        }
-        for (v, whole) in self.v.iter_mut().zip(&probe.v) {
-            *v = 2.0 * *v - whole;
-        }
-        for (m, whole) in self.skin_mean.iter_mut().zip(&probe.skin_mean) {
-            *m = 2.0 * *m - whole;
-        }
+        // Saved above: a missing copy would be a bug, refused rather than stepped wrong.
+        let whole = probe
+            .state
+            .as_ref()
+            .ok_or_else(|| Error::invalid("internal: the whole step's state was not kept"))?;
+        self.state.extrapolate(whole);
         if !integrator.is_implicit() {
-            self.keep_pin_secants(&probe.v);
+            self.keep_pin_secants(&whole.v);
         }
-        self.steps = steps + 1;
+        self.state.steps = steps + 1;
         let max2 = self.config.max_speed * self.config.max_speed;
-        let far = self.x.iter().position(|x| x.amax() >= super::MAX_COORDINATE);
-        if !integrate::sound(&self.x, &self.v, max2) || far.is_some() {
-            let i = (0..self.x.len())
+        let far = self
+            .state
+            .x
+            .iter()
+            .position(|x| x.amax() >= super::MAX_COORDINATE);
+        if !integrate::sound(&self.state.x, &self.state.v, max2) || far.is_some() {
+            let i = (0..self.state.x.len())
                 .find(|&i| {
-                    let (x, v) = (self.x[i], self.v[i]);
+                    let (x, v) = (self.state.x[i], self.state.v[i]);
                     !integrate::sound_particle([x.x, x.y, x.z], [v.x, v.y, v.z], max2)
                         || x.amax() >= super::MAX_COORDINATE
                 })
@@ -112,7 +113,7 @@ impl Cloth {
             return Err(Error::unstable(format!(
                 "{} with dt = {h} s is unstable at step {steps}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s) or leave the float range; state left unchanged, retry with a smaller dt (max_substep = FC_MAX_SUBSTEP_AUTO lets the library choose the substeps; or set max_substep, or call fc_cloth_step_substeps)",
                 self.config.integrator.name(),
-                self.v[i].norm(),
+                self.state.v[i].norm(),
                 self.config.max_speed
             )));
         }

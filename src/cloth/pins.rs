@@ -152,7 +152,7 @@ impl Cloth {
             self.pin_weight[i] = w;
             self.pinned[i] = w == 1.0;
             self.pin_list.push(i as u32);
-            self.pin_target[i] = self.x[i];
+            self.pin_target[i] = self.state.x[i];
         }
     }
 
@@ -183,7 +183,7 @@ impl Cloth {
     pub(super) fn start_pin_paths(&mut self) {
         let start = &mut self.scratch.pins.start;
         start.clear();
-        start.extend(self.pin_list.iter().map(|&i| self.x[i as usize]));
+        start.extend(self.pin_list.iter().map(|&i| self.state.x[i as usize]));
     }
 
     /// Where every pin is at the end of the step: its target, the plan's fraction of the way
@@ -221,7 +221,7 @@ impl Cloth {
             let along = |f: f64| p.start[k] + f * (self.pin_target[i] - p.start[k]);
             let end = f1.map_or(self.pin_target[i], along);
             p.mid.push(if self.pinned[i] {
-                0.625 * self.x[i] + 0.375 * end + (0.125 * h) * self.v[i]
+                0.625 * self.state.x[i] + 0.375 * end + (0.125 * h) * self.state.v[i]
             } else {
                 along(fmid)
             });
@@ -238,7 +238,7 @@ impl Cloth {
         for &i in &self.pin_list {
             let i = i as usize;
             if self.pinned[i] {
-                self.v[i] = whole_v[i];
+                self.state.v[i] = whole_v[i];
             }
         }
     }
@@ -271,7 +271,7 @@ impl Cloth {
                 s.v_new[i] = s.v_step[i];
             } else {
                 // Soft pin: the fraction w of the way onto the target and its velocity.
-                let v_goal = (goal[i] - self.x[i]) / h;
+                let v_goal = (goal[i] - self.state.x[i]) / h;
                 let (x_free, v_free) = (s.x_new[i], s.v_new[i]);
                 s.x_new[i] = x_free + w * (goal[i] - x_free);
                 s.v_new[i] = v_free + w * (v_goal - v_free);

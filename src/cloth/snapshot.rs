@@ -107,7 +107,7 @@ fn history_fingerprint(c: &Cloth) -> u64 {
     }
     // A history per spring (rotation-invariant fractional springs) changes the state's layout;
     // without one the fingerprint is what it always was.
-    if c.histories.layout() & 1 != 0 {
+    if c.state.histories.layout() & 1 != 0 {
         h.word(u64::from(b'S'));
     }
     h.0
@@ -267,13 +267,13 @@ impl Cloth {
         w.u64(topology_fingerprint(self));
         w.u8(self.history().tag());
         w.u64(history_fingerprint(self));
-        w.f64(self.time);
-        w.u64(self.steps);
+        w.f64(self.state.time);
+        w.u64(self.state.steps);
         w.vec3(&self.config.model.current);
         w.f64(self.config.solver.tolerance);
         w.u32(self.config.solver.max_iterations);
-        w.vec3s(&self.x);
-        w.vec3s(&self.v);
+        w.vec3s(&self.state.x);
+        w.vec3s(&self.state.v);
         w.f64s(&self.pin_weight);
         w.u64(self.pin_list.len() as u64);
         for &i in &self.pin_list {
@@ -292,11 +292,11 @@ impl Cloth {
                 }
             }
         }
-        self.histories.write_state(w)?;
+        self.state.histories.write_state(w)?;
         self.write_collision_state(w);
-        w.f64(self.motion.accel2);
-        w.f64(self.motion.vel2);
-        w.vec3s(&self.skin_mean);
+        w.f64(self.state.motion.accel2);
+        w.f64(self.state.motion.vel2);
+        w.vec3s(&self.state.skin_mean);
         Ok(())
     }
 
@@ -391,10 +391,10 @@ impl Cloth {
         r.vec3s_into(Some(n), &mut targets)?;
         let collider_slots = read_collider_slots(r, version)?;
         crate::memory::ensure_available(
-            2 * self.histories.bytes(&self.topology) + len as u64,
+            2 * self.state.histories.bytes(&self.topology) + len as u64,
             "loading a snapshot",
         )?;
-        let mut histories = self.histories.clone();
+        let mut histories = self.state.histories.clone();
         histories.read_state(r)?;
         let collisions = if version >= 5 {
             self.read_collision_state(r, version)?
@@ -541,20 +541,20 @@ impl Cloth {
     /// Exchanges this cloth's state with `s` (each vector of particles in place), and derives
     /// what follows from it (which particles are fully pinned, the colliders).
     fn swap_state(&mut self, s: &mut LoadedState) {
-        std::mem::swap(&mut self.time, &mut s.time);
-        std::mem::swap(&mut self.steps, &mut s.steps);
+        std::mem::swap(&mut self.state.time, &mut s.time);
+        std::mem::swap(&mut self.state.steps, &mut s.steps);
         std::mem::swap(&mut self.config.model.current, &mut s.current);
         std::mem::swap(&mut self.config.solver, &mut s.solver);
-        self.x.swap_with_slice(&mut s.x);
-        self.v.swap_with_slice(&mut s.v);
+        self.state.x.swap_with_slice(&mut s.x);
+        self.state.v.swap_with_slice(&mut s.v);
         swap_contents(&mut self.pin_weight, &mut s.weights);
         swap_contents(&mut self.pin_target, &mut s.targets);
         std::mem::swap(&mut self.pin_list, &mut s.pin_list);
         std::mem::swap(&mut self.collider_slots, &mut s.collider_slots);
-        std::mem::swap(&mut self.histories, &mut s.histories);
+        std::mem::swap(&mut self.state.histories, &mut s.histories);
         std::mem::swap(&mut self.mesh_slots, &mut s.meshes);
-        std::mem::swap(&mut self.motion, &mut s.motion);
-        std::mem::swap(&mut self.skin_mean, &mut s.skin_mean);
+        std::mem::swap(&mut self.state.motion, &mut s.motion);
+        std::mem::swap(&mut self.state.skin_mean, &mut s.skin_mean);
         for (p, &w) in self.pinned.iter_mut().zip(&self.pin_weight) {
             *p = w == 1.0;
         }
@@ -568,8 +568,8 @@ impl Cloth {
     /// trial without the half-derivative histories says whether they are what the cloth cannot
     /// step from.
     fn trial_step(&mut self) -> Result<(), Error> {
-        let h = if self.steps > 0 && self.time > 0.0 {
-            self.time / self.steps as f64
+        let h = if self.state.steps > 0 && self.state.time > 0.0 {
+            self.state.time / self.state.steps as f64
         } else {
             1e-4
         };
@@ -582,9 +582,9 @@ impl Cloth {
         }
         // Refused (rare): the same trial with empty histories says whether they are at fault.
         let mut histories = Histories::new(&self.config.model, self.config.scheme, &self.topology)?;
-        std::mem::swap(&mut self.histories, &mut histories);
+        std::mem::swap(&mut self.state.histories, &mut histories);
         let without = self.trial_in_place(h);
-        std::mem::swap(&mut self.histories, &mut histories);
+        std::mem::swap(&mut self.state.histories, &mut histories);
         let what = if without.is_ok() {
             "its half-derivative history holds values the cloth cannot step from"
         } else {
@@ -611,7 +611,7 @@ impl Cloth {
         // Pins held where they are.
         let mut targets = std::mem::take(&mut snap.targets);
         targets.clear();
-        targets.extend_from_slice(&self.x);
+        targets.extend_from_slice(&self.state.x);
         std::mem::swap(&mut self.pin_target, &mut targets);
         let unconverged = std::mem::replace(&mut self.config.accept_unconverged, true);
         let (solver, stats, carried) = (self.solver_stats, self.step_stats, self.mesh_carried);
@@ -745,17 +745,17 @@ mod tests {
             a.step(1e-3).unwrap();
         }
         let n = a.vertex_count();
-        assert_eq!(a.skin_mean.len(), n);
-        assert!(a.skin_mean.iter().any(|m| m.x.abs() > 1e-4));
+        assert_eq!(a.state.skin_mean.len(), n);
+        assert!(a.state.skin_mean.iter().any(|m| m.x.abs() > 1e-4));
         let snap = a.save_snapshot().unwrap();
         let mut b = make();
         b.load_snapshot(&snap).unwrap();
-        assert_eq!(b.skin_mean, a.skin_mean);
+        assert_eq!(b.state.skin_mean, a.state.skin_mean);
         // The same load with the mean restarted from the flow.
         let mut c = make();
         c.load_snapshot(&snap).unwrap();
         let current = c.config.model.current;
-        c.skin_mean = c.flow_mean(current).unwrap();
+        c.state.skin_mean = c.flow_mean(current).unwrap();
         for k in 300..400 {
             for cloth in [&mut a, &mut b, &mut c] {
                 drive(cloth, k);
@@ -768,8 +768,8 @@ mod tests {
         let old = sealed(snap[..snap.len() - 4 - 8 - 24 * n].to_vec(), 7);
         let mut d = make();
         d.load_snapshot(&old).unwrap();
-        let want: Vec<Vec3> = d.v.iter().map(|v| v - current).collect();
-        assert_eq!(d.skin_mean, want);
+        let want: Vec<Vec3> = d.state.v.iter().map(|v| v - current).collect();
+        assert_eq!(d.state.skin_mean, want);
         // A mean of the wrong length is refused, the cloth unchanged.
         let mut bad = snap[..snap.len() - 4 - 8 - 24 * n].to_vec();
         bad.extend_from_slice(&1u64.to_le_bytes());
@@ -791,19 +791,19 @@ mod tests {
             c.set_pin_targets(&[0, 1, 2], &targets).unwrap();
             c.step(1e-3).unwrap();
         }
-        let kept = c.skin_mean.clone();
+        let kept = c.state.skin_mean.clone();
         assert_eq!(kept.len(), c.vertex_count());
         let mut config = c.config.clone();
         config.model.current = Vec3::new(0.0, 0.0, 0.05);
         c.reconfigure(config.clone()).unwrap();
-        assert_eq!(c.skin_mean, kept, "kept while the term stays on");
+        assert_eq!(c.state.skin_mean, kept, "kept while the term stays on");
         config.model.water.skin_drag_unsteady = 0.0;
         c.reconfigure(config.clone()).unwrap();
-        assert!(c.skin_mean.is_empty());
+        assert!(c.state.skin_mean.is_empty());
         config.model.water.skin_drag_unsteady = 1.0;
         c.reconfigure(config).unwrap();
-        let want: Vec<Vec3> = c.v.iter().map(|v| v - Vec3::new(0.0, 0.0, 0.05)).collect();
-        assert_eq!(c.skin_mean, want);
+        let want: Vec<Vec3> = c.state.v.iter().map(|v| v - Vec3::new(0.0, 0.0, 0.05)).collect();
+        assert_eq!(c.state.skin_mean, want);
         c.step(1e-3).unwrap();
     }
 
@@ -845,7 +845,7 @@ mod tests {
 
         // A version-6 snapshot (no averages, and no skin drag mean: 8 bytes of an empty
         // list here) loads with the motion unseen.
-        assert!(a.skin_mean.is_empty());
+        assert!(a.state.skin_mean.is_empty());
         let old = sealed(snap[..snap.len() - 4 - 8 - 16].to_vec(), 6);
         let mut c = make();
         c.load_snapshot(&old).unwrap();

@@ -230,6 +230,7 @@ impl Cloth {
     /// pieces its free vertices' speeds ask for (0: whole).
     fn predicted_split(&self, h: f64, limit: f64) -> (bool, u32) {
         let fastest2 = self
+            .state
             .v
             .iter()
             .zip(&self.pinned)

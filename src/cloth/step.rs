@@ -8,7 +8,8 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::pins::{PinPaths, PinSampling};
-use super::{prepass, Cloth, Histories, FAR_STEP, MAX_COORDINATE};
+use super::state::State;
+use super::{prepass, Cloth, FAR_STEP, MAX_COORDINATE};
 use crate::error::Error;
 use crate::forces::{self, ElementScratch, ForceInput, ForceScratch, Memory, SpringInputs, Weights, TILE};
 use crate::integrate::{self, implicit_euler, ImplicitInput, ImplicitScratch, StepSoa};
@@ -171,20 +172,15 @@ pub(super) struct StepScratch {
     pub implicit: ImplicitScratch,
 }
 
-/// State saved before a multi-substep call, restored if a substep fails (and around the whole
-/// step of an extrapolated integrator).
+/// What a refused call puts back: the [`State`] saved before a multi-substep call (and around
+/// the whole step of an extrapolated integrator), with self-collision's remembered pairs.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Rollback {
-    pub(super) x: crate::aligned::AlignedVec3,
-    pub(super) v: crate::aligned::AlignedVec3,
-    histories: Option<Histories>,
+    /// The state as saved (none before the first save).
+    pub(super) state: Option<State>,
     /// Self-collision's remembered pairs and sides (state: a snapshot carries them).
     pub(super) self_collision: crate::collide::self_collision::SavedMemory,
-    /// The unsteady skin drag's running mean.
-    pub(super) skin_mean: Vec<Vec3>,
     mesh_from: f64,
-    time: f64,
-    steps: u64,
     /// Room for the pins' targets a snapshot's trial step sets aside (not saved or restored).
     pub(super) targets: Vec<Vec3>,
 }
@@ -193,39 +189,19 @@ impl Rollback {
     /// Copies the state, or fails with an out-of-memory error when the copy of a history
     /// that grew (the full history) cannot be allocated.
     pub(super) fn save(&mut self, c: &Cloth) -> Result<(), Error> {
-        let need = c.histories.bytes(&c.topology);
-        let have = self.histories.as_ref().map_or(0, |h| h.bytes(&c.topology));
-        if need > have {
-            crate::memory::ensure_available(
-                2 * (need - have),
-                "the copy that makes a multi-substep call atomic",
-            )?;
-        }
-        self.x.clone_from(&c.x);
-        self.v.clone_from(&c.v);
-        self.skin_mean.clone_from(&c.skin_mean);
-        match &mut self.histories {
-            Some(h) => h.clone_from(&c.histories),
-            None => self.histories = Some(c.histories.clone()),
-        }
+        c.state.copy_into(&mut self.state, &c.topology)?;
         c.self_collision.save_memory(&mut self.self_collision);
         self.mesh_from = c.mesh_from;
-        self.time = c.time;
-        self.steps = c.steps;
         Ok(())
     }
 
+    /// Puts the saved state back (the cloth's is kept here in exchange).
     pub(super) fn restore(&mut self, c: &mut Cloth) {
-        std::mem::swap(&mut c.x, &mut self.x);
-        std::mem::swap(&mut c.v, &mut self.v);
-        std::mem::swap(&mut c.skin_mean, &mut self.skin_mean);
-        if let Some(h) = &mut self.histories {
-            std::mem::swap(&mut c.histories, h);
+        if let Some(state) = &mut self.state {
+            std::mem::swap(&mut c.state, state);
         }
         c.self_collision.swap_memory(&mut self.self_collision);
         c.mesh_from = self.mesh_from;
-        c.time = self.time;
-        c.steps = self.steps;
     }
 }
 
@@ -236,13 +212,13 @@ macro_rules! force_input {
         ForceInput {
             model: &$c.config.model,
             topology: &$c.topology,
-            x: &$c.x,
+            x: &$c.state.x,
             v: &$s.v_step,
             half_derivative: &$s.half,
             colliders: &$c.colliders,
             prior_forces: &$s.prior_forces,
             weights: $weights,
-            skin_mean: &$c.skin_mean,
+            skin_mean: &$c.state.skin_mean,
         }
     };
 }
@@ -253,8 +229,8 @@ macro_rules! force_input {
 macro_rules! first_pass {
     ($c:ident, $s:ident, $plan:expr, $past:expr, $sx:expr, $sq:expr) => {
         prepass::FirstPass {
-            x: &$c.x,
-            v: &$c.v,
+            x: &$c.state.x,
+            v: &$c.state.v,
             goal: &$s.pins.goal,
             hard_pins: &$s.pins.hard,
             h: $plan.h,
@@ -317,7 +293,7 @@ impl Cloth {
 
     /// Sizes the step's buffers and lets the histories make room for the step.
     fn prepare(&mut self) -> Result<(), Error> {
-        self.histories.reserve_step()?;
+        self.state.histories.reserve_step()?;
         let n = self.vertex_count();
         let s = &mut self.scratch;
         for buf in [&mut s.v_step, &mut s.half, &mut s.x_new, &mut s.v_new] {
@@ -336,7 +312,7 @@ impl Cloth {
     fn step_velocities(&mut self, plan: &StepPlan) -> Weights {
         let n = self.vertex_count();
         let s = &mut self.scratch;
-        let history = self.histories.get_mut(Memory::Particles);
+        let history = self.state.histories.get_mut(Memory::Particles);
         let with_history = !history.is_off();
         // The history folds the last accepted step in during this pass (SOE).
         let past = with_history.then(|| history.begin_step());
@@ -350,7 +326,7 @@ impl Cloth {
             unsafe { first.run(lo..lo + len) };
         });
         if with_history {
-            self.histories.get_mut(Memory::Particles).end_step();
+            self.state.histories.get_mut(Memory::Particles).end_step();
         }
         let mut weights = Weights::default();
         weights.0[Memory::Particles.index()] = w0;
@@ -387,7 +363,7 @@ impl Cloth {
         step: StepSoa,
     ) -> bool {
         let s = &mut self.scratch;
-        let history = self.histories.get_mut(Memory::Particles);
+        let history = self.state.histories.get_mut(Memory::Particles);
         let with_history = !history.is_off();
         let past = with_history.then(|| history.begin_step());
         // A tiled topology: the walk transposes its own spring inputs.
@@ -403,13 +379,13 @@ impl Cloth {
         let input = ForceInput {
             model: &self.config.model,
             topology: &self.topology,
-            x: &self.x,
+            x: &self.state.x,
             v: &[],
             half_derivative: &[],
             colliders: &self.colliders,
             prior_forces: &s.prior_forces,
             weights,
-            skin_mean: &self.skin_mean,
+            skin_mean: &self.state.skin_mean,
         };
         let sound = explicit_tiles(
             &input,
@@ -422,7 +398,7 @@ impl Cloth {
             step,
         );
         if with_history {
-            self.histories.get_mut(Memory::Particles).end_step();
+            self.state.histories.get_mut(Memory::Particles).end_step();
         }
         sound
     }
@@ -431,7 +407,7 @@ impl Cloth {
     /// from the step's velocities, its past, and their forces, into the prior forces; fills in
     /// those memories' weights.
     fn element_forces(&mut self, weights: &mut Weights) {
-        let (s, histories) = (&mut self.scratch, &mut self.histories);
+        let (s, histories) = (&mut self.scratch, &mut self.state.histories);
         let memory_past = |memory: Memory, out: &mut [Vec3]| {
             let history = histories.get_mut(memory);
             let past = history.begin_step();
@@ -445,7 +421,7 @@ impl Cloth {
         forces::prior_forces(
             &self.config.model,
             &self.topology,
-            &self.x,
+            &self.state.x,
             &s.v_step,
             &mut s.elements,
             memory_past,
@@ -465,9 +441,9 @@ impl Cloth {
             return Ok(());
         }
         if s.prior_forces.is_empty() {
-            s.prior_forces.resize(self.x.len(), Vec3::zeros());
+            s.prior_forces.resize(self.state.x.len(), Vec3::zeros());
         }
-        s.projected.resize(self.x.len(), 0.0);
+        s.projected.resize(self.state.x.len(), 0.0);
         let m = &self.config.model;
         let wanted = (w.coarse_added_mass, w.coarse_length);
         if wanted.0 == 0.0 {
@@ -484,11 +460,11 @@ impl Cloth {
                 &self.pinned,
             )?);
         }
-        let normals = s.force_pass.normals_to_write(self.x.len());
+        let normals = s.force_pass.normals_to_write(self.state.x.len());
         forces::turning_forces(
             m,
             t,
-            &self.x,
+            &self.state.x,
             &s.v_rel,
             &mut s.turning,
             &mut s.projected,
@@ -508,9 +484,9 @@ impl Cloth {
         }
         let (s, t) = (&mut self.scratch, &self.topology);
         if s.prior_forces.is_empty() {
-            s.prior_forces.resize(self.x.len(), Vec3::zeros());
+            s.prior_forces.resize(self.state.x.len(), Vec3::zeros());
         }
-        let normals = s.force_pass.normals_ahead(&self.x, t);
+        let normals = s.force_pass.normals_ahead(&self.state.x, t);
         forces::add_wide_form_drag(m, t, normals, &s.v_rel, &mut s.wide_drag, &mut s.prior_forces);
     }
 
@@ -573,7 +549,7 @@ impl Cloth {
             let len = hi - lo;
             let mut a = [[0.0; TILE]; 9];
             for k in 0..len {
-                let (xk, vk, fk) = (self.x[lo + k], s.v_step[lo + k], s.force_array[lo + k]);
+                let (xk, vk, fk) = (self.state.x[lo + k], s.v_step[lo + k], s.force_array[lo + k]);
                 for c in 0..3 {
                     a[c][k] = xk[c];
                     a[3 + c][k] = vk[c];
@@ -605,7 +581,7 @@ impl Cloth {
         forces::linearise(&input, s.force_pass.normals(), &s.projected, &mut s.implicit.lin);
         let inp = ImplicitInput {
             h,
-            x: &self.x,
+            x: &self.state.x,
             v: &s.v_step,
             force: &s.force_array,
             masses: &self.topology.masses,
@@ -629,7 +605,7 @@ impl Cloth {
             )));
         }
         for i in 0..n {
-            s.x_new[i] = self.x[i] + h * s.v_new[i];
+            s.x_new[i] = self.state.x[i] + h * s.v_new[i];
         }
         Ok(false)
     }
@@ -642,7 +618,7 @@ impl Cloth {
             &self.colliders,
             &self.friction,
             h,
-            &self.x,
+            &self.state.x,
             &self.topology.masses,
             &self.pinned,
             &mut self.scratch.v_new,
@@ -669,22 +645,23 @@ impl Cloth {
     /// rates their elements' passes wrote.
     fn commit(&mut self, h: f64) {
         let s = &mut self.scratch;
-        std::mem::swap(&mut self.x, &mut s.x_new);
-        std::mem::swap(&mut self.v, &mut s.v_new);
-        if !self.skin_mean.is_empty() {
-            let (m, v) = (&self.config.model, &self.v[..]);
+        std::mem::swap(&mut self.state.x, &mut s.x_new);
+        std::mem::swap(&mut self.state.v, &mut s.v_new);
+        if !self.state.skin_mean.is_empty() {
+            let (m, v) = (&self.config.model, &self.state.v[..]);
             if parallel::worth_it(v.len()) {
                 use rayon::prelude::*;
-                self.skin_mean
+                self.state
+                    .skin_mean
                     .par_chunks_mut(parallel::CHUNK)
                     .zip(v.par_chunks(parallel::CHUNK))
                     .for_each(|(mean, v)| forces::follow_skin_mean(m, v, h, mean));
             } else {
-                forces::follow_skin_mean(m, v, h, &mut self.skin_mean);
+                forces::follow_skin_mean(m, v, h, &mut self.state.skin_mean);
             }
         }
         for memory in Memory::ALL {
-            let history = self.histories.get_mut(memory);
+            let history = self.state.histories.get_mut(memory);
             if history.is_off() {
                 continue;
             }
@@ -694,8 +671,8 @@ impl Cloth {
             };
             history.record(rates, h);
         }
-        self.time += h;
-        self.steps += 1;
+        self.state.time += h;
+        self.state.steps += 1;
     }
 
     /// Whether the proposed state of particle `i` is not finite or faster than `max_speed`.
@@ -719,7 +696,7 @@ impl Cloth {
             Some(i) => Err(Error::unstable(format!(
                 "{} with dt = {dt} s is unstable at step {}: vertex {i} would reach speed {:.3e} m/s (limit {} m/s); state left unchanged, retry with a smaller dt (max_substep = FC_MAX_SUBSTEP_AUTO lets the library choose the substeps; or set max_substep, or call fc_cloth_step_substeps)",
                 self.config.integrator.name(),
-                self.steps,
+                self.state.steps,
                 v[i].norm(),
                 self.config.max_speed
             ))),
