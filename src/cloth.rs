@@ -12,7 +12,9 @@ mod extrapolate;
 mod histories;
 mod motion;
 mod pins;
+mod plan;
 mod prepass;
+mod scratch;
 mod snapshot;
 mod split;
 mod state;
@@ -20,7 +22,8 @@ mod step;
 
 use histories::Histories;
 use pins::check_weight;
-use step::{Rollback, StepScratch};
+use scratch::StepScratch;
+use step::Rollback;
 
 pub use auto_step::{safety, StepStats, AUTO, MAX_RETRIES, SAFETY, SAFETY_SYMPLECTIC};
 pub use snapshot::SNAPSHOT_VERSION;
@@ -174,24 +177,12 @@ pub struct Cloth {
     mesh_slots: Vec<Option<MeshCollider>>,
     /// Self-collision's search and remembered sides (`collide/self_collision.rs`).
     self_collision: SelfCollision,
-    /// Where the mesh colliders were (a fraction of the call's travel) when the last accepted
-    /// step of this call ended: where the next step's continuous check starts them.
-    mesh_from: f64,
     /// Cloth vertices the mesh colliders carried (kept from passing through them), summed
     /// over the steps since the cloth was made.
     mesh_carried: u64,
-    /// What self-collision's step limit did since the cloth was made (`split.rs`).
-    limit_stats: StepLimitStats,
-    /// Whether the call under way is the automatic step's (its substeps are stable already:
-    /// `split.rs` sizes a split substep's pieces for stability only at a host's fixed step).
-    auto_call: bool,
-    /// The substep under way and its level of pieces, while `split.rs` takes it: the step
-    /// limit's proof (`collisions.rs`) is trusted only for a piece stable by itself.
-    limit_piece: Option<(f64, u32)>,
-    /// Substeps to wait before trying whole a substep the speeds would split, and the wait
-    /// after the next failure (`split.rs`).
-    whole_wait: u32,
-    whole_backoff: u32,
+    /// Self-collision's step limit's splitter: what it did and when it next tries a
+    /// substep whole (`split.rs`).
+    splitter: split::Splitter,
     scratch: StepScratch,
     rollback: Rollback,
     /// The whole step of an extrapolated integrator, beside its two half steps.
@@ -264,13 +255,8 @@ impl Cloth {
             friction: Vec::new(),
             mesh_slots: Vec::new(),
             self_collision,
-            mesh_from: 0.0,
             mesh_carried: 0,
-            limit_stats: StepLimitStats::default(),
-            auto_call: false,
-            limit_piece: None,
-            whole_wait: 0,
-            whole_backoff: 0,
+            splitter: split::Splitter::default(),
             scratch: StepScratch::default(),
             rollback: Rollback::default(),
             probe: Rollback::default(),
@@ -653,7 +639,7 @@ impl Cloth {
                 "dt / max_substep = {n} substeps exceeds the limit of {MAX_SUBSTEPS}"
             )));
         }
-        self.step_substeps(dt, n as u32)
+        self.call(dt, n as u32, false)
     }
 
     /// Advances by `dt` seconds in `substeps` equal substeps. Pins travel in a straight
@@ -661,6 +647,13 @@ impl Cloth {
     /// substep fails, the cloth is restored to its state before the call. With self-collision
     /// a substep may be taken in pieces (`cloth/split.rs`).
     pub fn step_substeps(&mut self, dt: f64, substeps: u32) -> Result<(), Error> {
+        check_dt(dt)?;
+        self.call(dt, substeps, false)
+    }
+
+    /// One call of `dt` seconds (checked) in `substeps` substeps, `auto` when the automatic
+    /// step chose them, on the cloth's threads.
+    fn call(&mut self, dt: f64, substeps: u32, auto: bool) -> Result<(), Error> {
         match &self.threads {
             // A cloth that spreads its passes over the shared pool, called from outside it:
             // the whole call runs on one of its workers (`rayon::scope` hands it over once),
@@ -671,10 +664,10 @@ impl Cloth {
                 if crate::parallel::worth_it(self.vertex_count())
                     && rayon::current_thread_index().is_none() =>
             {
-                rayon::scope(|_| self.step_substeps_here(dt, substeps))
+                rayon::scope(|_| self.call_here(dt, substeps, auto))
             }
-            Threads::Shared => self.step_substeps_here(dt, substeps),
-            threads => threads.clone().run(|| self.step_substeps_here(dt, substeps)),
+            Threads::Shared => self.call_here(dt, substeps, auto),
+            threads => threads.clone().run(|| self.call_here(dt, substeps, auto)),
         }
     }
 
@@ -691,15 +684,15 @@ impl Cloth {
     }
 
     /// One call: the mesh colliders travel to where the host put them over it.
-    fn step_substeps_here(&mut self, dt: f64, substeps: u32) -> Result<(), Error> {
-        check_dt(dt)?;
+    fn call_here(&mut self, dt: f64, substeps: u32, auto: bool) -> Result<(), Error> {
         self.begin_collider_motion(dt)?;
-        self.step_substeps_inner(dt, substeps)?;
+        self.call_substeps(dt, substeps, auto)?;
         self.colliders_arrive();
         Ok(())
     }
 
-    fn step_substeps_inner(&mut self, dt: f64, substeps: u32) -> Result<(), Error> {
+    /// The substeps of a call, atomic: on an error the call's start is put back.
+    fn call_substeps(&mut self, dt: f64, substeps: u32, auto: bool) -> Result<(), Error> {
         if substeps == 0 || substeps > MAX_SUBSTEPS {
             return Err(Error::invalid(format!(
                 "substeps must be in 1..={MAX_SUBSTEPS}, got {substeps}"
@@ -709,7 +702,6 @@ impl Cloth {
             substeps,
             ..StepStats::default()
         };
-        self.mesh_from = 0.0;
         let h = dt / f64::from(substeps);
         let mut snap = std::mem::take(&mut self.rollback);
         // A call of one first-order step commits nothing before its end, so it needs no copy
@@ -726,7 +718,7 @@ impl Cloth {
         for k in 1..=substeps {
             let f0 = f64::from(k - 1) / f64::from(substeps);
             let goal = (k < substeps).then_some(f64::from(k) / f64::from(substeps));
-            match self.take_substep(h, f0, goal, &mut snap, &mut saved) {
+            match self.take_substep(h, (f0, goal), auto, &mut snap, &mut saved) {
                 Ok(taken) => pieces = pieces.saturating_add(taken),
                 Err(mut e) => {
                     if saved {

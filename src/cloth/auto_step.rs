@@ -148,9 +148,7 @@ impl Cloth {
         let mut retries = 0;
         loop {
             let substeps = n as u32;
-            self.auto_call = true;
-            let stepped = self.step_substeps(dt, substeps);
-            self.auto_call = false;
+            let stepped = self.call(dt, substeps, true);
             match stepped {
                 Ok(()) => {
                     if tracks {

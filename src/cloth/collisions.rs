@@ -2,7 +2,7 @@
 //! pass, which turns both into [`Contact`] elements (their forces join the force pass, their
 //! Jacobian blocks the implicit system, their friction the friction pass).
 
-use super::step::StepLimit;
+use super::plan::{StepLimit, StepPlan};
 use super::Cloth;
 use crate::bytes::{ByteReader, ByteWriter};
 use crate::collide::impact_zones::{keep_from_passing, ZoneInput, ZoneTotals};
@@ -273,13 +273,13 @@ impl Cloth {
     /// too fast for the penalty to stop the cloth within its margin still cannot go through.
     /// Looked at again (the carried vertices may meet another face) up to
     /// [`MESH_PASSAGE_ROUNDS`] times. Returns how many vertices were carried.
-    pub(super) fn carry_through_meshes(&mut self, h: f64, fraction: Option<f64>) -> usize {
+    pub(super) fn carry_through_meshes(&mut self, h: f64, from: f64, fraction: Option<f64>) -> usize {
         let s = &mut self.scratch;
         s.carried.clear();
         if self.mesh_slots.iter().all(Option::is_none) {
             return 0;
         }
-        let (f0, f1) = (self.mesh_from, fraction.unwrap_or(1.0));
+        let (f0, f1) = (from, fraction.unwrap_or(1.0));
         let tolerance = PASSAGE_TOLERANCE * self.config.model.collision_margin;
         for _ in 0..MESH_PASSAGE_ROUNDS {
             s.mesh_passages.clear();
@@ -341,7 +341,7 @@ impl Cloth {
         {
             return Ok(0);
         }
-        let super::step::StepScratch {
+        let super::scratch::StepScratch {
             carried,
             kinematic,
             x_new,
@@ -398,11 +398,11 @@ impl Cloth {
 
     /// Whether the proposed step is proved to bring no pair of self-collision's within its
     /// reach at any instant (`Unfolded::out_of_reach_throughout`), and stable by itself.
-    fn limit_needless(&mut self) -> bool {
-        let Some((h, level)) = self.limit_piece else {
+    fn limit_needless(&mut self, plan: &StepPlan) -> bool {
+        let Some((h, level)) = plan.piece else {
             return false;
         };
-        if level < self.stable_level(h) {
+        if level < self.stable_level(h, plan.auto) {
             return false;
         }
         let mut end = std::mem::take(&mut self.scratch.step_end);
@@ -423,7 +423,7 @@ impl Cloth {
     /// faster than its thickness a step, would pass through itself) either refuses the step,
     /// saying by how much it is over ([`StepLimit::Refuse`]: the driver splits the step), or
     /// is moved only that far, its velocity scaled alike ([`StepLimit::Slow`]).
-    pub(super) fn limit_collision_step(&mut self, mode: StepLimit) -> Limited {
+    pub(super) fn limit_collision_step(&mut self, plan: &StepPlan) -> Limited {
         let thickness = self.config.model.self_collision_thickness;
         if thickness <= 0.0 {
             return Limited::Slowed(0);
@@ -445,8 +445,8 @@ impl Cloth {
         // driver may take whole: `split.rs`). Only where the step is stable as it is: an
         // explicit integrator's fixed step too long to be stable is still split into stable
         // pieces, not refused.
-        if self.limit_needless() {
-            self.limit_stats.proved_whole += 1;
+        if self.limit_needless(plan) {
+            self.splitter.stats.proved_whole += 1;
             return Limited::Slowed(0);
         }
         let s = &mut self.scratch;
@@ -458,7 +458,7 @@ impl Cloth {
                 .then(|| len2.sqrt())
                 .filter(|&len| len > limit)
         };
-        if mode == StepLimit::Refuse {
+        if plan.limit == StepLimit::Refuse {
             let farthest = (0..self.state.x.len())
                 .filter_map(|i| over(&s.x_new, i))
                 .fold(0.0, f64::max);

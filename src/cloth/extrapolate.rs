@@ -17,28 +17,23 @@
 //! [`Integrator::ExtrapolatedSymplectic`]: crate::Integrator::ExtrapolatedSymplectic
 //! [`Integrator::ExtrapolatedImplicit`]: crate::Integrator::ExtrapolatedImplicit
 
-use super::step::{Advanced, Stage, StepLimit, StepPlan};
+use super::plan::{Stage, StepLimit, StepPlan};
+use super::step::Advanced;
 use super::Cloth;
 use crate::error::Error;
 use crate::integrate;
 
 impl Cloth {
-    /// One extrapolated step of size `h` whose pins start at fraction `f0` of the call's pin
-    /// travel and end at `f1` (None: at their targets). Not atomic by itself: the caller
-    /// restores its rollback on an error. Self-collision's step limit acts on the whole step
-    /// and on each half step as `limit` says: refused (nothing committed: for a refused second
-    /// half the step's start, kept aside while a refusal is possible, is put back) or slowed
-    /// (the last resort).
-    pub(super) fn extrapolated_advance(
-        &mut self,
-        h: f64,
-        f0: f64,
-        f1: Option<f64>,
-        limit: StepLimit,
-    ) -> Result<Advanced, Error> {
+    /// One extrapolated step as `plan` says (its size, where its pins start and end, its
+    /// limit: the whole step's plan). Not atomic by itself: the caller restores its rollback
+    /// on an error. Self-collision's step limit acts on the whole step and on each half step
+    /// as the plan's limit says: refused (nothing committed: for a refused second half the
+    /// step's start, kept aside while a refusal is possible, is put back) or slowed (the last
+    /// resort).
+    pub(super) fn extrapolated_advance(&mut self, plan: StepPlan) -> Result<Advanced, Error> {
         let mut probe = std::mem::take(&mut self.probe);
         let mut start = std::mem::take(&mut self.probe_start);
-        let done = self.extrapolate_with(&mut probe, &mut start, h, f0, f1, limit);
+        let done = self.extrapolate_with(&mut probe, &mut start, plan);
         self.probe = probe;
         self.probe_start = start;
         done
@@ -48,11 +43,9 @@ impl Cloth {
         &mut self,
         probe: &mut super::Rollback,
         start: &mut super::Rollback,
-        h: f64,
-        f0: f64,
-        f1: Option<f64>,
-        limit: StepLimit,
+        plan: StepPlan,
     ) -> Result<Advanced, Error> {
+        let (h, f0, f1) = (plan.h, plan.from, plan.fraction);
         let steps = self.state.steps;
         probe.save(self)?;
         // A refused second half needs the start back: one more copy of the state, with
@@ -60,7 +53,7 @@ impl Cloth {
         // pieces a frame: 9.0-9.4 s a 12 s bake against 8.9 s without the copy, `water_sweep`).
         let refusable = self.config.model.self_collision_thickness > 0.0;
         let limit = match refusable {
-            true => limit,
+            true => plan.limit,
             false => StepLimit::Slow,
         };
         if limit == StepLimit::Refuse {
@@ -69,7 +62,14 @@ impl Cloth {
         let integrator = self.config.integrator;
         // The whole step, kept aside in `probe` (restoring swaps it there). A whole step too
         // far for self-collision's limit is refused before anything is committed.
-        let whole = StepPlan::new(integrator, h, f1, Stage::Whole).limited(limit);
+        // Each of the three steps is the call's (automatic or not, the piece of a split
+        // substep), at its own stage.
+        let staged = |h, from, fraction, stage| StepPlan {
+            auto: plan.auto,
+            piece: plan.piece,
+            ..StepPlan::new(integrator, h, from, fraction, stage).limited(limit)
+        };
+        let whole = staged(h, f0, f1, Stage::Whole);
         if let Advanced::TooFar(ratio) = self.advance(whole)? {
             return Ok(Advanced::TooFar(ratio));
         }
@@ -77,12 +77,12 @@ impl Cloth {
         // Two half steps, the first with the pins aimed at their mid goals (`pins.rs`). A
         // refused first half committed nothing; a refused second half puts the start back.
         let fmid = self.plan_mid_goals(h, f0, f1);
-        let first = StepPlan::new(integrator, 0.5 * h, Some(fmid), Stage::FirstHalf);
-        if let Advanced::TooFar(ratio) = self.advance(first.limited(limit))? {
+        let first = staged(0.5 * h, f0, Some(fmid), Stage::FirstHalf);
+        if let Advanced::TooFar(ratio) = self.advance(first)? {
             return Ok(Advanced::TooFar(ratio));
         }
-        let second = StepPlan::new(integrator, 0.5 * h, f1, Stage::SecondHalf);
-        if let Advanced::TooFar(ratio) = self.advance(second.limited(limit))? {
+        let second = staged(0.5 * h, fmid, f1, Stage::SecondHalf);
+        if let Advanced::TooFar(ratio) = self.advance(second)? {
             start.restore(self);
             return Ok(Advanced::TooFar(ratio));
         }

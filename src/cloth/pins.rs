@@ -6,10 +6,9 @@
 //! (`PinPaths::start`) to the host's target, a fraction of the way per substep; an extrapolated
 //! step's first half aims hard pins at a point on a parabola instead (`Cloth::plan_mid_goals`).
 
-use super::step::{Stage, StepPlan};
+use super::plan::{Stage, StepPlan};
 use super::Cloth;
 use crate::error::{check_finite_vec, Error};
-use crate::integrate::Integrator;
 use crate::math::Vec3;
 
 /// The pins' buffers a step reuses.
@@ -23,47 +22,6 @@ pub(super) struct PinPaths {
     pub mid: Vec<Vec3>,
     /// Fully pinned particles, ascending (to find those of a tile by bisection).
     pub hard: Vec<u32>,
-}
-
-/// Which velocity a hard pin gives the history (and this step's D^{1/2}), from its stored
-/// velocity `v` and its step velocity, the secant to its goal, `v_step`.
-///
-/// A hard pin's step velocity is its goal's secant, the velocity half a step ahead. The
-/// second-order integrators give the history the slope of the pin's path at the start of the
-/// (half) step instead: the history keeps every sample, so a first-order error in them would
-/// never be extrapolated away. Its stored velocity is read as the last secant, half a step
-/// back (what extrapolated symplectic Euler leaves it; extrapolated implicit Euler
-/// extrapolates it and measured best so), giving the mean of it and this secant; in the first
-/// half step, whose secant reaches only a quarter step ahead, `(S_prev + 2 S_1) / 3`. The
-/// first-order integrators keep the secant.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum PinSampling {
-    Secant,
-    Central,
-    StartSlope,
-}
-
-impl PinSampling {
-    pub(super) fn of(integrator: Integrator, stage: Stage) -> PinSampling {
-        if !integrator.is_extrapolated() {
-            PinSampling::Secant
-        } else if !integrator.is_implicit() && stage == Stage::FirstHalf {
-            PinSampling::StartSlope
-        } else {
-            PinSampling::Central
-        }
-    }
-
-    #[inline]
-    pub(super) fn rate(self, v: Vec3, v_step: Vec3) -> Vec3 {
-        match self {
-            PinSampling::Secant => v_step,
-            PinSampling::Central => 0.5 * (v + v_step),
-            // The slope at the start from the last whole secant (a step back) and this half
-            // step's: p'(0) = S_prev / 3 + 2 S_1 / 3 on a parabola.
-            PinSampling::StartSlope => (v + 2.0 * v_step) / 3.0,
-        }
-    }
 }
 
 pub(super) fn check_weight(i: usize, w: f64) -> Result<(), Error> {

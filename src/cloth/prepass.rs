@@ -2,7 +2,7 @@
 //! vector unit the CPU has ([`crate::simd`]): they move every particle's numbers between
 //! `Vec3` arrays and component arrays, which vectorises only with wide shuffles.
 
-use super::pins::PinSampling;
+use super::plan::PinSampling;
 use crate::forces::{SpringRate, TILE};
 use crate::history::StepPast;
 use crate::math::Vec3;

@@ -39,7 +39,7 @@
 //! checksum and every value before touching the cloth: a truncated, corrupted or foreign snapshot
 //! is rejected with a message and the cloth is left exactly as it was.
 
-use super::step::{Stage, StepPlan};
+use super::plan::{Stage, StepPlan};
 use super::{check_weight, checked_collider, Cloth, Histories};
 use crate::bytes::{ByteReader, ByteWriter};
 use crate::cloth::MAX_COORDINATE;
@@ -615,26 +615,24 @@ impl Cloth {
         std::mem::swap(&mut self.pin_target, &mut targets);
         let unconverged = std::mem::replace(&mut self.config.accept_unconverged, true);
         let (solver, stats, carried) = (self.solver_stats, self.step_stats, self.mesh_carried);
-        let limit_stats = self.limit_stats;
+        let splitter = self.splitter;
         // The mesh colliders as loaded (their lists and trees empty: small to copy), so that
         // the step's refresh of them is not kept.
         let meshes = self.mesh_slots.clone();
         // The mesh colliders travel from where they are to where the host put them, as the
-        // next call's step moves them (from the start of the call).
-        let mesh_from = std::mem::replace(&mut self.mesh_from, 0.0);
-        // Self-collision's limit slows a vertex here (`StepPlan::new`'s), never refuses.
-        let done = self.begin_collider_motion(h).and_then(|()| {
-            self.advance(StepPlan::new(self.config.integrator, h, None, Stage::Whole))
-                .map(|_| ())
-        });
+        // next call's step moves them (from the start of the call). Self-collision's limit
+        // slows a vertex here (`StepPlan::new`'s), never refuses.
+        let plan = StepPlan::new(self.config.integrator, h, 0.0, None, Stage::Whole);
+        let done = self
+            .begin_collider_motion(h)
+            .and_then(|()| self.advance(plan).map(|_| ()));
         self.mesh_slots = meshes;
-        self.mesh_from = mesh_from;
         snap.restore(self);
         std::mem::swap(&mut self.pin_target, &mut targets);
         snap.targets = targets;
         self.config.accept_unconverged = unconverged;
         (self.solver_stats, self.step_stats, self.mesh_carried) = (solver, stats, carried);
-        self.limit_stats = limit_stats;
+        self.splitter = splitter;
         self.rollback = snap;
         done
     }

@@ -40,7 +40,8 @@
 //! [`SELF_COLLISION_STEP_LIMIT`]: super::collisions::SELF_COLLISION_STEP_LIMIT
 
 use super::collisions::SELF_COLLISION_STEP_LIMIT;
-use super::step::{Advanced, Stage, StepLimit, StepPlan};
+use super::plan::{Stage, StepLimit, StepPlan};
+use super::step::Advanced;
 use super::{Cloth, Rollback};
 use crate::error::Error;
 
@@ -80,22 +81,32 @@ pub struct StepLimitStats {
     pub slowed: u64,
 }
 
+/// The splitter's state: what it did, and when it next tries whole a substep the speeds would
+/// split.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Splitter {
+    pub stats: StepLimitStats,
+    /// Substeps to wait before the next try, and the wait after the next failure.
+    whole_wait: u32,
+    whole_backoff: u32,
+}
+
 impl Cloth {
     /// What self-collision's step limit did since the cloth was made ([`StepLimitStats`]).
     pub fn step_limit_stats(&self) -> StepLimitStats {
-        self.limit_stats
+        self.splitter.stats
     }
 
     /// One substep of size `h` whose pins and mesh colliders go from fraction `f0` of the
     /// call's travel to `f1` (None: the call's end), split as self-collision's step limit needs
-    /// (module docs). Returns the pieces taken. Not atomic: on an error the caller restores
+    /// (module docs); `auto` when the automatic step chose it. Returns the pieces taken. Not atomic: on an error the caller restores
     /// `snap` when `saved` says it holds the call's start; a call of one first-order step has
     /// none until a split needs it (made here, before the first piece commits anything).
     pub(super) fn take_substep(
         &mut self,
         h: f64,
-        f0: f64,
-        f1: Option<f64>,
+        (f0, f1): (f64, Option<f64>),
+        auto: bool,
         snap: &mut Rollback,
         saved: &mut bool,
     ) -> Result<u32, Error> {
@@ -116,12 +127,12 @@ impl Cloth {
         // the next try.
         let mut whole = false;
         if level > 0 {
-            let floor = *stable.get_or_insert_with(|| self.stable_level(h));
-            if floor == 0 && self.self_collision.last_look_proved() && self.whole_wait == 0 {
+            let floor = *stable.get_or_insert_with(|| self.stable_level(h, auto));
+            if floor == 0 && self.self_collision.last_look_proved() && self.splitter.whole_wait == 0 {
                 whole = true;
                 level = 0;
             } else {
-                self.whole_wait = self.whole_wait.saturating_sub(1);
+                self.splitter.whole_wait = self.splitter.whole_wait.saturating_sub(1);
                 level = level.max(floor);
             }
         }
@@ -133,10 +144,10 @@ impl Cloth {
             if done == pieces {
                 if whole {
                     // Taken whole: try again at the next one.
-                    self.whole_backoff = 0;
+                    self.splitter.whole_backoff = 0;
                 }
                 if taken > 1 {
-                    let stats = &mut self.limit_stats;
+                    let stats = &mut self.splitter.stats;
                     stats.split_substeps += 1;
                     stats.pieces += u64::from(taken);
                 }
@@ -164,14 +175,13 @@ impl Cloth {
             let at = |j: u32| f0 + (end - f0) * f64::from(j) / f64::from(pieces);
             let (a, b) = (at(done), (done + 1 < pieces).then(|| at(done + 1)).or(f1));
             let piece = h / f64::from(pieces);
-            self.limit_piece = Some((h, level));
+            let mut plan = StepPlan::new(self.config.integrator, piece, a, b, Stage::Whole).limited(limit);
+            (plan.auto, plan.piece) = (auto, Some((h, level)));
             let outcome = if self.config.integrator.is_extrapolated() {
-                self.extrapolated_advance(piece, a, b, limit)
+                self.extrapolated_advance(plan)
             } else {
-                let plan = StepPlan::new(self.config.integrator, piece, b, Stage::Whole);
-                self.advance(plan.limited(limit))
+                self.advance(plan)
             };
-            self.limit_piece = None;
             match outcome {
                 Ok(Advanced::Taken) => {
                     done += 1;
@@ -182,10 +192,11 @@ impl Cloth {
                         self.self_collision.swap_memory(&mut memory);
                     }
                     if std::mem::take(&mut whole) {
-                        self.whole_backoff = (2 * self.whole_backoff).clamp(1, WHOLE_BACKOFF);
-                        self.whole_wait = self.whole_backoff;
+                        let s = &mut self.splitter;
+                        s.whole_backoff = (2 * s.whole_backoff).clamp(1, WHOLE_BACKOFF);
+                        s.whole_wait = s.whole_backoff;
                     }
-                    let floor = *stable.get_or_insert_with(|| self.stable_level(h));
+                    let floor = *stable.get_or_insert_with(|| self.stable_level(h, auto));
                     let next = (level + more_levels(ratio)).max(floor).min(top(stable));
                     done <<= next - level;
                     level = next;
@@ -214,9 +225,9 @@ impl Cloth {
     /// stable substep (`Cloth::auto_substep`): a split substep's pieces are no longer, so that
     /// a host's fixed step too long to be stable, split for the limit, is split into stable
     /// pieces instead of jittering at the limit's scale. 0 for implicit Euler (no stability
-    /// bound) and in the automatic step's own calls (its substeps are stable already).
-    pub(super) fn stable_level(&self, h: f64) -> u32 {
-        if self.auto_call || self.config.integrator.is_implicit() {
+    /// bound) and in the automatic step's own calls (`auto`: its substeps are stable already).
+    pub(super) fn stable_level(&self, h: f64, auto: bool) -> u32 {
+        if auto || self.config.integrator.is_implicit() {
             return 0;
         }
         let stable = self.auto_substep(h);
@@ -381,7 +392,7 @@ mod tests {
         let h = 1.0 / 30.0;
         let limit = SELF_COLLISION_STEP_LIMIT * 0.004;
         assert_eq!(split.predicted_split(h, limit), (true, 2));
-        let floor = split.stable_level(h);
+        let floor = split.stable_level(h, false);
         assert!(
             split.auto_substep(h) * 16.0 < h,
             "1/30 s is far past the stable substep"
@@ -392,8 +403,7 @@ mod tests {
         asked.step_substeps(h, 1 << floor).expect("the asked call");
         assert!(state(&split) == state(&asked));
         // The automatic step's own calls are stable already: no floor.
-        split.auto_call = true;
-        assert_eq!(split.stable_level(h), 0);
+        assert_eq!(split.stable_level(h, true), 0);
     }
 
     /// A piece that fails (here implicit Euler's solve, stopped after one iteration) fails the

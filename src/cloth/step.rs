@@ -7,44 +7,14 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::pins::{PinPaths, PinSampling};
+use super::plan::StepPlan;
 use super::state::State;
 use super::{prepass, Cloth, FAR_STEP, MAX_COORDINATE};
 use crate::error::Error;
-use crate::forces::{self, ElementScratch, ForceInput, ForceScratch, Memory, SpringInputs, Weights, TILE};
-use crate::integrate::{self, implicit_euler, ImplicitInput, ImplicitScratch, StepSoa};
+use crate::forces::{self, ForceInput, ForceScratch, Memory, SpringInputs, Weights, TILE};
+use crate::integrate::{self, implicit_euler, ImplicitInput, StepSoa};
 use crate::math::Vec3;
 use crate::parallel;
-
-/// What the driver decides for one step, built once by it (`Cloth::step_substeps`,
-/// `extrapolate.rs`, the snapshot's trial step) and read by the passes, instead of locals and
-/// flags (the role of Box2D's `b2StepContext` and rapier's `IntegrationParameters`).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct StepPlan {
-    /// Step size, s.
-    pub h: f64,
-    /// Where pins and mesh colliders are at the end of the step: this fraction of the way
-    /// through the call, or None for where the host put them.
-    pub fraction: Option<f64>,
-    /// Which part of the integrator's step this is.
-    pub stage: Stage,
-    /// Which velocity a hard pin gives the history.
-    pub sampling: PinSampling,
-    /// What self-collision's step limit does to a vertex that would move too far.
-    pub limit: StepLimit,
-}
-
-/// What self-collision's step limit ([`super::collisions::SELF_COLLISION_STEP_LIMIT`]) does
-/// with a step in which a free vertex would move farther than it allows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum StepLimit {
-    /// Slows the vertex to the limit (the last resort: the step is already as short as the
-    /// driver splits it, or nothing can split it).
-    Slow,
-    /// Refuses the step, nothing committed ([`Advanced::TooFar`]), so that the driver takes it
-    /// in shorter pieces (`Cloth::take_substep`).
-    Refuse,
-}
 
 /// What [`Cloth::advance`] did.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,39 +25,6 @@ pub(super) enum Advanced {
     /// ([`StepLimit::Refuse`] only). Self-collision's remembered pairs may have changed: the
     /// driver restores them.
     TooFar(f64),
-}
-
-/// Which part of an integrator's step a step is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Stage {
-    /// A whole step (a first-order integrator's, or an extrapolated step's whole run).
-    Whole,
-    /// The first of an extrapolated step's two half steps: hard pins aim at their mid goals.
-    FirstHalf,
-    /// The second half step.
-    SecondHalf,
-}
-
-impl StepPlan {
-    pub(super) fn new(
-        integrator: integrate::Integrator,
-        h: f64,
-        fraction: Option<f64>,
-        stage: Stage,
-    ) -> Self {
-        StepPlan {
-            h,
-            fraction,
-            stage,
-            sampling: PinSampling::of(integrator, stage),
-            limit: StepLimit::Slow,
-        }
-    }
-
-    /// The same plan, its step limit `limit`.
-    pub(super) fn limited(self, limit: StepLimit) -> Self {
-        StepPlan { limit, ..self }
-    }
 }
 
 /// How a step goes from forces to the new state, chosen by [`Route::of`]:
@@ -115,63 +52,6 @@ impl Route {
     }
 }
 
-/// Buffers a step reuses (no allocation in a step once they have grown).
-#[derive(Clone, Debug, Default)]
-pub(super) struct StepScratch {
-    /// The step's velocity of every particle (pins' from their goals), m/s.
-    pub v_step: crate::aligned::AlignedVec3,
-    /// Velocity relative to the water, m/s.
-    pub v_rel: Vec<Vec3>,
-    /// D^{1/2}x of the displacement relative to the water, m s^{-1/2}.
-    pub half: crate::aligned::AlignedVec3,
-    /// Total forces as one array (the implicit route only), N.
-    pub force_array: Vec<Vec3>,
-    /// The velocities where an automatic call with implicit Euler began (`motion.rs`).
-    pub motion_v: Vec<Vec3>,
-    /// The state the step proposes; committed only if sound.
-    pub x_new: crate::aligned::AlignedVec3,
-    pub v_new: crate::aligned::AlignedVec3,
-    /// The pins' goals and paths (`pins.rs`).
-    pub pins: PinPaths,
-    /// Where a step over self-collision's limit would end, pins included (`collisions.rs`).
-    pub step_end: Vec<Vec3>,
-    /// The pair elements' own passes: the rates their memories record (`forces::elements`).
-    pub elements: ElementScratch,
-    /// Forces of the whole-cloth passes before the force pass (pair elements with a pass of
-    /// their own, the carried water's turning forces), one per particle; empty without them.
-    pub prior_forces: Vec<Vec3>,
-    /// The collision pass's contact elements (mesh colliders, self-collision).
-    pub contacts: Vec<crate::collide::Contact>,
-    /// Self-collision's memory before a piece of a split substep (`split.rs`).
-    pub piece_memory: crate::collide::self_collision::SavedMemory,
-    /// The free vertices self-collision's impact zones moved this step.
-    pub zone_moved: Vec<u32>,
-    /// The cloth's passages through the mesh colliders this step, the free vertices they
-    /// carried (ascending) and, when some were, the vertices the impact zones may not move
-    /// (pinned or carried).
-    pub mesh_passages: Vec<crate::collide::mesh::MeshPassage>,
-    pub carried: Vec<u32>,
-    pub kinematic: Vec<bool>,
-    /// The passages they stopped (`collide::impact_zones`).
-    pub zone_stopped: Vec<crate::collide::impact_zones::Passage>,
-    /// The impact zones' own buffers (their union-find, the passages of a round).
-    pub zones: crate::collide::impact_zones::ZoneScratch,
-    /// The mesh colliders' contacts where a call begins, and each vertex's weight from them
-    /// (`Cloth::measure_contact_weights`; empty without contacts).
-    pub start_contacts: Vec<crate::collide::Contact>,
-    pub contact_weight: Vec<f64>,
-    pub turning: forces::TurningScratch,
-    /// The coarse level of the carried water (`forces::coarse_water`), when the model has one.
-    pub coarse: Option<forces::coarse_water::CoarseWater>,
-    /// The wide form drag's buffers and rest weights.
-    pub wide_drag: forces::WideDragScratch,
-    /// Each patch's projected-area ratio ([`forces::patch_normals`]), with normal added mass
-    /// only (else empty).
-    pub projected: Vec<f64>,
-    pub force_pass: ForceScratch,
-    pub implicit: ImplicitScratch,
-}
-
 /// What a refused call puts back: the [`State`] saved before a multi-substep call (and around
 /// the whole step of an extrapolated integrator), with self-collision's remembered pairs.
 #[derive(Clone, Debug, Default)]
@@ -180,7 +60,6 @@ pub(super) struct Rollback {
     pub(super) state: Option<State>,
     /// Self-collision's remembered pairs and sides (state: a snapshot carries them).
     pub(super) self_collision: crate::collide::self_collision::SavedMemory,
-    mesh_from: f64,
     /// Room for the pins' targets a snapshot's trial step sets aside (not saved or restored).
     pub(super) targets: Vec<Vec3>,
 }
@@ -191,7 +70,6 @@ impl Rollback {
     pub(super) fn save(&mut self, c: &Cloth) -> Result<(), Error> {
         c.state.copy_into(&mut self.state, &c.topology)?;
         c.self_collision.save_memory(&mut self.self_collision);
-        self.mesh_from = c.mesh_from;
         Ok(())
     }
 
@@ -201,7 +79,6 @@ impl Rollback {
             std::mem::swap(&mut c.state, state);
         }
         c.self_collision.swap_memory(&mut self.self_collision);
-        c.mesh_from = self.mesh_from;
     }
 }
 
@@ -270,15 +147,15 @@ impl Cloth {
             (None, Route::Implicit) => self.forces_and_implicit_step(h, weights)?,
         };
         let friction = self.friction(h) | self.contact_friction(h);
-        let limited = match self.limit_collision_step(plan.limit) {
+        let limited = match self.limit_collision_step(&plan) {
             super::collisions::Limited::Over(ratio) => return Ok(Advanced::TooFar(ratio)),
             super::collisions::Limited::Slowed(count) => {
-                self.limit_stats.slowed += count as u64;
+                self.splitter.stats.slowed += count as u64;
                 count > 0
             }
         };
         self.pins(h);
-        let carried = self.carry_through_meshes(h, plan.fraction);
+        let carried = self.carry_through_meshes(h, plan.from, plan.fraction);
         self.mesh_carried += carried as u64;
         let carried = carried > 0;
         let zoned = self.impact_zones(h)? > 0;
@@ -287,7 +164,6 @@ impl Cloth {
             self.learn_stopped_sides();
         }
         self.commit(h);
-        self.mesh_from = plan.fraction.unwrap_or(1.0);
         Ok(Advanced::Taken)
     }
 
