@@ -75,12 +75,12 @@ pub type PairLists<'a> = (&'a [(u32, u32)], &'a [(u32, u32)]);
 
 /// Distance between the segments `e` and `f` of positions `x`.
 fn edge_distance(x: &[Vec3], e: &[u32; 2], f: &[u32; 2]) -> f64 {
-    super::self_collision::edge_edge(x, e, f).0
+    super::pair::edge_edge(x, e, f).0
 }
 
 /// Distance between vertex `p` and triangle `t` of positions `x`.
 fn vertex_distance(x: &[Vec3], p: u32, t: &[u32; 3]) -> f64 {
-    super::self_collision::vertex_triangle(x, p, t).0
+    super::pair::vertex_triangle(x, p, t).0
 }
 
 impl Guard {

@@ -12,7 +12,7 @@
 
 use super::ccd::{edge_passes_edge, start_sign, vertex_passes_triangle, Path};
 use super::geometry::segment_crosses_triangle;
-use super::self_collision::Pair;
+use super::pair::Pair;
 use crate::math::Vec3;
 use crate::topology::Adjacency;
 

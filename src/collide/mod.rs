@@ -28,6 +28,7 @@ pub mod intersections;
 pub mod mesh;
 mod neighbours;
 pub mod ownership;
+mod pair;
 pub(crate) mod room;
 pub mod self_collision;
 pub mod shapes;

@@ -13,8 +13,8 @@ use super::ownership::Ownership;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, AtomicU8, AtomicUsize, Ordering::Relaxed};
 
+use super::pair::{edge_edge, vertex_triangle};
 use super::room::{make_room, Full, Room};
-use super::self_collision::{edge_edge, vertex_triangle};
 use crate::math::Vec3;
 
 /// The triangles' rest boxes grown by half the exclusion radius, and their tree: two triangles

@@ -651,7 +651,7 @@ pub unsafe extern "C" fn fc_cloth_get_desc_sized(
 ) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promise.
-        let cloth = unsafe { super::cloth::handle(cloth) }?;
+        let cloth = unsafe { super::handle::handle(cloth) }?;
         let t = cloth.topology();
         let mut d = FcClothDesc::from_model(cloth.model(), cloth.config());
         let (w, h) = t.grid.unwrap_or((0, 0));
@@ -682,7 +682,7 @@ pub unsafe extern "C" fn fc_cloth_get_desc_sized(
 pub unsafe extern "C" fn fc_cloth_set_desc(cloth: *mut super::FcCloth, desc: *const FcClothDesc) -> FcStatus {
     guard(|| {
         // SAFETY: forwarded caller promises.
-        let cloth = unsafe { super::cloth::handle_mut(cloth) }?;
+        let cloth = unsafe { super::handle::handle_mut(cloth) }?;
         let desc = unsafe { read_desc(desc, fc_cloth_desc_default()) }?;
         let mut config = desc.config()?;
         config.accept_unconverged = cloth.config().accept_unconverged;

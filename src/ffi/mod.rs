@@ -23,6 +23,7 @@ pub mod collider;
 pub mod desc;
 pub mod desc_size;
 pub mod geometry;
+pub mod handle;
 pub mod mesh;
 pub mod mesh_collider;
 pub mod snapshot;

@@ -461,8 +461,8 @@ mod tests {
     #[test]
     fn the_coarse_turning_forces_are_lagranges_terms() {
         let (t, x, v, m, mut c) = setup();
-        let (got, _, _) = crate::forces::inertia::check::turning_of(&m, &t, &x, &v, Some(&mut c));
-        crate::forces::inertia::check::lagranges_terms(
+        let (got, _, _) = crate::forces::turning::check::turning_of(&m, &t, &x, &v, Some(&mut c));
+        crate::forces::turning::check::lagranges_terms(
             &got,
             &x,
             &v,

@@ -11,6 +11,17 @@
 use crate::math::Vec3;
 use crate::model::Model;
 
+/// A per-particle coefficient plus a per-area one times the particle's area. The sum is `k`
+/// exactly when the per-area one is zero, so models without it keep their bits.
+#[inline(always)]
+pub fn per_particle(k: f64, k_area: f64, area: f64) -> f64 {
+    if k_area == 0.0 {
+        k
+    } else {
+        k + k_area * area
+    }
+}
+
 crate::simd_dispatch! { pub(super) fn add_viscous(m: &Model, v: [&[f64]; 3], areas: &[f64], f: [&mut [f64]; 3]) => add_viscous_kernel }
 
 #[inline(always)]
@@ -43,7 +54,7 @@ fn add_history_kernel(m: &Model, v: [&[f64]; 3], d: [&[f64]; 3], areas: &[f64], 
     let (k, ka, c) = (m.history_drag, m.water.history_drag, m.current);
     let areas = &areas[..len];
     for t in 0..len {
-        let k = super::terms::per_particle(k, ka, areas[t]);
+        let k = per_particle(k, ka, areas[t]);
         let (rx, ry, rz) = (vx[t] - c.x, vy[t] - c.y, vz[t] - c.z);
         let speed2 = rx * rx + ry * ry + rz * rz;
         let dr = dx[t] * rx + dy[t] * ry + dz[t] * rz;
@@ -78,7 +89,7 @@ fn add_with_normals(
 pub(super) fn add_normal(m: &Model, v: [&[f64]; 3], n: &[Vec3], areas: &[f64], f: [&mut [f64]; 3]) {
     let (k, ka) = (m.normal_drag, m.water.normal_drag);
     add_with_normals(m, v, n, areas, f, |_, rel, nt, a| {
-        -(super::terms::per_particle(k, ka, a) * rel.dot(nt) * nt)
+        -(per_particle(k, ka, a) * rel.dot(nt) * nt)
     });
 }
 

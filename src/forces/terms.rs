@@ -15,6 +15,7 @@ use nalgebra::Matrix3;
 use super::body::add_weight_widest;
 use super::contact;
 use super::drag;
+pub use super::drag::per_particle;
 use super::Collider;
 use crate::math::Vec3;
 use crate::model::Model;
@@ -146,17 +147,6 @@ const VISCOUS_DRAG: Term = Term {
         b.damping += per_particle(m.viscous_drag, m.water.viscous_drag, p.area) * Matrix3::identity()
     }),
 };
-
-/// A per-particle coefficient plus a per-area one times the particle's area. The sum is `k`
-/// exactly when the per-area one is zero, so models without it keep their bits.
-#[inline(always)]
-pub fn per_particle(k: f64, k_area: f64, area: f64) -> f64 {
-    if k_area == 0.0 {
-        k
-    } else {
-        k + k_area * area
-    }
-}
 
 /// History (Basset) drag, Eq. 4.
 const HISTORY_DRAG: Term = Term {

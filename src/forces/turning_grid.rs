@@ -33,7 +33,7 @@
 //! thread; the chunks' borders and wavefront on two. Walking each band once (above) saves
 //! more: see `docs/benchmarks.md` for the figures.
 
-use super::inertia::{patch_range, PatchOut};
+use super::patch::{patch_range, PatchOut};
 use crate::math::Vec3;
 use crate::parallel;
 use crate::topology::Topology;
@@ -700,7 +700,8 @@ fn block<const K: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::forces::inertia::{turning_forces, turning_serial, TurningScratch, CARRIED_FULL};
+    use crate::forces::inertia::CARRIED_FULL;
+    use crate::forces::turning::{turning_forces, turning_serial, TurningScratch};
     use crate::Model;
 
     /// The grid's gathered passes give the scatter's bits (forces added to what was there,
