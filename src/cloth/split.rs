@@ -91,6 +91,15 @@ pub(super) struct Splitter {
     whole_backoff: u32,
 }
 
+impl Splitter {
+    /// A substep tried whole was refused: wait twice as long as last time (up to
+    /// `WHOLE_BACKOFF` substeps) before the next try.
+    fn whole_failed(&mut self) {
+        self.whole_backoff = (2 * self.whole_backoff).clamp(1, WHOLE_BACKOFF);
+        self.whole_wait = self.whole_backoff;
+    }
+}
+
 impl Cloth {
     /// What self-collision's step limit did since the cloth was made ([`StepLimitStats`]).
     pub fn step_limit_stats(&self) -> StepLimitStats {
@@ -99,9 +108,10 @@ impl Cloth {
 
     /// One substep of size `h` whose pins and mesh colliders go from fraction `f0` of the
     /// call's travel to `f1` (None: the call's end), split as self-collision's step limit needs
-    /// (module docs); `auto` when the automatic step chose it. Returns the pieces taken. Not atomic: on an error the caller restores
-    /// `snap` when `saved` says it holds the call's start; a call of one first-order step has
-    /// none until a split needs it (made here, before the first piece commits anything).
+    /// (module docs); `auto` when the automatic step chose it. Returns the pieces taken. Not
+    /// atomic: on an error the caller restores `snap` when `saved` says it holds the call's
+    /// start; a call of one first-order step has none until a split needs it (made here,
+    /// before the first piece commits anything).
     pub(super) fn take_substep(
         &mut self,
         h: f64,
@@ -120,21 +130,9 @@ impl Cloth {
         let mut stable: Option<u32> = None;
         // The limit splits up to `MAX_SPLIT_LEVEL` levels beyond those.
         let top = |stable: Option<u32>| MAX_SPLIT_LEVEL + stable.unwrap_or(0);
-        // A substep the speeds would split is tried whole first when the last look found the
-        // cloth out of its own reach (the proof may then show it so throughout the substep,
-        // and the limit is not needed: `Cloth::limit_needless`), unless a try failed lately:
-        // after a failure 1, 2, 4, ... up to `WHOLE_BACKOFF` substeps are split at once before
-        // the next try.
         let mut whole = false;
         if level > 0 {
-            let floor = *stable.get_or_insert_with(|| self.stable_level(h, auto));
-            if floor == 0 && self.self_collision.last_look_proved() && self.splitter.whole_wait == 0 {
-                whole = true;
-                level = 0;
-            } else {
-                self.splitter.whole_wait = self.splitter.whole_wait.saturating_sub(1);
-                level = level.max(floor);
-            }
+            (level, whole) = self.first_level(h, auto, level, &mut stable);
         }
         let end = f1.unwrap_or(1.0);
         let (mut done, mut taken) = (0u32, 0u32);
@@ -174,15 +172,9 @@ impl Cloth {
             }
             let at = |j: u32| f0 + (end - f0) * f64::from(j) / f64::from(pieces);
             let (a, b) = (at(done), (done + 1 < pieces).then(|| at(done + 1)).or(f1));
-            let piece = h / f64::from(pieces);
-            let mut plan = StepPlan::new(self.config.integrator, piece, a, b, Stage::Whole).limited(limit);
-            (plan.auto, plan.piece) = (auto, Some((h, level)));
-            let outcome = if self.config.integrator.is_extrapolated() {
-                self.extrapolated_advance(plan)
-            } else {
-                self.advance(plan)
-            };
-            match outcome {
+            let mut plan = StepPlan::new(self.config.integrator, h / f64::from(pieces), a, b, Stage::Whole);
+            (plan.limit, plan.auto, plan.piece) = (limit, auto, Some((h, level)));
+            match self.take_piece(plan) {
                 Ok(Advanced::Taken) => {
                     done += 1;
                     taken += 1;
@@ -192,9 +184,7 @@ impl Cloth {
                         self.self_collision.swap_memory(&mut memory);
                     }
                     if std::mem::take(&mut whole) {
-                        let s = &mut self.splitter;
-                        s.whole_backoff = (2 * s.whole_backoff).clamp(1, WHOLE_BACKOFF);
-                        s.whole_wait = s.whole_backoff;
+                        self.splitter.whole_failed();
                     }
                     let floor = *stable.get_or_insert_with(|| self.stable_level(h, auto));
                     let next = (level + more_levels(ratio)).max(floor).min(top(stable));
@@ -219,6 +209,31 @@ impl Cloth {
         };
         self.scratch.piece_memory = memory;
         result
+    }
+
+    /// The level a substep the speeds would split (at `level`) starts at, and whether it is
+    /// tried whole: first, when the last look found the cloth out of its own reach (the proof
+    /// may then show it so throughout the substep, and the limit is not needed:
+    /// `Cloth::limit_needless`), unless a try failed lately (after a failure 1, 2, 4, ... up
+    /// to `WHOLE_BACKOFF` substeps are split at once before the next try). `stable` gets the
+    /// level its pieces must be at to be stable.
+    fn first_level(&mut self, h: f64, auto: bool, level: u32, stable: &mut Option<u32>) -> (u32, bool) {
+        let floor = *stable.get_or_insert_with(|| self.stable_level(h, auto));
+        if floor == 0 && self.self_collision.last_look_proved() && self.splitter.whole_wait == 0 {
+            (0, true)
+        } else {
+            self.splitter.whole_wait = self.splitter.whole_wait.saturating_sub(1);
+            (level.max(floor), false)
+        }
+    }
+
+    /// One piece as `plan` says, by the integrator's own step.
+    fn take_piece(&mut self, plan: StepPlan) -> Result<Advanced, Error> {
+        if self.config.integrator.is_extrapolated() {
+            self.extrapolated_advance(plan)
+        } else {
+            self.advance(plan)
+        }
     }
 
     /// The fewest levels of pieces that bring a substep of `h` within the automatic step's

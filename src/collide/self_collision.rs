@@ -144,6 +144,134 @@ pub struct SelfCollision {
 
 pub use super::guard::{GUARD_QUANTILE, GUARD_SKIN};
 
+/// The contact of vertex `p` with triangle `tri` at `x` (signed distance, direction, the
+/// triangle's weights), its remembered side `s` learnt or forgotten on the way; `None` when
+/// the pair is apart or its direction is not defined.
+#[inline]
+fn vertex_triangle_contact(
+    x: &[Vec3],
+    p: u32,
+    tri: &[u32; 3],
+    s: &mut i8,
+    thickness: f64,
+    reach: f64,
+) -> Option<(f64, Vec3, [f64; 3])> {
+    let (d, w, r) = vertex_triangle(x, p, tri);
+    let [a, b, c] = tri.map(|i| x[i as usize]);
+    let interior = w.iter().all(|&wk| wk > 0.0);
+    let normal = (b - a).cross(&(c - a)).try_normalize(0.0)?;
+    if d >= thickness {
+        // Apart. Over the face on the other side of the remembered one, within the
+        // reach: it went through (a step moves a pair at most one thickness closer, so
+        // it cannot be past the reach already) and is pushed back. Else nothing
+        // crossed and the side is learnt afresh (a triangle that turned over).
+        let now = side(r.dot(&normal));
+        if !interior {
+            // Beside the face it may go round the triangle's border: forgotten.
+            *s = 0;
+            return None;
+        }
+        if settled_apart(s, now, d, reach) {
+            return None;
+        }
+    }
+    if *s == 0 && interior {
+        // First over the triangle's face: the side it comes from is known now.
+        *s = side(r.dot(&normal));
+    }
+    let side_n = f64::from(*s) * normal;
+    let (dist, dir) = if interior && r.dot(&side_n) <= 0.0 {
+        (-d, side_n)
+    } else if interior && *s != 0 {
+        (r.dot(&side_n), side_n)
+    } else if d > 1e-12 {
+        (d, r / d)
+    } else {
+        return None;
+    };
+    Some((dist, dir, w))
+}
+
+/// The contact of edges `ee` and `ff` at `x` (signed distance, direction, the parameters of
+/// the closest points), their remembered side `s` learnt or forgotten on the way; `None` when
+/// they are apart, past an end, or their direction is not defined.
+#[inline]
+fn edge_edge_contact(
+    x: &[Vec3],
+    ee: &[u32; 2],
+    ff: &[u32; 2],
+    s: &mut i8,
+    thickness: f64,
+    reach: f64,
+) -> Option<(f64, Vec3, f64, f64)> {
+    let (d, a, b, r, n) = edge_edge(x, ee, ff);
+    if !(a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0) {
+        if d >= thickness {
+            // Apart and past an end: it may go round the edge's end, forgotten.
+            *s = 0;
+        }
+        return None;
+    }
+    // The side is kept relative to e x f, which means something only while the edges
+    // are not near parallel (and flips as they turn through parallel).
+    let lengths = (x[ee[1] as usize] - x[ee[0] as usize]).norm()
+        * (x[ff[1] as usize] - x[ff[0] as usize]).norm();
+    let n_len = n.norm();
+    let conditioned = n_len > PARALLEL_SINE * lengths;
+    if d >= thickness {
+        // Apart: as for a vertex and a triangle, on the other side within the reach
+        // they went through each other; else the side is learnt afresh (edges that
+        // turned). Turning through parallel flips `e x f` without crossing, so near
+        // parallel the side is forgotten.
+        if !conditioned {
+            *s = 0;
+            return None;
+        }
+        let now = side(r.dot(&n));
+        if settled_apart(s, now, d, reach) {
+            return None;
+        }
+    }
+    let (dist, dir) = if conditioned {
+        let n = n / n_len;
+        if *s == 0 {
+            *s = side(r.dot(&n));
+        }
+        let side_n = f64::from(*s) * n;
+        if r.dot(&side_n) <= 0.0 {
+            (-d, side_n)
+        } else {
+            (d, r / d)
+        }
+    } else if d > 1e-12 {
+        // Near parallel: pushed apart along the line between them (the vertex-triangle
+        // pairs of their triangles keep the sides).
+        (d, r / d)
+    } else {
+        return None;
+    };
+    Some((dist, dir, a, b))
+}
+
+/// The pairs of the vertices in no triangle (`orphans`), one query each of the triangles'
+/// tree, into `out`.
+fn orphan_pairs(search: &Search<'_>, tri_bvh: &Bvh, orphans: &[u32], out: &mut Found) {
+    for &p in orphans {
+        let q = Aabb {
+            min: search.x[p as usize],
+            max: search.x[p as usize],
+        }
+        .inflated(0.5 * search.reach);
+        tri_bvh.overlapping(&q, |t| {
+            if room_for(&mut out.vt, 1) {
+                search.vertex_pair(p, t, &mut out.vt);
+            } else {
+                out.failed = true;
+            }
+        });
+    }
+}
+
 /// The mean length of the edges `edges` at positions `x` (0 with no edge).
 fn mean_edge(x: &[Vec3], edges: &[[u32; 2]]) -> f64 {
     let total: f64 = edges
@@ -528,104 +656,27 @@ impl SelfCollision {
         };
         for (p, t, s) in self.vertex_triangle.iter_mut().map(|q| (q.0, q.1, &mut q.2)) {
             let tri = &triangles[t as usize];
-            let (d, w, r) = vertex_triangle(x, p, tri);
-            let [a, b, c] = tri.map(|i| x[i as usize]);
-            let interior = w.iter().all(|&wk| wk > 0.0);
-            let Some(normal) = (b - a).cross(&(c - a)).try_normalize(0.0) else {
-                continue;
-            };
-            if d >= thickness {
-                // Apart. Over the face on the other side of the remembered one, within the
-                // reach: it went through (a step moves a pair at most one thickness closer, so
-                // it cannot be past the reach already) and is pushed back. Else nothing
-                // crossed and the side is learnt afresh (a triangle that turned over).
-                let now = side(r.dot(&normal));
-                if !interior {
-                    // Beside the face it may go round the triangle's border: forgotten.
-                    *s = 0;
-                    continue;
-                }
-                if settled_apart(s, now, d, reach) {
-                    continue;
-                }
+            if let Some((dist, dir, w)) = vertex_triangle_contact(x, p, tri, s, thickness, reach) {
+                push(
+                    out,
+                    [p, tri[0], tri[1], tri[2]],
+                    [1.0, -w[0], -w[1], -w[2]],
+                    dist,
+                    dir,
+                );
             }
-            if *s == 0 && interior {
-                // First over the triangle's face: the side it comes from is known now.
-                *s = side(r.dot(&normal));
-            }
-            let side_n = f64::from(*s) * normal;
-            let (dist, dir) = if interior && r.dot(&side_n) <= 0.0 {
-                (-d, side_n)
-            } else if interior && *s != 0 {
-                (r.dot(&side_n), side_n)
-            } else if d > 1e-12 {
-                (d, r / d)
-            } else {
-                continue;
-            };
-            push(
-                out,
-                [p, tri[0], tri[1], tri[2]],
-                [1.0, -w[0], -w[1], -w[2]],
-                dist,
-                dir,
-            );
         }
         for (e, f, s) in self.edge_edge.iter_mut().map(|p| (p.0, p.1, &mut p.2)) {
             let (ee, ff) = (&self.edges[e as usize], &self.edges[f as usize]);
-            let (d, a, b, r, n) = edge_edge(x, ee, ff);
-            if !(a > 0.0 && a < 1.0 && b > 0.0 && b < 1.0) {
-                if d >= thickness {
-                    // Apart and past an end: it may go round the edge's end, forgotten.
-                    *s = 0;
-                }
-                continue;
+            if let Some((dist, dir, a, b)) = edge_edge_contact(x, ee, ff, s, thickness, reach) {
+                push(
+                    out,
+                    [ee[0], ee[1], ff[0], ff[1]],
+                    [1.0 - a, a, -(1.0 - b), -b],
+                    dist,
+                    dir,
+                );
             }
-            // The side is kept relative to e x f, which means something only while the edges
-            // are not near parallel (and flips as they turn through parallel).
-            let lengths = (x[ee[1] as usize] - x[ee[0] as usize]).norm()
-                * (x[ff[1] as usize] - x[ff[0] as usize]).norm();
-            let n_len = n.norm();
-            let conditioned = n_len > PARALLEL_SINE * lengths;
-            if d >= thickness {
-                // Apart: as for a vertex and a triangle, on the other side within the reach
-                // they went through each other; else the side is learnt afresh (edges that
-                // turned). Turning through parallel flips `e x f` without crossing, so near
-                // parallel the side is forgotten.
-                if !conditioned {
-                    *s = 0;
-                    continue;
-                }
-                let now = side(r.dot(&n));
-                if settled_apart(s, now, d, reach) {
-                    continue;
-                }
-            }
-            let (dist, dir) = if conditioned {
-                let n = n / n_len;
-                if *s == 0 {
-                    *s = side(r.dot(&n));
-                }
-                let side_n = f64::from(*s) * n;
-                if r.dot(&side_n) <= 0.0 {
-                    (-d, side_n)
-                } else {
-                    (d, r / d)
-                }
-            } else if d > 1e-12 {
-                // Near parallel: pushed apart along the line between them (the vertex-triangle
-                // pairs of their triangles keep the sides).
-                (d, r / d)
-            } else {
-                continue;
-            };
-            push(
-                out,
-                [ee[0], ee[1], ff[0], ff[1]],
-                [1.0 - a, a, -(1.0 - b), -b],
-                dist,
-                dir,
-            );
         }
         Ok(())
     }
@@ -895,22 +946,7 @@ impl SelfCollision {
         } else {
             found.iter_mut().enumerate().for_each(|(k, f)| part(k, f));
         }
-        // Vertices in no triangle, one query each.
-        let orphans = &mut found[0];
-        for &p in self.owners.orphans() {
-            let q = Aabb {
-                min: x[p as usize],
-                max: x[p as usize],
-            }
-            .inflated(0.5 * reach);
-            tri_bvh.overlapping(&q, |t| {
-                if room_for(&mut orphans.vt, 1) {
-                    search.vertex_pair(p, t, &mut orphans.vt);
-                } else {
-                    orphans.failed = true;
-                }
-            });
-        }
+        orphan_pairs(&search, tri_bvh, self.owners.orphans(), &mut found[0]);
         if found.iter().any(|f| f.failed) {
             return Err(oom("the pairs a look found"));
         }

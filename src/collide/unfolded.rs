@@ -441,6 +441,36 @@ fn swept_gradient(x0: &[Vec3], x1: &[Vec3], t: &[u32; 3], m: &[f64; 4]) -> Optio
     Some(span)
 }
 
+/// The border edges of `triangles` (those in one triangle), or `None` unless each edge is in
+/// at most two triangles, in opposite directions (or its list cannot be allocated).
+fn border_edges(triangles: &[[u32; 3]]) -> Option<Vec<(u32, u32)>> {
+    let mut directed: Vec<(u32, u32, bool)> = Vec::new();
+    directed.try_reserve_exact(3 * triangles.len()).ok()?;
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            directed.push((a.min(b), a.max(b), a < b));
+        }
+    }
+    directed.sort_unstable();
+    let mut border = Vec::new();
+    let mut k = 0;
+    while k < directed.len() {
+        let mut end = k + 1;
+        while end < directed.len() && directed[end].0 == directed[k].0 && directed[end].1 == directed[k].1
+        {
+            end += 1;
+        }
+        match end - k {
+            1 => border.push((directed[k].0, directed[k].1)),
+            2 if directed[k].2 != directed[k + 1].2 => {}
+            _ => return None,
+        }
+        k = end;
+    }
+    Some(border)
+}
+
 impl Sheet {
     /// The sheet's numbers, or `None` when the rest shape is not a flat convex sheet or its
     /// lists cannot be allocated.
@@ -493,31 +523,7 @@ impl Sheet {
             area += 0.5 * det;
             inverse.push([m11 / det, -m01 / det, -m10 / det, m00 / det]);
         }
-        // Each edge in at most two triangles, in opposite directions; the border edges.
-        let mut directed: Vec<(u32, u32, bool)> = Vec::new();
-        directed.try_reserve_exact(3 * triangles.len()).ok()?;
-        for t in triangles {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                directed.push((a.min(b), a.max(b), a < b));
-            }
-        }
-        directed.sort_unstable();
-        let mut border = Vec::new();
-        let mut k = 0;
-        while k < directed.len() {
-            let mut end = k + 1;
-            while end < directed.len() && directed[end].0 == directed[k].0 && directed[end].1 == directed[k].1
-            {
-                end += 1;
-            }
-            match end - k {
-                1 => border.push((directed[k].0, directed[k].1)),
-                2 if directed[k].2 != directed[k + 1].2 => {}
-                _ => return None,
-            }
-            k = end;
-        }
+        let border = border_edges(triangles)?;
         // The hull: its area is the triangles', and every border edge lies on its border.
         let mut used = Vec::new();
         used.try_reserve_exact(rest.len()).ok()?;
