@@ -678,8 +678,17 @@ impl MeshCollider {
         c.touching.resize(x.len(), false);
         c.inside.resize(x.len(), false);
         c.distance.resize(x.len(), f64::INFINITY);
+        self.vertex_contacts(x, f, margin, max_depth, out);
+        self.triangle_contacts(x, cloth_triangles, f, margin, max_depth, out);
+        self.edge_contacts(x, f, margin, max_depth, out);
+        Ok(())
+    }
+
+    /// Each cloth vertex at `x` against its nearest candidate triangle (the mesh at fraction
+    /// `f` of the call): a contact within `margin` (depth at most `max_depth`), and what the
+    /// other contacts and the continuous check read of it (touching, inside, distance).
+    fn vertex_contacts(&mut self, x: &[Vec3], f: f64, margin: f64, max_depth: f64, out: &mut Vec<Contact>) {
         let friction = self.friction;
-        // Cloth vertex against the nearest mesh triangle.
         for &i in &self.cache.with_vertex {
             let i = i as usize;
             let cands = &self.cache.vertex[i];
@@ -727,7 +736,20 @@ impl MeshCollider {
                 }
             }
         }
-        // Mesh vertex against cloth triangle.
+    }
+
+    /// Each mesh vertex against its candidate cloth triangles, where no corner of the triangle
+    /// touches the mesh already.
+    fn triangle_contacts(
+        &self,
+        x: &[Vec3],
+        cloth_triangles: &[[u32; 3]],
+        f: f64,
+        margin: f64,
+        max_depth: f64,
+        out: &mut Vec<Contact>,
+    ) {
+        let friction = self.friction;
         for &t in &self.cache.with_triangle {
             let cands = &self.cache.triangle[t as usize];
             let tri = cloth_triangles[t as usize];
@@ -767,10 +789,14 @@ impl MeshCollider {
                 });
             }
         }
-        // Mesh edge against cloth edge, where the nearest points are inside both edges (at an
-        // end, a vertex contact above takes it) and neither cloth vertex touches the mesh
-        // already: edge contacts catch what the vertices miss (a thin collider between them),
-        // and do not double the push where the cloth lies on the mesh.
+    }
+
+    /// Mesh edge against cloth edge, where the nearest points are inside both edges (at an
+    /// end, a vertex contact above takes it) and neither cloth vertex touches the mesh
+    /// already: edge contacts catch what the vertices miss (a thin collider between them),
+    /// and do not double the push where the cloth lies on the mesh.
+    fn edge_contacts(&self, x: &[Vec3], f: f64, margin: f64, max_depth: f64, out: &mut Vec<Contact>) {
+        let friction = self.friction;
         for &e in &self.cache.with_edge {
             let cands = &self.cache.edge[e as usize];
             let [i0, i1] = self.cache.cloth_edges[e as usize];
@@ -803,7 +829,6 @@ impl MeshCollider {
                 });
             }
         }
-        Ok(())
     }
 
     /// The cloth's passages through this mesh over a step (continuous check, `ccd.rs`): the
@@ -942,9 +967,168 @@ impl MeshCollider {
         margin: f64,
         skin: f64,
     ) -> Result<(), Full> {
-        let reach = margin + skin;
+        // The lists apart from the mesh they are looked up in, for the refresh's steps.
+        let mut c = std::mem::take(&mut self.cache);
+        let done = self.refresh_lists(&mut c, x, cloth_triangles, margin + skin, skin);
+        self.cache = c;
+        done
+    }
+
+    /// [`Self::refresh_candidates`] on the lists `c`, `reach` the margin and the skin.
+    fn refresh_lists(
+        &self,
+        c: &mut Candidates,
+        x: &[Vec3],
+        cloth_triangles: &[[u32; 3]],
+        reach: f64,
+        skin: f64,
+    ) -> Result<(), Full> {
         let capacity = candidate_room(x.len());
-        let c = &mut self.cache;
+        let all = c.prepare(x, cloth_triangles);
+        let mut room = Room::new(capacity.saturating_sub(c.total));
+        // The entries the lists hold once the room is spent as far as it is.
+        let refused = |c: &mut Candidates, room: &Room| {
+            c.total = capacity - room.left();
+            for &i in c.looked.iter().chain(&c.pending) {
+                c.looked_now[i as usize] = false;
+            }
+            Err(room.full.unwrap_or(Full::Entries))
+        };
+        c.looked.clear();
+        c.dirty_triangles.clear();
+        c.dirty_edges.clear();
+        c.pending.clear();
+        c.pending.extend((0..x.len() as u32).filter(|&i| {
+            all || moved(
+                &c.vertex_at[i as usize],
+                &x[i as usize],
+                c.vertex_slack[i as usize],
+            )
+        }));
+        // Rounds: the vertices that moved past their slack look, with their triangles and
+        // edges; a vertex of those triangles and edges that is past its new slack looks in the
+        // next round (rarely more than one).
+        while !c.pending.is_empty() {
+            let from = (c.dirty_triangles.len(), c.dirty_edges.len());
+            for k in 0..c.pending.len() {
+                let i = c.pending[k] as usize;
+                if !self.vertex_looks(c, &mut room, x, i, reach) {
+                    return refused(c, &room);
+                }
+                if !all {
+                    c.dirty_triangles.extend_from_slice(c.vertex_triangles.row(i));
+                    c.dirty_edges.extend_from_slice(c.vertex_edges.row(i));
+                }
+            }
+            if all {
+                c.dirty_triangles.extend(0..cloth_triangles.len() as u32);
+                c.dirty_edges.extend(0..c.cloth_edges.len() as u32);
+            } else {
+                sort_dedup_tail(&mut c.dirty_triangles, from.0);
+                sort_dedup_tail(&mut c.dirty_edges, from.1);
+            }
+            if !self.dirty_look(c, &mut room, x, cloth_triangles, skin, from) {
+                return refused(c, &room);
+            }
+            c.next_round(x, cloth_triangles, skin, all, from);
+        }
+        c.finish(all);
+        c.total = capacity - room.left();
+        Ok(())
+    }
+
+    /// Cloth vertex `i` at `x` looks up its candidate triangles within `reach` into its list
+    /// (in `room`); one that finds none inside a closed mesh takes the nearest of the whole
+    /// mesh. False when the room is spent.
+    fn vertex_looks(&self, c: &mut Candidates, room: &mut Room, x: &[Vec3], i: usize, reach: f64) -> bool {
+        let p = x[i];
+        c.vertex_at[i] = p;
+        c.looked_now[i] = true;
+        c.looked.push(i as u32);
+        let q = Aabb { min: p, max: p }.inflated(reach);
+        let Some(gap) = refill(&mut c.vertex[i], room, |push| {
+            self.tri_bvh.overlapping_apart(&q, push)
+        }) else {
+            return false;
+        };
+        c.vertex_gap[i] = gap;
+        let list = &mut c.vertex[i];
+        if list.is_empty() && self.closed && self.tri_bvh.bounds().contains(&p) {
+            // Possibly deep inside: the nearest triangle of the whole mesh decides.
+            let (tris, target) = (&self.triangles, &self.target);
+            let nearest = self.tri_bvh.nearest(&p, f64::INFINITY, |t| {
+                closest_at(target, &tris[t as usize], &p).1.norm_squared()
+            });
+            if let Some((t, _)) = nearest {
+                if !room.push(list, t) {
+                    return false;
+                }
+                // Inside, the nearest of the whole mesh changes with every move: looked up
+                // again at the next substep (outside, it is beyond reach: no contact).
+                let (w, r) = closest_at(target, &tris[t as usize], &p);
+                let n = pseudo_normal(
+                    tris,
+                    &self.neighbours,
+                    &self.face_normal,
+                    &self.vertex_normal,
+                    t,
+                    w,
+                );
+                if r.dot(&n) < 0.0 {
+                    c.vertex_at[i] = Vec3::repeat(f64::INFINITY);
+                }
+            }
+        }
+        true
+    }
+
+    /// The cloth triangles and edges made dirty in this round (from `from`) look up their
+    /// candidate mesh vertices and edges (the mesh's boxes hold the reach already; theirs grow
+    /// by the skin). False when the room is spent.
+    fn dirty_look(
+        &self,
+        c: &mut Candidates,
+        room: &mut Room,
+        x: &[Vec3],
+        cloth_triangles: &[[u32; 3]],
+        skin: f64,
+        (triangles_from, edges_from): (usize, usize),
+    ) -> bool {
+        for &t in &c.dirty_triangles[triangles_from..] {
+            let tri = &cloth_triangles[t as usize];
+            let q = Aabb::of(tri.iter().map(|&i| &x[i as usize])).inflated(skin);
+            let Some(gap) = refill(&mut c.triangle[t as usize], room, |push| {
+                self.vert_bvh.overlapping_apart(&q, push)
+            }) else {
+                return false;
+            };
+            c.triangle_gap[t as usize] = gap;
+        }
+        for &e in &c.dirty_edges[edges_from..] {
+            let [i0, i1] = c.cloth_edges[e as usize];
+            let q = Aabb::of([&x[i0 as usize], &x[i1 as usize]]).inflated(skin);
+            let Some(gap) = refill(&mut c.edge[e as usize], room, |push| {
+                self.edge_bvh.overlapping_apart(&q, push)
+            }) else {
+                return false;
+            };
+            c.edge_gap[e as usize] = gap;
+        }
+        true
+    }
+}
+
+/// Whether a vertex at `p` has moved past `slack` from `at`.
+fn moved(at: &Vec3, p: &Vec3, slack: f64) -> bool {
+    (p - at).norm_squared() > slack * slack
+}
+
+impl Candidates {
+    /// Sizes the lists for a cloth at `x` of `cloth_triangles` (its edges and incidences
+    /// found once); whether every list is looked up again (the mesh moved, or the cloth
+    /// changed), every list then emptied.
+    fn prepare(&mut self, x: &[Vec3], cloth_triangles: &[[u32; 3]]) -> bool {
+        let c = self;
         let resized = c.vertex.len() != x.len() || c.triangle.len() != cloth_triangles.len();
         if resized || c.cloth_edges.is_empty() {
             // The cloth's edges and incidences once (a moving mesh makes every call `all`).
@@ -970,144 +1154,61 @@ impl MeshCollider {
             c.total = 0;
             c.stale = false;
         }
-        let mut room = Room::new(capacity.saturating_sub(c.total));
-        // The entries the lists hold once the room is spent as far as it is.
-        let refused = |c: &mut Candidates, room: &Room| {
-            c.total = capacity - room.left();
-            for &i in c.looked.iter().chain(&c.pending) {
-                c.looked_now[i as usize] = false;
-            }
-            Err(room.full.unwrap_or(Full::Entries))
-        };
-        let moved = |at: &Vec3, p: &Vec3, slack: f64| (p - at).norm_squared() > slack * slack;
-        let bounds = self.tri_bvh.bounds();
-        c.looked.clear();
-        c.dirty_triangles.clear();
-        c.dirty_edges.clear();
-        c.pending.clear();
-        c.pending.extend((0..x.len() as u32).filter(|&i| {
-            all || moved(
-                &c.vertex_at[i as usize],
-                &x[i as usize],
-                c.vertex_slack[i as usize],
-            )
-        }));
-        // Rounds: the vertices that moved past their slack look, with their triangles and
-        // edges; a vertex of those triangles and edges that is past its new slack looks in the
-        // next round (rarely more than one).
-        while !c.pending.is_empty() {
-            let (triangles_from, edges_from) = (c.dirty_triangles.len(), c.dirty_edges.len());
-            for k in 0..c.pending.len() {
-                let i = c.pending[k] as usize;
-                let p = x[i];
-                c.vertex_at[i] = p;
-                c.looked_now[i] = true;
-                c.looked.push(i as u32);
-                let q = Aabb { min: p, max: p }.inflated(reach);
-                let Some(gap) = refill(&mut c.vertex[i], &mut room, |push| {
-                    self.tri_bvh.overlapping_apart(&q, push)
-                }) else {
-                    return refused(c, &room);
-                };
-                c.vertex_gap[i] = gap;
-                let list = &mut c.vertex[i];
-                if list.is_empty() && self.closed && bounds.contains(&p) {
-                    // Possibly deep inside: the nearest triangle of the whole mesh decides.
-                    let (tris, target) = (&self.triangles, &self.target);
-                    let nearest = self.tri_bvh.nearest(&p, f64::INFINITY, |t| {
-                        closest_at(target, &tris[t as usize], &p).1.norm_squared()
-                    });
-                    if let Some((t, _)) = nearest {
-                        if !room.push(list, t) {
-                            return refused(c, &room);
-                        }
-                        // Inside, the nearest of the whole mesh changes with every move: looked up
-                        // again at the next substep (outside, it is beyond reach: no contact).
-                        let (w, r) = closest_at(target, &tris[t as usize], &p);
-                        let n = pseudo_normal(
-                            tris,
-                            &self.neighbours,
-                            &self.face_normal,
-                            &self.vertex_normal,
-                            t,
-                            w,
-                        );
-                        if r.dot(&n) < 0.0 {
-                            c.vertex_at[i] = Vec3::repeat(f64::INFINITY);
-                        }
-                    }
-                }
-                if !all {
-                    c.dirty_triangles.extend_from_slice(c.vertex_triangles.row(i));
-                    c.dirty_edges.extend_from_slice(c.vertex_edges.row(i));
-                }
-            }
-            if all {
-                c.dirty_triangles.extend(0..cloth_triangles.len() as u32);
-                c.dirty_edges.extend(0..c.cloth_edges.len() as u32);
-            } else {
-                sort_dedup_tail(&mut c.dirty_triangles, triangles_from);
-                sort_dedup_tail(&mut c.dirty_edges, edges_from);
-            }
-            for &t in &c.dirty_triangles[triangles_from..] {
-                let tri = &cloth_triangles[t as usize];
-                // The vertices' boxes hold `reach` already; the triangle's grows by the skin.
-                let q = Aabb::of(tri.iter().map(|&i| &x[i as usize])).inflated(skin);
-                let Some(gap) = refill(&mut c.triangle[t as usize], &mut room, |push| {
-                    self.vert_bvh.overlapping_apart(&q, push)
-                }) else {
-                    return refused(c, &room);
-                };
-                c.triangle_gap[t as usize] = gap;
-            }
-            for &e in &c.dirty_edges[edges_from..] {
-                let [i0, i1] = c.cloth_edges[e as usize];
-                // The mesh edges' boxes hold `reach` already.
-                let q = Aabb::of([&x[i0 as usize], &x[i1 as usize]]).inflated(skin);
-                let Some(gap) = refill(&mut c.edge[e as usize], &mut room, |push| {
-                    self.edge_bvh.overlapping_apart(&q, push)
-                }) else {
-                    return refused(c, &room);
-                };
-                c.edge_gap[e as usize] = gap;
-            }
-            // The new slacks of the vertices that looked and of every vertex of what looked
-            // (a vertex in no triangle has only its own lookup); those past theirs look next.
-            c.affected.clear();
-            if all {
-                c.affected.extend(0..x.len() as u32);
-            } else {
-                c.affected.extend_from_slice(&c.pending);
-                c.affected.extend(
-                    c.dirty_triangles[triangles_from..]
-                        .iter()
-                        .flat_map(|&t| cloth_triangles[t as usize])
-                        .chain(
-                            c.dirty_edges[edges_from..]
-                                .iter()
-                                .flat_map(|&e| c.cloth_edges[e as usize]),
-                        ),
-                );
-                sort_dedup_tail(&mut c.affected, 0);
-            }
-            c.pending.clear();
-            for &b in &c.affected {
-                let b = b as usize;
-                let gap = c
-                    .vertex_triangles
-                    .row(b)
+        all
+    }
+
+    /// The new slacks of the vertices that looked in this round and of every vertex of the
+    /// triangles and edges that looked (from `from`; a vertex in no triangle has only its own
+    /// lookup): those past theirs look in the next round.
+    fn next_round(
+        &mut self,
+        x: &[Vec3],
+        cloth_triangles: &[[u32; 3]],
+        skin: f64,
+        all: bool,
+        (triangles_from, edges_from): (usize, usize),
+    ) {
+        let c = self;
+        c.affected.clear();
+        if all {
+            c.affected.extend(0..x.len() as u32);
+        } else {
+            c.affected.extend_from_slice(&c.pending);
+            c.affected.extend(
+                c.dirty_triangles[triangles_from..]
                     .iter()
-                    .map(|&t| c.triangle_gap[t as usize])
-                    .chain(c.vertex_edges.row(b).iter().map(|&e| c.edge_gap[e as usize]))
-                    .fold(c.vertex_gap[b], f64::min);
-                let slack = if skin > 0.0 { 0.5 * (skin + gap) } else { 0.0 };
-                c.vertex_slack[b] = slack;
-                if !c.looked_now[b] && moved(&c.vertex_at[b], &x[b], slack) {
-                    c.looked_now[b] = true;
-                    c.pending.push(b as u32);
-                }
+                    .flat_map(|&t| cloth_triangles[t as usize])
+                    .chain(
+                        c.dirty_edges[edges_from..]
+                            .iter()
+                            .flat_map(|&e| c.cloth_edges[e as usize]),
+                    ),
+            );
+            sort_dedup_tail(&mut c.affected, 0);
+        }
+        c.pending.clear();
+        for &b in &c.affected {
+            let b = b as usize;
+            let gap = c
+                .vertex_triangles
+                .row(b)
+                .iter()
+                .map(|&t| c.triangle_gap[t as usize])
+                .chain(c.vertex_edges.row(b).iter().map(|&e| c.edge_gap[e as usize]))
+                .fold(c.vertex_gap[b], f64::min);
+            let slack = if skin > 0.0 { 0.5 * (skin + gap) } else { 0.0 };
+            c.vertex_slack[b] = slack;
+            if !c.looked_now[b] && moved(&c.vertex_at[b], &x[b], slack) {
+                c.looked_now[b] = true;
+                c.pending.push(b as u32);
             }
         }
+    }
+
+    /// The refresh is done: the looked flags cleared, the dirty lists each once, and the
+    /// lists of what has candidates brought up to date.
+    fn finish(&mut self, all: bool) {
+        let c = self;
         for &i in &c.looked {
             c.looked_now[i as usize] = false;
         }
@@ -1125,8 +1226,6 @@ impl MeshCollider {
         update_with(&mut c.with_vertex, &c.vertex, &c.looked);
         update_with(&mut c.with_triangle, &c.triangle, &c.dirty_triangles);
         update_with(&mut c.with_edge, &c.edge, &c.dirty_edges);
-        c.total = capacity - room.left();
-        Ok(())
     }
 }
 

@@ -214,8 +214,8 @@ fn edge_edge_contact(
     }
     // The side is kept relative to e x f, which means something only while the edges
     // are not near parallel (and flips as they turn through parallel).
-    let lengths = (x[ee[1] as usize] - x[ee[0] as usize]).norm()
-        * (x[ff[1] as usize] - x[ff[0] as usize]).norm();
+    let lengths =
+        (x[ee[1] as usize] - x[ee[0] as usize]).norm() * (x[ff[1] as usize] - x[ff[0] as usize]).norm();
     let n_len = n.norm();
     let conditioned = n_len > PARALLEL_SINE * lengths;
     if d >= thickness {

@@ -457,8 +457,7 @@ fn border_edges(triangles: &[[u32; 3]]) -> Option<Vec<(u32, u32)>> {
     let mut k = 0;
     while k < directed.len() {
         let mut end = k + 1;
-        while end < directed.len() && directed[end].0 == directed[k].0 && directed[end].1 == directed[k].1
-        {
+        while end < directed.len() && directed[end].0 == directed[k].0 && directed[end].1 == directed[k].1 {
             end += 1;
         }
         match end - k {
