@@ -306,158 +306,290 @@ fn spring_sums<T>(
         "fractional spring damping needs the half-derivatives (ForceInput::half_derivative)"
     );
     if let Some(layout) = layout {
-        // One window per task; task k walks the contiguous groups `k * groups / tasks ..
-        // (k + 1) * groups / tasks` (which task walks a group does not change its sums). Tasks
-        // of as near equal work as whole groups allow, in order: the pool halves the list of
-        // tasks between its threads, so each thread gets the groups of one half (interleaved
-        // groups gave one thread of two 6 of 201 x 201's 10 groups and the other 4).
-        let groups = n.div_ceil(layout.group);
-        let tasks = if par {
+        spring_sums_tiled(
+            input,
+            &params,
+            layout,
+            (windows, ahead_room),
+            sources,
+            ahead,
+            finish,
+        );
+    } else {
+        debug_assert!(ahead.is_none(), "the first pass runs inside tile walks only");
+        spring_sums_untiled(t, &params, par, spring_buffer, &sources, finish);
+    }
+}
+
+/// [`spring_sums`] on a tiled topology (`layout`): the groups of tiles cut into [`Tasks`], each
+/// with its window, and with `ahead` the first pass run into windows that slide with the walk.
+fn spring_sums_tiled<T>(
+    input: &ForceInput<'_>,
+    params: &springs::Params<'_>,
+    layout: &crate::topology::TileLayout,
+    (windows, ahead_room): (&mut crate::aligned::AlignedF64, &mut crate::aligned::AlignedVec3),
+    sources: Sources<'_>,
+    ahead: Option<&Ahead<'_>>,
+    finish: T,
+) where
+    T: Fn(usize, [&mut [f64]; 3], &TileState<'_>) + Sync,
+{
+    let t = input.topology;
+    let n = input.x.len();
+    let par = parallel::worth_it(n);
+    let tk = Tasks::new(n, layout.group, par, t.tile_runs.max_offset);
+    let (tasks, band, max_offset) = (tk.count, tk.band, t.tile_runs.max_offset);
+    let w = tiles::scratch(layout);
+    windows.resize(w * tasks);
+    // The first pass's velocities and D^{1/2}x: a window of `room` particles a task (the
+    // group it walks, the springs' reach either side, a tile of rounding, [`LINED`]), and
+    // the bands.
+    let room = (layout.group + 2 * max_offset + 2 * TILE + LINED)
+        .min(n)
+        .next_multiple_of(LINED);
+    let (task_room, band_room) = if ahead.is_some() {
+        (2 * room, 4 * band)
+    } else {
+        (0, 0)
+    };
+    ahead_room.resize(tasks * task_room + tasks.saturating_sub(1) * band_room);
+    let (task_rooms, band_rooms) = ahead_room.split_at_mut(tasks * task_room);
+    if let Some(a) = ahead {
+        tk.run_bands(a, band_rooms, band_room);
+    }
+    let band_rooms = &*band_rooms;
+    // The band where tasks k - 1 and k meet: its particles and its two parts.
+    let band_of = |k: usize| {
+        let b = &band_rooms[(k - 1) * band_room..k * band_room];
+        let (bv, bh) = b.split_at(2 * band);
+        (tk.band(k), bv, bh)
+    };
+    let task_rooms = parallel::Disjoint::new(task_rooms);
+    parallel::chunks(par, &mut windows[..w * tasks], w, |first, window| {
+        let (sums, buf) = window.split_at_mut(tiles::sums_scratch(layout));
+        let k = first / w;
+        let done = tk.own(k).start;
+        // SAFETY: each task takes its own part.
+        let mine = unsafe { task_rooms.range(k * task_room..(k + 1) * task_room) };
+        let (wv, wh) = mine.split_at_mut(task_room / 2);
+        let mut win = AheadWindow {
+            v: wv,
+            h: wh,
+            lo: 0,
+            hi: 0,
+            done,
+            room,
+        };
+        for g in tk.groups(k) {
+            let c0 = g * layout.group;
+            let len = layout.group.min(n - c0);
+            let finish = |p0: usize, sums: [&mut [f64]; 3], w: &InputWindow<'_>| {
+                let len = sums[0].len();
+                finish(p0, sums, &w.tile(p0, p0 + len))
+            };
+            let start = c0.saturating_sub(max_offset);
+            let end = (c0 + len + max_offset).min(n);
+            let sources = match ahead {
+                None => sources,
+                Some(a) => {
+                    // The first pass over this task's particles up to what the group's
+                    // springs read, a tile at a time; the bands' particles (run before
+                    // the tasks) copied in.
+                    let own = tk.own(k);
+                    let target = end.max(end.next_multiple_of(TILE).min(own.end));
+                    win.reach(a, own, start, target, |at| band_of(if at { k } else { k + 1 }));
+                    let (v, h) = win.held(start..end);
+                    Sources {
+                        x: &input.x[start..end],
+                        v: Some(v),
+                        half: sources.half.map(|_| h),
+                        base: start,
+                        ..sources
+                    }
+                }
+            };
+            let mut window = InputWindow::new(sources, buf, start);
+            if layout.gather_runs > 0 {
+                tiles::spring_forces_gathered(params, t, layout, c0, len, sums, &mut window, finish);
+            } else {
+                tiles::spring_forces(params, t, c0, len, sums, &mut window, finish);
+            }
+        }
+        debug_assert!(ahead.is_none() || win.done == tk.own(k).end);
+    });
+}
+
+/// [`spring_sums`] on a topology the force pass cannot walk in tiles: every spring's force
+/// into `spring_buffer`, then each tile's sums gathered along the adjacency, its state
+/// gathered from `sources`.
+fn spring_sums_untiled<T>(
+    t: &Topology,
+    params: &springs::Params<'_>,
+    par: bool,
+    spring_buffer: &mut Soa3,
+    sources: &Sources<'_>,
+    finish: T,
+) where
+    T: Fn(usize, [&mut [f64]; 3], &TileState<'_>) + Sync,
+{
+    let n = t.vertex_count();
+    springs::compute(params, &t.spring_runs, par, spring_buffer);
+    let spring_force = spring_buffer.slices();
+    parallel::for_chunks(par, n, parallel::CHUNK, |first, len| {
+        let mut acc = [[0.0; TILE]; 3];
+        let mut state = [[0.0; TILE]; 9];
+        for p0 in (first..first + len).step_by(TILE) {
+            let m = TILE.min(first + len - p0);
+            super::assemble::add_spring_forces(t, p0, m, spring_force, &mut acc);
+            let gathered = gather(sources, p0, m, &mut state);
+            let [ax, ay, az] = &mut acc;
+            finish(p0, [&mut ax[..m], &mut ay[..m], &mut az[..m]], &gathered);
+        }
+    });
+}
+
+/// How a tiled walk of `n` particles is cut into tasks, one window each: task k walks the
+/// contiguous groups `k * groups / count .. (k + 1) * groups / count` (which task walks a group
+/// does not change its sums). Tasks of as near equal work as whole groups allow, in order: the
+/// pool halves the list of tasks between its threads, so each thread gets the groups of one
+/// half (interleaved groups gave one thread of two 6 of 201 x 201's 10 groups and the other 4).
+#[derive(Clone, Copy)]
+struct Tasks {
+    n: usize,
+    groups: usize,
+    count: usize,
+    group: usize,
+    /// The band around a task's first particle that reads across two tasks.
+    band: usize,
+}
+
+impl Tasks {
+    fn new(n: usize, group: usize, par: bool, max_offset: usize) -> Self {
+        let groups = n.div_ceil(group);
+        let count = if par {
             groups.min(2 * rayon::current_num_threads())
         } else {
             1
         };
-        let w = tiles::scratch(layout);
-        windows.resize(w * tasks);
-        let max_offset = t.tile_runs.max_offset;
-        // Task k's first particle, and the band around it that reads across two tasks.
-        let task_start = |k: usize| ((k * groups / tasks) * layout.group).min(n);
         let band = max_offset.next_multiple_of(TILE);
-        // Where each task's own run of the first pass begins and ends: the bands are run
-        // first, before the tasks (tasks are at least a group, eight offsets, long).
-        let own = |k: usize| {
-            let lo = if k == 0 { 0 } else { (task_start(k) + band).min(n) };
-            let hi = if k + 1 == tasks {
-                n
-            } else {
-                task_start(k + 1).saturating_sub(band)
-            };
-            lo..hi.max(lo)
-        };
-        // The first pass's velocities and D^{1/2}x: a window of `room` particles a task (the
-        // group it walks, the springs' reach either side, a tile of rounding), and the bands.
-        // Windows start on a particle a multiple of `LINED` from the first, so each particle
-        // sits at the same place in its cache line as in an array of the whole cloth (the
-        // walk's loads split no more lines than they did there).
-        const LINED: usize = 8;
-        let room = (layout.group + 2 * max_offset + 2 * TILE + LINED)
-            .min(n)
-            .next_multiple_of(LINED);
-        let (task_room, band_room) = if ahead.is_some() {
-            (2 * room, 4 * band)
-        } else {
-            (0, 0)
-        };
-        ahead_room.resize(tasks * task_room + tasks.saturating_sub(1) * band_room);
-        let (task_rooms, band_rooms) = ahead_room.split_at_mut(tasks * task_room);
-        if let Some(a) = ahead {
-            for (k, b) in (1..tasks).zip(band_rooms.chunks_mut(band_room)) {
-                // The particles `band_of(k)` says.
-                let c = task_start(k);
-                let r = c.saturating_sub(band)..(c + band).min(n);
-                let (bv, bh) = b.split_at_mut(2 * band);
-                (a.run)(r.clone(), &mut bv[..r.len()], &mut bh[..r.len()]);
-            }
+        Tasks {
+            n,
+            groups,
+            count,
+            group,
+            band,
         }
-        let band_rooms = &*band_rooms;
-        // The band where tasks k - 1 and k meet: its particles and its two parts.
-        let band_of = |k: usize| {
-            let b = &band_rooms[(k - 1) * band_room..k * band_room];
-            let (bv, bh) = b.split_at(2 * band);
-            let c = task_start(k);
-            (c.saturating_sub(band)..(c + band).min(n), bv, bh)
+    }
+
+    /// Task k's groups.
+    fn groups(&self, k: usize) -> std::ops::Range<usize> {
+        k * self.groups / self.count..(k + 1) * self.groups / self.count
+    }
+
+    /// Task k's first particle.
+    fn start(&self, k: usize) -> usize {
+        ((k * self.groups / self.count) * self.group).min(self.n)
+    }
+
+    /// Where task k's own run of the first pass begins and ends: the bands are run first,
+    /// before the tasks (tasks are at least a group, eight offsets, long).
+    fn own(&self, k: usize) -> std::ops::Range<usize> {
+        let lo = if k == 0 {
+            0
+        } else {
+            (self.start(k) + self.band).min(self.n)
         };
-        let task_rooms = parallel::Disjoint::new(task_rooms);
-        parallel::chunks(par, &mut windows[..w * tasks], w, |first, window| {
-            let (sums, buf) = window.split_at_mut(tiles::sums_scratch(layout));
-            let k = first / w;
-            let mut done = own(k).start;
-            // SAFETY: each task takes its own part.
-            let mine = unsafe { task_rooms.range(k * task_room..(k + 1) * task_room) };
-            let (wv, wh) = mine.split_at_mut(task_room / 2);
-            // The window holds particles `lo .. hi` at `wv[0..]`, `wh[0..]`.
-            let (mut lo, mut hi) = (0, 0);
-            for g in k * groups / tasks..(k + 1) * groups / tasks {
-                let c0 = g * layout.group;
-                let len = layout.group.min(n - c0);
-                let finish = |p0: usize, sums: [&mut [f64]; 3], w: &InputWindow<'_>| {
-                    let len = sums[0].len();
-                    finish(p0, sums, &w.tile(p0, p0 + len))
-                };
-                let start = c0.saturating_sub(max_offset);
-                let end = (c0 + len + max_offset).min(n);
-                let sources = match ahead {
-                    None => sources,
-                    Some(a) => {
-                        // The first pass over this task's particles up to what the group's
-                        // springs read, a tile at a time; the bands' particles (run before
-                        // the tasks) copied in.
-                        let own = own(k);
-                        let target = end.max(end.next_multiple_of(TILE).min(own.end));
-                        // The window slides to what the group's springs read when it would
-                        // not hold them (never on a cloth it holds whole).
-                        if hi <= start {
-                            (lo, hi) = (start - start % LINED, start - start % LINED);
-                        } else if target - lo > room {
-                            let from = start - start % LINED;
-                            wv.copy_within(from - lo..hi - lo, 0);
-                            wh.copy_within(from - lo..hi - lo, 0);
-                            lo = from;
-                        }
-                        while hi < target {
-                            let next = if own.contains(&hi) {
-                                debug_assert_eq!(hi, done);
-                                let e = target.next_multiple_of(TILE).min(own.end);
-                                (a.run)(hi..e, &mut wv[hi - lo..e - lo], &mut wh[hi - lo..e - lo]);
-                                done = e;
-                                e
-                            } else {
-                                // A band's particles: the one the task starts in, or ends in.
-                                let (b, bv, bh) = band_of(if hi < own.start { k } else { k + 1 });
-                                let e = target.min(b.end);
-                                wv[hi - lo..e - lo].copy_from_slice(&bv[hi - b.start..e - b.start]);
-                                wh[hi - lo..e - lo].copy_from_slice(&bh[hi - b.start..e - b.start]);
-                                e
-                            };
-                            debug_assert!(next > hi, "the window did not grow");
-                            if next <= hi {
-                                break;
-                            }
-                            hi = next;
-                        }
-                        Sources {
-                            x: &input.x[start..end],
-                            v: Some(&wv[start - lo..end - lo]),
-                            half: sources.half.map(|_| &wh[start - lo..end - lo]),
-                            base: start,
-                            ..sources
-                        }
-                    }
-                };
-                let mut window = InputWindow::new(sources, buf, start);
-                if layout.gather_runs > 0 {
-                    tiles::spring_forces_gathered(&params, t, layout, c0, len, sums, &mut window, finish);
-                } else {
-                    tiles::spring_forces(&params, t, c0, len, sums, &mut window, finish);
-                }
+        let hi = if k + 1 == self.count {
+            self.n
+        } else {
+            self.start(k + 1).saturating_sub(self.band)
+        };
+        lo..hi.max(lo)
+    }
+
+    /// The first pass over the bands where tasks meet, into `rooms` (`room` each: the
+    /// velocities, then the half-derivatives), before the tasks run.
+    fn run_bands(&self, a: &Ahead<'_>, rooms: &mut [Vec3], room: usize) {
+        for (k, b) in (1..self.count).zip(rooms.chunks_mut(room)) {
+            let r = self.band(k);
+            let (bv, bh) = b.split_at_mut(2 * self.band);
+            (a.run)(r.clone(), &mut bv[..r.len()], &mut bh[..r.len()]);
+        }
+    }
+
+    /// The particles of the band where tasks k - 1 and k meet.
+    fn band(&self, k: usize) -> std::ops::Range<usize> {
+        let c = self.start(k);
+        c.saturating_sub(self.band)..(c + self.band).min(self.n)
+    }
+}
+
+/// A task's window of the first pass's velocities and D^{1/2}x ([`Ahead`]): particles
+/// `lo .. hi` at `v[0..]`, `h[0..]`, at most `room`, slid along the task's walk; `done` the
+/// end of what the task has run of its own particles.
+struct AheadWindow<'w> {
+    v: &'w mut [Vec3],
+    h: &'w mut [Vec3],
+    lo: usize,
+    hi: usize,
+    done: usize,
+    room: usize,
+}
+
+/// Windows start on a particle a multiple of this from the first, so each particle sits at the
+/// same place in its cache line as in an array of the whole cloth (the walk's loads split no
+/// more lines than they did there).
+const LINED: usize = 8;
+
+impl AheadWindow<'_> {
+    /// Makes the window hold particles `start .. target`: slid to `start` when it would not
+    /// hold them (never on a cloth it holds whole), then grown by the first pass over the
+    /// task's `own` particles and by copies of the bands' (`band(true)` the band the task
+    /// starts in, `band(false)` the one it ends in: its particles and their two parts).
+    fn reach<'b>(
+        &mut self,
+        a: &Ahead<'_>,
+        own: std::ops::Range<usize>,
+        start: usize,
+        target: usize,
+        band: impl Fn(bool) -> (std::ops::Range<usize>, &'b [Vec3], &'b [Vec3]),
+    ) {
+        let (wv, wh) = (&mut *self.v, &mut *self.h);
+        let (lo, hi) = (&mut self.lo, &mut self.hi);
+        if *hi <= start {
+            (*lo, *hi) = (start - start % LINED, start - start % LINED);
+        } else if target - *lo > self.room {
+            let from = start - start % LINED;
+            wv.copy_within(from - *lo..*hi - *lo, 0);
+            wh.copy_within(from - *lo..*hi - *lo, 0);
+            *lo = from;
+        }
+        while *hi < target {
+            let next = if own.contains(hi) {
+                debug_assert_eq!(*hi, self.done);
+                let e = target.next_multiple_of(TILE).min(own.end);
+                (a.run)(*hi..e, &mut wv[*hi - *lo..e - *lo], &mut wh[*hi - *lo..e - *lo]);
+                self.done = e;
+                e
+            } else {
+                let (b, bv, bh) = band(*hi < own.start);
+                let e = target.min(b.end);
+                wv[*hi - *lo..e - *lo].copy_from_slice(&bv[*hi - b.start..e - b.start]);
+                wh[*hi - *lo..e - *lo].copy_from_slice(&bh[*hi - b.start..e - b.start]);
+                e
+            };
+            debug_assert!(next > *hi, "the window did not grow");
+            if next <= *hi {
+                break;
             }
-            debug_assert!(ahead.is_none() || done == own(k).end);
-        });
-    } else {
-        debug_assert!(ahead.is_none(), "the first pass runs inside tile walks only");
-        springs::compute(&params, &t.spring_runs, par, spring_buffer);
-        let spring_force = spring_buffer.slices();
-        parallel::for_chunks(par, n, parallel::CHUNK, |first, len| {
-            let mut acc = [[0.0; TILE]; 3];
-            let mut state = [[0.0; TILE]; 9];
-            for p0 in (first..first + len).step_by(TILE) {
-                let m = TILE.min(first + len - p0);
-                super::assemble::add_spring_forces(t, p0, m, spring_force, &mut acc);
-                let gathered = gather(&sources, p0, m, &mut state);
-                let [ax, ay, az] = &mut acc;
-                finish(p0, [&mut ax[..m], &mut ay[..m], &mut az[..m]], &gathered);
-            }
-        });
+            *hi = next;
+        }
+    }
+
+    /// The velocities and D^{1/2}x of particles `r`, which the window holds.
+    fn held(&self, r: std::ops::Range<usize>) -> (&[Vec3], &[Vec3]) {
+        let (a, b) = (r.start - self.lo, r.end - self.lo);
+        (&self.v[a..b], &self.h[a..b])
     }
 }
 

@@ -261,6 +261,21 @@ fn run_kernel<'a, const UNIFORM: bool, const TWO: bool>(
 
 crate::simd_dispatch! { pub(super) fn run_choice_widest(p: &Params<'_>, run: &SpringRun, choice: &Choice, select: &[u8], first_slot: usize, out: [&mut [f64]; 3]) => run_kernel_choice }
 
+// Slot t's place of one end: `second` when `on`, else `first`. Both are loaded and one kept
+// by a mask on the bits (a select of two loads would be compiled as a gather, slower).
+macro_rules! pick {
+    ($first:expr, $second:expr, $on:expr, $t:expr) => {{
+        let (f, s, t) = ($first, $second, $t);
+        let m = 0u64.wrapping_sub(u64::from($on));
+        let keep = |a: f64, b: f64| f64::from_bits((a.to_bits() & !m) | (b.to_bits() & m));
+        [
+            keep(f[0][t], s[0][t]),
+            keep(f[1][t], s[1][t]),
+            keep(f[2][t], s[2][t]),
+        ]
+    }};
+}
+
 /// Slots `first_slot ..` of the choice run `run` (`crate::topology::Choice`: slot t's ends are at
 /// `key + a[select & 1]` and `key + b[(select >> 1) & 1]`, `key = first_vertex + t`), as many as
 /// `out` holds; `select` holds those slots' select bytes. Each slot loads both places of each
@@ -298,20 +313,6 @@ fn run_kernel_choice<'a>(
     let rest = &p.rest[first_slot..first_slot + n];
     let (ks, kd) = (p.stiffness[usize::from(run.kind)], p.kd[usize::from(run.kind)]);
     let undamped = kd == 0.0;
-    // Slot t's place of one end: `second` when `on`, else `first`. Both are loaded and one kept
-    // by a mask on the bits (a select of two loads would be compiled as a gather, slower).
-    macro_rules! pick {
-        ($first:expr, $second:expr, $on:expr, $t:expr) => {{
-            let (f, s, t) = ($first, $second, $t);
-            let m = 0u64.wrapping_sub(u64::from($on));
-            let keep = |a: f64, b: f64| f64::from_bits((a.to_bits() & !m) | (b.to_bits() & m));
-            [
-                keep(f[0][t], s[0][t]),
-                keep(f[1][t], s[1][t]),
-                keep(f[2][t], s[2][t]),
-            ]
-        }};
-    }
     let mut outside = false;
     for t in 0..n {
         let (i_at, j_at) = (select[t] & 1 != 0, select[t] & 2 != 0);
@@ -333,44 +334,68 @@ fn run_kernel_choice<'a>(
         fz[t] = s * l[2];
     }
     if outside {
-        // The selected places, then the exact pass over them.
-        let mut places = [[0.0; crate::parallel::TILE]; 12];
-        for start in (0..n).step_by(crate::parallel::TILE) {
-            let m = (n - start).min(crate::parallel::TILE);
-            for t in 0..m {
-                let s = start + t;
-                let (i_at, j_at) = (select[s] & 1 != 0, select[s] & 2 != 0);
-                let v = [
-                    pick!(xa, xb, i_at, s),
-                    pick!(xc, xd, j_at, s),
-                    pick!(qa, qb, i_at, s),
-                    pick!(qc, qd, j_at, s),
-                ];
-                for (k, w) in v.iter().enumerate() {
-                    for c in 0..3 {
-                        places[3 * k + c][t] = w[c];
-                    }
+        exact_choice(
+            undamped,
+            (ks, kd, rest),
+            select,
+            [xa, xb, xc, xd],
+            [qa, qb, qc, qd],
+            [fx, fy, fz],
+        );
+    }
+}
+
+/// [`run_kernel_choice`]'s exact pass, for a run some slot of which fell outside the fast
+/// kernel's range: the selected places of both ends gathered a tile at a time, then
+/// [`exact_kernel`] over them.
+#[cold]
+#[allow(clippy::type_complexity)]
+fn exact_choice(
+    undamped: bool,
+    (ks, kd, rest): (f64, f64, &[f64]),
+    select: &[u8],
+    [xa, xb, xc, xd]: [[&[f64]; 3]; 4],
+    [qa, qb, qc, qd]: [[&[f64]; 3]; 4],
+    [fx, fy, fz]: [&mut [f64]; 3],
+) {
+    let n = fx.len();
+    // The selected places, then the exact pass over them.
+    let mut places = [[0.0; crate::parallel::TILE]; 12];
+    for start in (0..n).step_by(crate::parallel::TILE) {
+        let m = (n - start).min(crate::parallel::TILE);
+        for t in 0..m {
+            let s = start + t;
+            let (i_at, j_at) = (select[s] & 1 != 0, select[s] & 2 != 0);
+            let v = [
+                pick!(xa, xb, i_at, s),
+                pick!(xc, xd, j_at, s),
+                pick!(qa, qb, i_at, s),
+                pick!(qc, qd, j_at, s),
+            ];
+            for (k, w) in v.iter().enumerate() {
+                for c in 0..3 {
+                    places[3 * k + c][t] = w[c];
                 }
             }
-            let [x0, x1, x2, y0, y1, y2, q0, q1, q2, r0, r1, r2] = &places;
-            fn part(a: &[f64; crate::parallel::TILE], m: usize) -> &[f64] {
-                &a[..m]
-            }
-            let part = |a| part(a, m);
-            exact_kernel(
-                undamped,
-                [part(x0), part(x1), part(x2)],
-                [part(y0), part(y1), part(y2)],
-                [part(q0), part(q1), part(q2)],
-                [part(r0), part(r1), part(r2)],
-                |t| (ks, kd, rest[start + t]),
-                [
-                    &mut fx[start..start + m],
-                    &mut fy[start..start + m],
-                    &mut fz[start..start + m],
-                ],
-            );
         }
+        let [x0, x1, x2, y0, y1, y2, q0, q1, q2, r0, r1, r2] = &places;
+        fn part(a: &[f64; crate::parallel::TILE], m: usize) -> &[f64] {
+            &a[..m]
+        }
+        let part = |a| part(a, m);
+        exact_kernel(
+            undamped,
+            [part(x0), part(x1), part(x2)],
+            [part(y0), part(y1), part(y2)],
+            [part(q0), part(q1), part(q2)],
+            [part(r0), part(r1), part(r2)],
+            |t| (ks, kd, rest[start + t]),
+            [
+                &mut fx[start..start + m],
+                &mut fy[start..start + m],
+                &mut fz[start..start + m],
+            ],
+        );
     }
 }
 
