@@ -161,13 +161,8 @@ pub struct Cloth {
     config: ClothConfig,
     /// Positions, velocities, time, steps and the memories (`state.rs`).
     state: state::State,
-    /// Fully pinned (weight 1): the solver treats these as prescribed.
-    pinned: Vec<bool>,
-    /// Pin weight of every vertex in [0, 1]; 0 = free.
-    pin_weight: Vec<f64>,
-    /// Vertices with a weight > 0, in the order they were pinned.
-    pin_list: Vec<u32>,
-    pin_target: Vec<Vec3>,
+    /// The pins as the host set them (`pins.rs`).
+    pins: pins::Pins,
     /// Colliders by id, each with its friction coefficient.
     collider_slots: Vec<Option<ColliderSlot>>,
     colliders: Vec<Collider>,
@@ -216,7 +211,7 @@ impl Cloth {
             Scheme::SumOfExponentials { .. } => 24 * (64 + 2),
             Scheme::Off => 0,
         };
-        let self_collision_bytes = if config.model.self_collision_thickness > 0.0 {
+        let self_collision_bytes = if config.model.self_collision_on() {
             crate::memory::SELF_COLLISION_BYTES_PER_PARTICLE
         } else {
             0
@@ -246,10 +241,12 @@ impl Cloth {
             config.model.self_collision_thickness,
         )?;
         Ok(Self {
-            pinned: vec![false; n],
-            pin_weight: vec![0.0; n],
-            pin_list: Vec::new(),
-            pin_target: topology.rest_positions.clone(),
+            pins: pins::Pins {
+                pinned: vec![false; n],
+                weight: vec![0.0; n],
+                list: Vec::new(),
+                target: topology.rest_positions.clone(),
+            },
             collider_slots: Vec::new(),
             colliders: Vec::new(),
             friction: Vec::new(),
@@ -424,8 +421,8 @@ impl Cloth {
     pub fn set_positions(&mut self, x: &[Vec3]) -> Result<(), Error> {
         self.check_all(x, "position")?;
         self.state.x.copy_from_slice(x);
-        for &i in &self.pin_list {
-            self.pin_target[i as usize] = x[i as usize];
+        for &i in &self.pins.list {
+            self.pins.target[i as usize] = x[i as usize];
         }
         // Teleported: the sides self-collision remembered no longer hold.
         self.self_collision.set_pairs(Vec::new(), Vec::new());
@@ -780,7 +777,7 @@ impl Cloth {
         if w.coarse_added_mass > 0.0 {
             let s = |i: usize| projected[i] * normals[i].dot(&self.state.v[i]);
             match &self.scratch.coarse {
-                Some(c) if c.built_for(w.coarse_added_mass, w.coarse_length, &self.pinned) => {
+                Some(c) if c.built_for(w.coarse_added_mass, w.coarse_length, &self.pins.pinned) => {
                     e += c.kinetic_energy(s);
                 }
                 // Not stepped yet with these pins: the level the next step will build.
@@ -789,7 +786,7 @@ impl Cloth {
                         t,
                         w.coarse_added_mass,
                         w.coarse_length,
-                        &self.pinned,
+                        &self.pins.pinned,
                     ) {
                         e += c.kinetic_energy(s);
                     }

@@ -215,6 +215,12 @@ impl Model {
         }
     }
 
+    /// Whether the cloth keeps apart from itself (a self-collision thickness in metres; a
+    /// cloth's model has its thickness in spacings resolved into it).
+    pub fn self_collision_on(&self) -> bool {
+        self.self_collision_thickness > 0.0
+    }
+
     /// Checks every coefficient; the cloth is never built from a model that fails this.
     pub fn validate(&self) -> Result<(), Error> {
         check_positive("cloth_density", self.cloth_density)?;

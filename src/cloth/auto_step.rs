@@ -154,7 +154,9 @@ impl Cloth {
                     if tracks {
                         let t = &self.topology;
                         let (start, end) = (&self.scratch.motion_v, &self.state.v);
-                        self.state.motion.update(&t.masses, &self.pinned, start, end, dt);
+                        self.state
+                            .motion
+                            .update(&t.masses, &self.pins.pinned, start, end, dt);
                     }
                     self.step_stats = StepStats {
                         // Self-collision may have split some (`split.rs`).
@@ -243,7 +245,7 @@ impl Cloth {
         let rate = damping_rate(m);
         let mut floor = f64::INFINITY;
         for i in 0..self.state.x.len() {
-            if self.pinned[i] {
+            if self.pins.pinned[i] {
                 continue;
             }
             let inertia = Inertia::of(m, t.masses[i], t.areas[i], Vec3::z(), 0.0);
@@ -294,9 +296,9 @@ impl Cloth {
             }
         }
         // Pins travel at most one rest length of their springs per substep.
-        for &p in &self.pin_list {
+        for &p in &self.pins.list {
             let p = p as usize;
-            let travel = (self.pin_target[p] - self.state.x[p]).norm();
+            let travel = (self.pins.target[p] - self.state.x[p]).norm();
             let shortest = t
                 .vertex_springs
                 .row(p)

@@ -210,7 +210,7 @@ impl Cloth {
             .map_err(|why| Self::too_many_candidates(id, mesh, margin, self.state.x.len(), why))?;
         }
         let mesh_contacts = s.contacts.len();
-        if m.self_collision_thickness > 0.0 {
+        if m.self_collision_on() {
             self.self_collision.contacts(
                 &self.state.x,
                 &self.topology.rest_positions,
@@ -232,7 +232,7 @@ impl Cloth {
                 |i: usize| crate::forces::Inertia::of(m, t.masses[i], t.areas[i], normals[i], projected[i]);
             contact::inertia_scale(
                 &mut s.contacts[mesh_contacts..],
-                &self.pinned,
+                &self.pins.pinned,
                 |i, n| inertia(i).effective_force(n) / t.masses[i],
                 |i| 1.0 / inertia(i).isotropic(),
             );
@@ -261,7 +261,7 @@ impl Cloth {
             h,
             &s.v_step,
             &self.topology.masses,
-            &self.pinned,
+            &self.pins.pinned,
             &mut s.v_new,
         )
     }
@@ -300,7 +300,7 @@ impl Cloth {
             for p in &s.mesh_passages {
                 for &i in &p.cloth {
                     let i = i as usize;
-                    if !self.pinned[i] {
+                    if !self.pins.pinned[i] {
                         s.x_new[i] = self.state.x[i] + p.carry;
                         s.v_new[i] = p.carry / h;
                         s.carried.push(i as u32);
@@ -321,10 +321,10 @@ impl Cloth {
     /// out-of-memory error (the state left unchanged) when the zones' union-find, one number
     /// a vertex, cannot be allocated the first time a step needs it.
     pub(super) fn impact_zones(&mut self, h: f64) -> Result<usize, Error> {
-        let thickness = self.config.model.self_collision_thickness;
-        if thickness <= 0.0 {
+        if !self.config.model.self_collision_on() {
             return Ok(0);
         }
+        let thickness = self.config.model.self_collision_thickness;
         let tolerance = PASSAGE_TOLERANCE * thickness;
         self.self_collision.watch_guard(
             &self.state.x,
@@ -353,9 +353,9 @@ impl Cloth {
         } = &mut self.scratch;
         // Vertices a mesh carried this step are held like pins.
         let kinematic = if carried.is_empty() {
-            &self.pinned
+            &self.pins.pinned
         } else {
-            kinematic.clone_from(&self.pinned);
+            kinematic.clone_from(&self.pins.pinned);
             for &i in carried.iter() {
                 kinematic[i as usize] = true;
             }
@@ -424,10 +424,10 @@ impl Cloth {
     /// saying by how much it is over ([`StepLimit::Refuse`]: the driver splits the step), or
     /// is moved only that far, its velocity scaled alike ([`StepLimit::Slow`]).
     pub(super) fn limit_collision_step(&mut self, plan: &StepPlan) -> Limited {
-        let thickness = self.config.model.self_collision_thickness;
-        if thickness <= 0.0 {
+        if !self.config.model.self_collision_on() {
             return Limited::Slowed(0);
         }
+        let thickness = self.config.model.self_collision_thickness;
         let limit = SELF_COLLISION_STEP_LIMIT * thickness;
         let s = &mut self.scratch;
         // Most steps move no vertex that far: one pass without branches says so (its bound a
@@ -436,7 +436,7 @@ impl Cloth {
         if !any_past_widest(
             bytemuck::cast_slice(&s.x_new),
             bytemuck::cast_slice(&self.state.x),
-            &self.pinned,
+            &self.pins.pinned,
             limit * limit * (1.0 - 1e-12),
         ) {
             return Limited::Slowed(0);
@@ -454,7 +454,7 @@ impl Cloth {
         // root only for a vertex over it; a NaN displacement is left to the step's check).
         let over = |x_new: &[Vec3], i: usize| {
             let len2 = (x_new[i] - self.state.x[i]).norm_squared();
-            (!self.pinned[i] && len2 > limit * limit && !len2.is_nan())
+            (!self.pins.pinned[i] && len2 > limit * limit && !len2.is_nan())
                 .then(|| len2.sqrt())
                 .filter(|&len| len > limit)
         };

@@ -51,7 +51,7 @@ impl Cloth {
         // A refused second half needs the start back: one more copy of the state, with
         // self-collision only (61 x 41 symplectic2 at a fixed 1/30 s, self-collision 4 mm, 32
         // pieces a frame: 9.0-9.4 s a 12 s bake against 8.9 s without the copy, `water_sweep`).
-        let refusable = self.config.model.self_collision_thickness > 0.0;
+        let refusable = self.config.model.self_collision_on();
         let limit = match refusable {
             true => plan.limit,
             false => StepLimit::Slow,

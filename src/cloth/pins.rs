@@ -11,6 +11,19 @@ use super::Cloth;
 use crate::error::{check_finite_vec, Error};
 use crate::math::Vec3;
 
+/// The pins as the host set them: what a snapshot carries of them.
+#[derive(Clone, Debug)]
+pub(super) struct Pins {
+    /// Fully pinned (weight 1): the solver treats these as prescribed.
+    pub pinned: Vec<bool>,
+    /// Pin weight of every vertex in [0, 1]; 0 = free.
+    pub weight: Vec<f64>,
+    /// Vertices with a weight > 0, in the order they were pinned.
+    pub list: Vec<u32>,
+    /// Where each pinned vertex is to be at the end of the next call, m.
+    pub target: Vec<Vec3>,
+}
+
 /// The pins' buffers a step reuses.
 #[derive(Clone, Debug, Default)]
 pub(super) struct PinPaths {
@@ -37,7 +50,7 @@ pub(super) fn check_weight(i: usize, w: f64) -> Result<(), Error> {
 impl Cloth {
     /// Pinned vertex indices, in the order they were given.
     pub fn pinned(&self) -> &[u32] {
-        &self.pin_list
+        &self.pins.list
     }
 
     /// Replaces the pinned set: the listed vertices are fully pinned (weight 1), every other
@@ -83,10 +96,10 @@ impl Cloth {
         }
         for &i in indices {
             let i = i as usize;
-            if self.pin_weight[i] > 0.0 {
-                self.pin_weight[i] = 0.0;
-                self.pinned[i] = false;
-                self.pin_list.retain(|&p| p as usize != i);
+            if self.pins.weight[i] > 0.0 {
+                self.pins.weight[i] = 0.0;
+                self.pins.pinned[i] = false;
+                self.pins.list.retain(|&p| p as usize != i);
             }
             self.pin(i, weight);
         }
@@ -95,22 +108,22 @@ impl Cloth {
 
     /// Pin weight of every vertex.
     pub fn pin_weights(&self) -> &[f64] {
-        &self.pin_weight
+        &self.pins.weight
     }
 
     fn clear_pins(&mut self) {
-        self.pinned.fill(false);
-        self.pin_weight.fill(0.0);
-        self.pin_list.clear();
+        self.pins.pinned.fill(false);
+        self.pins.weight.fill(0.0);
+        self.pins.list.clear();
     }
 
     /// Pins free vertex `i` with weight `w` (nothing for w = 0) at its current position.
     fn pin(&mut self, i: usize, w: f64) {
-        if w > 0.0 && self.pin_weight[i] == 0.0 {
-            self.pin_weight[i] = w;
-            self.pinned[i] = w == 1.0;
-            self.pin_list.push(i as u32);
-            self.pin_target[i] = self.state.x[i];
+        if w > 0.0 && self.pins.weight[i] == 0.0 {
+            self.pins.weight[i] = w;
+            self.pins.pinned[i] = w == 1.0;
+            self.pins.list.push(i as u32);
+            self.pins.target[i] = self.state.x[i];
         }
     }
 
@@ -126,13 +139,13 @@ impl Cloth {
         }
         for (&i, t) in indices.iter().zip(targets) {
             let i = self.check_index(i)?;
-            if self.pin_weight[i] == 0.0 {
+            if self.pins.weight[i] == 0.0 {
                 return Err(Error::invalid(format!("vertex {i} is not pinned")));
             }
             check_finite_vec("pin target", t)?;
         }
         for (&i, t) in indices.iter().zip(targets) {
-            self.pin_target[i as usize] = *t;
+            self.pins.target[i as usize] = *t;
         }
         Ok(())
     }
@@ -141,7 +154,7 @@ impl Cloth {
     pub(super) fn start_pin_paths(&mut self) {
         let start = &mut self.scratch.pins.start;
         start.clear();
-        start.extend(self.pin_list.iter().map(|&i| self.state.x[i as usize]));
+        start.extend(self.pins.list.iter().map(|&i| self.state.x[i as usize]));
     }
 
     /// Where every pin is at the end of the step: its target, the plan's fraction of the way
@@ -149,17 +162,17 @@ impl Cloth {
     /// its mid goal. Also lists the hard pins for the velocity pass.
     pub(super) fn pin_goals(&mut self, plan: &StepPlan) {
         let p = &mut self.scratch.pins;
-        for (k, &i) in self.pin_list.iter().enumerate() {
+        for (k, &i) in self.pins.list.iter().enumerate() {
             let i = i as usize;
             p.goal[i] = match (plan.stage, plan.fraction) {
                 (Stage::FirstHalf, _) => p.mid[k],
-                (_, Some(f)) => p.start[k] + f * (self.pin_target[i] - p.start[k]),
-                (_, None) => self.pin_target[i],
+                (_, Some(f)) => p.start[k] + f * (self.pins.target[i] - p.start[k]),
+                (_, None) => self.pins.target[i],
             };
         }
         p.hard.clear();
         p.hard
-            .extend(self.pin_list.iter().filter(|&&i| self.pinned[i as usize]));
+            .extend(self.pins.list.iter().filter(|&&i| self.pins.pinned[i as usize]));
         p.hard.sort_unstable();
     }
 
@@ -174,11 +187,11 @@ impl Cloth {
         let fmid = 0.5 * (f0 + f1.unwrap_or(1.0));
         let p = &mut self.scratch.pins;
         p.mid.clear();
-        for (k, &i) in self.pin_list.iter().enumerate() {
+        for (k, &i) in self.pins.list.iter().enumerate() {
             let i = i as usize;
-            let along = |f: f64| p.start[k] + f * (self.pin_target[i] - p.start[k]);
-            let end = f1.map_or(self.pin_target[i], along);
-            p.mid.push(if self.pinned[i] {
+            let along = |f: f64| p.start[k] + f * (self.pins.target[i] - p.start[k]);
+            let end = f1.map_or(self.pins.target[i], along);
+            p.mid.push(if self.pins.pinned[i] {
                 0.625 * self.state.x[i] + 0.375 * end + (0.125 * h) * self.state.v[i]
             } else {
                 along(fmid)
@@ -193,9 +206,9 @@ impl Cloth {
     /// into the next through the mid goal, a recurrence whose error after a kink in the path
     /// never dies out.)
     pub(super) fn keep_pin_secants(&mut self, whole_v: &[Vec3]) {
-        for &i in &self.pin_list {
+        for &i in &self.pins.list {
             let i = i as usize;
-            if self.pinned[i] {
+            if self.pins.pinned[i] {
                 self.state.v[i] = whole_v[i];
             }
         }
@@ -206,12 +219,12 @@ impl Cloth {
         let s = &self.scratch;
         out.clear();
         out.extend_from_slice(&s.x_new);
-        for &i in &self.pin_list {
+        for &i in &self.pins.list {
             let i = i as usize;
             let goal = s.pins.goal[i];
-            out[i] = match self.pinned[i] {
+            out[i] = match self.pins.pinned[i] {
                 true => goal,
-                false => s.x_new[i] + self.pin_weight[i] * (goal - s.x_new[i]),
+                false => s.x_new[i] + self.pins.weight[i] * (goal - s.x_new[i]),
             };
         }
     }
@@ -221,10 +234,10 @@ impl Cloth {
     pub(super) fn pins(&mut self, h: f64) {
         let s = &mut self.scratch;
         let goal = &s.pins.goal;
-        for &i in &self.pin_list {
+        for &i in &self.pins.list {
             let i = i as usize;
-            let w = self.pin_weight[i];
-            if self.pinned[i] {
+            let w = self.pins.weight[i];
+            if self.pins.pinned[i] {
                 s.x_new[i] = goal[i];
                 s.v_new[i] = s.v_step[i];
             } else {

@@ -274,12 +274,12 @@ impl Cloth {
         w.u32(self.config.solver.max_iterations);
         w.vec3s(&self.state.x);
         w.vec3s(&self.state.v);
-        w.f64s(&self.pin_weight);
-        w.u64(self.pin_list.len() as u64);
-        for &i in &self.pin_list {
+        w.f64s(&self.pins.weight);
+        w.u64(self.pins.list.len() as u64);
+        for &i in &self.pins.list {
             w.u32(i);
         }
-        w.vec3s(&self.pin_target);
+        w.vec3s(&self.pins.target);
         w.u64(self.collider_slots.len() as u64);
         for slot in &self.collider_slots {
             match slot {
@@ -547,15 +547,15 @@ impl Cloth {
         std::mem::swap(&mut self.config.solver, &mut s.solver);
         self.state.x.swap_with_slice(&mut s.x);
         self.state.v.swap_with_slice(&mut s.v);
-        swap_contents(&mut self.pin_weight, &mut s.weights);
-        swap_contents(&mut self.pin_target, &mut s.targets);
-        std::mem::swap(&mut self.pin_list, &mut s.pin_list);
+        swap_contents(&mut self.pins.weight, &mut s.weights);
+        swap_contents(&mut self.pins.target, &mut s.targets);
+        std::mem::swap(&mut self.pins.list, &mut s.pin_list);
         std::mem::swap(&mut self.collider_slots, &mut s.collider_slots);
         std::mem::swap(&mut self.state.histories, &mut s.histories);
         std::mem::swap(&mut self.mesh_slots, &mut s.meshes);
         std::mem::swap(&mut self.state.motion, &mut s.motion);
         std::mem::swap(&mut self.state.skin_mean, &mut s.skin_mean);
-        for (p, &w) in self.pinned.iter_mut().zip(&self.pin_weight) {
+        for (p, &w) in self.pins.pinned.iter_mut().zip(&self.pins.weight) {
             *p = w == 1.0;
         }
         self.rebuild_colliders();
@@ -612,7 +612,7 @@ impl Cloth {
         let mut targets = std::mem::take(&mut snap.targets);
         targets.clear();
         targets.extend_from_slice(&self.state.x);
-        std::mem::swap(&mut self.pin_target, &mut targets);
+        std::mem::swap(&mut self.pins.target, &mut targets);
         let unconverged = std::mem::replace(&mut self.config.accept_unconverged, true);
         let (solver, stats, carried) = (self.solver_stats, self.step_stats, self.mesh_carried);
         let splitter = self.splitter;
@@ -628,7 +628,7 @@ impl Cloth {
             .and_then(|()| self.advance(plan).map(|_| ()));
         self.mesh_slots = meshes;
         snap.restore(self);
-        std::mem::swap(&mut self.pin_target, &mut targets);
+        std::mem::swap(&mut self.pins.target, &mut targets);
         snap.targets = targets;
         self.config.accept_unconverged = unconverged;
         (self.solver_stats, self.step_stats, self.mesh_carried) = (solver, stats, carried);

@@ -120,8 +120,11 @@ impl Cloth {
         snap: &mut Rollback,
         saved: &mut bool,
     ) -> Result<u32, Error> {
-        let thickness = self.config.model.self_collision_thickness;
-        let (watched, mut level) = match thickness > 0.0 {
+        let (on, thickness) = (
+            self.config.model.self_collision_on(),
+            self.config.model.self_collision_thickness,
+        );
+        let (watched, mut level) = match on {
             true => self.predicted_split(h, SELF_COLLISION_STEP_LIMIT * thickness),
             false => (false, 0),
         };
@@ -166,7 +169,7 @@ impl Cloth {
             // failed unsaved call. (A retry from the same state would look at the same pairs,
             // so for a refused piece this is defence: `a_refused_piece_leaves_no_trace` passes
             // without it; an unwatched substep goes without, module docs.)
-            let keep = thickness > 0.0 && (watched || !*saved);
+            let keep = on && (watched || !*saved);
             if keep {
                 self.self_collision.save_memory(&mut memory);
             }
@@ -259,7 +262,7 @@ impl Cloth {
             .state
             .v
             .iter()
-            .zip(&self.pinned)
+            .zip(&self.pins.pinned)
             .filter(|(_, &pinned)| !pinned)
             .map(|(v, _)| v.norm_squared())
             .fold(0.0, f64::max);

@@ -124,6 +124,48 @@ macro_rules! first_pass {
     };
 }
 
+/// A whole-cloth pass between the step's velocities and the force pass: what it is, when it
+/// does anything (each reads the step's velocities), and how it runs (it handles its own off
+/// state).
+struct PriorPass {
+    #[allow(dead_code)] // named for the reader and a debugger
+    name: &'static str,
+    on: fn(&Cloth) -> bool,
+    run: fn(&mut Cloth, &StepPlan, &mut Weights) -> Result<(), Error>,
+}
+
+/// The whole-cloth passes before the force pass, in the order [`Cloth::advance`] runs them.
+/// The step's first pass runs inside the force pass ([`Cloth::fused_route`]) only when none is
+/// on, so a pass added here is both run and waited for.
+const PRIOR_PASSES: [PriorPass; 4] = [
+    PriorPass {
+        name: "the pair elements' own passes",
+        on: |c| forces::prior_elements_on(&c.config.model),
+        run: |c, _, weights| {
+            c.element_forces(weights);
+            Ok(())
+        },
+    },
+    PriorPass {
+        name: "the carried water's turning forces",
+        on: |c| c.config.model.water.normal_water(),
+        run: |c, _, _| c.water_turning(),
+    },
+    PriorPass {
+        name: "the wide form drag",
+        on: |c| forces::wide_drag(&c.config.model),
+        run: |c, _, _| {
+            c.wide_form_drag();
+            Ok(())
+        },
+    },
+    PriorPass {
+        name: "collisions (mesh colliders, self-collision)",
+        on: |c| c.mesh_slots.iter().any(Option::is_some) || c.config.model.self_collision_on(),
+        run: |c, plan, _| c.collisions(plan.fraction),
+    },
+];
+
 impl Cloth {
     /// One step as `plan` says. Nothing is committed unless every pass succeeds and the step
     /// is [`Advanced::Taken`].
@@ -137,10 +179,9 @@ impl Cloth {
             Some(_) => Weights::default(),
             None => self.step_velocities(&plan),
         };
-        self.element_forces(&mut weights);
-        self.water_turning()?;
-        self.wide_form_drag();
-        self.collisions(plan.fraction)?;
+        for pass in &PRIOR_PASSES {
+            (pass.run)(self, &plan, &mut weights)?;
+        }
         let integrated_sound = match (fused, Route::of(self.config.integrator)) {
             (Some(step), _) => self.velocities_forces_and_explicit_step(&plan, weights, step),
             (None, Route::ExplicitTiles(step)) => self.forces_and_explicit_step(h, weights, step),
@@ -219,13 +260,8 @@ impl Cloth {
         let Route::ExplicitTiles(step) = Route::of(self.config.integrator) else {
             return None;
         };
-        let m = &self.config.model;
         let fusable = self.topology.tiled.is_some()
-            && !m.water.normal_water()
-            && !forces::wide_drag(m)
-            && !forces::prior_elements_on(m)
-            && self.mesh_slots.iter().all(Option::is_none)
-            && m.self_collision_thickness <= 0.0
+            && !PRIOR_PASSES.iter().any(|pass| (pass.on)(self))
             && fuse_enabled();
         fusable.then_some(step)
     }
@@ -327,13 +363,13 @@ impl Cloth {
         } else if s
             .coarse
             .as_ref()
-            .is_none_or(|c| !c.built_for(wanted.0, wanted.1, &self.pinned))
+            .is_none_or(|c| !c.built_for(wanted.0, wanted.1, &self.pins.pinned))
         {
             s.coarse = Some(forces::coarse_water::CoarseWater::new(
                 t,
                 wanted.0,
                 wanted.1,
-                &self.pinned,
+                &self.pins.pinned,
             )?);
         }
         let normals = s.force_pass.normals_to_write(self.state.x.len());
@@ -462,7 +498,7 @@ impl Cloth {
             force: &s.force_array,
             masses: &self.topology.masses,
             topology: &self.topology,
-            pinned: &self.pinned,
+            pinned: &self.pins.pinned,
             settings: self.config.solver,
             contacts: &s.contacts,
             contact_stiffness: self.config.model.collision_stiffness,
@@ -496,7 +532,7 @@ impl Cloth {
             h,
             &self.state.x,
             &self.topology.masses,
-            &self.pinned,
+            &self.pins.pinned,
             &mut self.scratch.v_new,
         );
         on
@@ -506,7 +542,7 @@ impl Cloth {
     /// `integrated_sound`: every particle the integrator wrote was checked and sound, so only
     /// what the pins changed is checked again.
     fn check(&self, h: f64, integrated_sound: bool) -> Result<(), Error> {
-        let pins_sound = || self.pin_list.iter().all(|&i| !self.unsound(i as usize));
+        let pins_sound = || self.pins.list.iter().all(|&i| !self.unsound(i as usize));
         if !(integrated_sound && pins_sound()) {
             self.check_sound(h)?;
         }
