@@ -260,15 +260,10 @@ impl Cloth {
             probe_start: Rollback::default(),
             solver_stats: SolverStats::default(),
             step_stats: StepStats::default(),
-            // At rest in the water's current: a flow that has always been there.
             state: state::State::at_rest(
                 &topology.rest_positions,
                 Histories::new(&config.model, config.scheme, &topology)?,
-                if config.model.water.unsteady_skin() {
-                    vec![-config.model.current; n]
-                } else {
-                    Vec::new()
-                },
+                &config.model,
             ),
             threads: Threads::default(),
             topology,
@@ -301,13 +296,9 @@ impl Cloth {
             ));
         }
         forces::coarse_water::check(&self.topology, &config.model)?;
-        // The unsteady skin drag turned on starts from the flow as it is (no sudden start),
-        // its room asked for before anything changes.
-        let new_mean = if config.model.water.unsteady_skin() && self.state.skin_mean.is_empty() {
-            Some(self.flow_mean(config.model.current)?)
-        } else {
-            None
-        };
+        // A memory the new model keeps starts from the state as it is, its room asked for
+        // before anything changes (`state.rs`).
+        let memories = self.state.memories_for(&config.model)?;
         let thickness = config.model.self_collision_thickness;
         let old_thickness = old.model.self_collision_thickness;
         // On the cloth's threads (its lists are made on the pool for a large cloth): a cloth
@@ -319,24 +310,9 @@ impl Cloth {
             // The pair list was found for the old reach.
             self.self_collision.look_again();
         }
-        if let Some(mean) = new_mean {
-            self.state.skin_mean = mean;
-        } else if !config.model.water.unsteady_skin() {
-            // Turned off: its mean is dropped.
-            self.state.skin_mean = Vec::new();
-        }
+        self.state.change_memories(memories);
         self.config = config;
         Ok(())
-    }
-
-    /// The velocities relative to a water of current `current`: where the unsteady skin drag's
-    /// running mean starts (a flow that has always been there). Out of memory, an error.
-    fn flow_mean(&self, current: Vec3) -> Result<Vec<Vec3>, Error> {
-        let mut mean = Vec::new();
-        mean.try_reserve_exact(self.state.v.len())
-            .map_err(|_| Error::out_of_memory("the skin drag's running mean cannot be allocated"))?;
-        mean.extend(self.state.v.iter().map(|v| v - current));
-        Ok(mean)
     }
 
     pub fn topology(&self) -> &Topology {

@@ -40,6 +40,7 @@
 //! is rejected with a message and the cloth is left exactly as it was.
 
 use super::plan::{Stage, StepPlan};
+use super::state::Change;
 use super::{check_weight, checked_collider, Cloth, Histories};
 use crate::bytes::{ByteReader, ByteWriter};
 use crate::cloth::MAX_COORDINATE;
@@ -459,13 +460,15 @@ impl Cloth {
                 .iter()
                 .try_for_each(|p| check_finite_vec("skin drag mean", p))?;
         }
-        if !self.config.model.water.unsteady_skin() {
-            skin_mean.clear();
-        } else if skin_mean.is_empty() {
-            skin_mean
-                .try_reserve_exact(n)
-                .map_err(|_| Error::out_of_memory("loading a snapshot: no room for the skin drag's mean"))?;
-            skin_mean.extend(v.iter().map(|vk| vk - current));
+        // This cloth's model decides whether the mean is kept, in the loaded current.
+        let model = crate::model::Model {
+            current,
+            ..self.config.model
+        };
+        match super::state::skin_mean_change(&model, &skin_mean, v)? {
+            Change::Keep => {}
+            Change::Start(mean) => skin_mean = mean,
+            Change::Drop => skin_mean.clear(),
         }
         Ok(skin_mean)
     }
@@ -753,7 +756,9 @@ mod tests {
         let mut c = make();
         c.load_snapshot(&snap).unwrap();
         let current = c.config.model.current;
-        c.state.skin_mean = c.flow_mean(current).unwrap();
+        c.state.skin_mean.clear();
+        let restart = c.state.memories_for(&c.config.model).unwrap();
+        c.state.change_memories(restart);
         for k in 300..400 {
             for cloth in [&mut a, &mut b, &mut c] {
                 drive(cloth, k);

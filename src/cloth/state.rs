@@ -2,6 +2,10 @@
 //! memories (the half-derivative histories, the unsteady skin drag's running mean, the motion's
 //! averages).
 //!
+//! Which memories a state keeps follows from its model ([`State::memories_for`]): a cloth
+//! built, reconfigured or loaded from a snapshot asks the same question, so a memory a term
+//! turns on starts (and one it turns off is dropped) the same way everywhere.
+//!
 //! A refused call puts the whole state back ([`State::copy_into`] before it, a swap after),
 //! an extrapolated step combines two states ([`State::extrapolate`]), and a snapshot writes
 //! and reads them in its format's order (`snapshot.rs`). Each memory says in [`Evolving`] how
@@ -17,6 +21,7 @@ use super::motion::MotionRate;
 use crate::aligned::AlignedVec3;
 use crate::error::Error;
 use crate::math::Vec3;
+use crate::model::Model;
 use crate::topology::Topology;
 
 /// How one memory of the state is copied, put back and extrapolated.
@@ -116,17 +121,78 @@ macro_rules! for_each_memory {
     };
 }
 
+/// What a model asks of one memory a state has or lacks.
+#[derive(Debug)]
+pub(super) enum Change<T> {
+    /// Kept as it is.
+    Keep,
+    /// Started, at this value.
+    Start(T),
+    /// Dropped: the model does not keep it.
+    Drop,
+}
+
+/// What a model asks of a state's memories besides the histories (whose layout is fixed when
+/// the cloth is made): each memory to keep, to start or to drop.
+#[derive(Debug)]
+pub(crate) struct MemoryChange {
+    skin_mean: Change<Vec<Vec3>>,
+}
+
+/// What `model` asks of a skin drag's mean `mean` of a state with velocities `v`: kept, started
+/// from the flow when missing, dropped when the model has no unsteady skin drag.
+pub(super) fn skin_mean_change(model: &Model, mean: &[Vec3], v: &[Vec3]) -> Result<Change<Vec<Vec3>>, Error> {
+    Ok(match (model.water.unsteady_skin(), mean.is_empty()) {
+        (false, _) => Change::Drop,
+        (true, true) => Change::Start(flow_mean(v, model.current)?),
+        (true, false) => Change::Keep,
+    })
+}
+
+/// The velocities `v` relative to a water of current `current`: where the unsteady skin drag's
+/// running mean starts (a flow that has always been there). Out of memory, an error.
+fn flow_mean(v: &[Vec3], current: Vec3) -> Result<Vec<Vec3>, Error> {
+    let mut mean = Vec::new();
+    mean.try_reserve_exact(v.len())
+        .map_err(|_| Error::out_of_memory("the skin drag's running mean cannot be allocated"))?;
+    mean.extend(v.iter().map(|v| v - current));
+    Ok(mean)
+}
+
 impl State {
-    /// At rest at positions `x`, its memories `histories` and `skin_mean`.
-    pub(crate) fn at_rest(x: &[Vec3], histories: Histories, skin_mean: Vec<Vec3>) -> Self {
+    /// At rest at positions `x` in the water of `model` (at rest in its current: a flow that
+    /// has always been there), its histories `histories`.
+    pub(crate) fn at_rest(x: &[Vec3], histories: Histories, model: &Model) -> Self {
         State {
             x: AlignedVec3::from_slice(x),
             v: AlignedVec3::zeros(x.len()),
             time: 0.0,
             steps: 0,
             histories,
-            skin_mean,
+            skin_mean: match model.water.unsteady_skin() {
+                true => vec![-model.current; x.len()],
+                false => Vec::new(),
+            },
             motion: MotionRate::default(),
+        }
+    }
+
+    /// What `model` asks of this state's memories (a reconfigured cloth's, or a loaded
+    /// snapshot's): a memory it keeps that the state lacks is started from the state as it is
+    /// (the skin drag's mean from the flow, no sudden start), its room asked for now; one it
+    /// does not keep is dropped. Nothing changes until [`State::change_memories`], so a caller
+    /// can refuse after this and leave the state whole.
+    pub(crate) fn memories_for(&self, model: &Model) -> Result<MemoryChange, Error> {
+        let skin_mean = skin_mean_change(model, &self.skin_mean, &self.v)?;
+        Ok(MemoryChange { skin_mean })
+    }
+
+    /// Makes the memories what [`State::memories_for`] said.
+    pub(crate) fn change_memories(&mut self, change: MemoryChange) {
+        match change.skin_mean {
+            Change::Keep => {}
+            Change::Start(mean) => self.skin_mean = mean,
+            Change::Drop => self.skin_mean = Vec::new(),
         }
     }
 
