@@ -120,13 +120,12 @@ impl Cloth {
         snap: &mut Rollback,
         saved: &mut bool,
     ) -> Result<u32, Error> {
-        let (on, thickness) = (
-            self.config.model.self_collision_on(),
-            self.config.model.self_collision_thickness,
-        );
-        let (watched, mut level) = match on {
-            true => self.predicted_split(h, SELF_COLLISION_STEP_LIMIT * thickness),
-            false => (false, 0),
+        let on = self.config.model.self_collision_on();
+        let limit_m = SELF_COLLISION_STEP_LIMIT * self.config.model.self_collision_thickness;
+        let (watched, mut level) = if on {
+            self.predicted_split(h, limit_m)
+        } else {
+            (false, 0)
         };
         // The level a split substep's pieces are at least at, to be stable (found once, when
         // the substep first splits).
