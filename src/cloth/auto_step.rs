@@ -241,7 +241,9 @@ impl Cloth {
             f64::INFINITY
         };
         let oscillator = if explicit { 0.5 } else { 1.0 };
-        let (ma, rho_w, cd) = (m.water.added_mass, m.water_density, m.water.form_drag);
+        let ma = m.water.added_mass;
+        // Each term's own rate (an off term's coefficients, and so its rate, are 0).
+        let terms = &crate::forces::terms::TERMS;
         let rate = damping_rate(m);
         let mut floor = f64::INFINITY;
         for i in 0..self.state.x.len() {
@@ -264,14 +266,9 @@ impl Cloth {
             let area = t.areas[i];
             let rel = self.state.v[i] - m.current;
             let speed = rel.norm();
-            // Drags' rates at the velocity the particle has now (each in its own direction;
-            // the largest is what limits).
-            let drag = (crate::forces::terms::per_particle(m.viscous_drag, m.water.viscous_drag, area)
-                + crate::forces::terms::per_particle(m.normal_drag, m.water.normal_drag, area)
-                + w0 * crate::forces::terms::per_particle(m.history_drag, m.water.history_drag, area)
-                + (m.water.skin_drag + m.water.skin_drag_unsteady) * area
-                + rho_w * cd * area * speed)
-                / mass;
+            // The terms' damping rates at the velocity the particle has now (each in its own
+            // direction; the largest is what limits), as each term says.
+            let drag = terms.iter().map(|t| (t.rate)(m, area, speed, w0)).sum::<f64>() / mass;
             let mut omega2 = 2.0 * k / mass;
             let mut gamma = 2.0 * c / mass + drag;
             // Contacts: every vertex may touch an analytic collider; the mesh colliders' by

@@ -114,6 +114,11 @@ pub struct Term {
     pub add: fn(&Context<'_>, &Tile<'_>, [&mut [f64]; 3]),
     /// Adds its blocks for the implicit integrator (None: it depends on neither x nor v).
     pub linearise: Option<fn(&Context<'_>, &Particle<'_>, &mut Blocks)>,
+    /// The largest damping rate (N s/m) it gives a particle of `area` (m^2) moving at `speed`
+    /// (m/s) relative to the water, `w0` the half-derivative's current weight: what it asks of
+    /// an explicit step (`cloth/auto_step.rs`). Contacts say 0: the automatic step weighs them
+    /// by where the colliders touch.
+    pub rate: fn(m: &Model, area: f64, speed: f64, w0: f64) -> f64,
 }
 
 /// Every per-particle term, in the order it is added.
@@ -134,6 +139,7 @@ const WEIGHT: Term = Term {
     reads: Reads::NONE,
     add: |c, t, f| add_weight_widest(f, t.masses, c.gravity),
     linearise: None,
+    rate: |_, _, _, _| 0.0,
 };
 
 /// Viscous drag on the velocity relative to the water, Eq. 3.
@@ -146,6 +152,7 @@ const VISCOUS_DRAG: Term = Term {
         let m = c.model;
         b.damping += per_particle(m.viscous_drag, m.water.viscous_drag, p.area) * Matrix3::identity()
     }),
+    rate: |m, area, _, _| per_particle(m.viscous_drag, m.water.viscous_drag, area),
 };
 
 /// History (Basset) drag, Eq. 4.
@@ -172,6 +179,7 @@ const HISTORY_DRAG: Term = Term {
             b.damping += k * p.w0 * (u * u.transpose());
         }
     }),
+    rate: |m, area, _, w0| w0 * per_particle(m.history_drag, m.water.history_drag, area),
 };
 
 /// Drag on the normal velocity (the paper's regular models, Fig. 7).
@@ -189,6 +197,7 @@ const NORMAL_DRAG: Term = Term {
         b.damping +=
             per_particle(m.normal_drag, m.water.normal_drag, p.area) * (p.normal * p.normal.transpose())
     }),
+    rate: |m, area, _, _| per_particle(m.normal_drag, m.water.normal_drag, area),
 };
 
 /// Form drag on the velocity normal to the cloth relative to the water, quadratic:
@@ -214,6 +223,7 @@ const FORM_DRAG: Term = Term {
         let k = m.water_density * m.water.form_drag * p.area * vn.abs();
         b.damping += k * (p.normal * p.normal.transpose());
     }),
+    rate: |m, area, speed, _| m.water_density * m.water.form_drag * area * speed,
 };
 
 /// Skin drag on the velocity along the cloth relative to the water, linear.
@@ -232,6 +242,7 @@ const SKIN_DRAG: Term = Term {
         let k = (w.skin_drag + w.skin_drag_unsteady) * p.area;
         b.damping += k * (Matrix3::identity() - p.normal * p.normal.transpose());
     }),
+    rate: |m, area, _, _| (m.water.skin_drag + m.water.skin_drag_unsteady) * area,
 };
 
 /// Penalty contacts with the colliders.
@@ -252,6 +263,7 @@ const CONTACTS: Term = Term {
             }
         }
     }),
+    rate: |_, _, _, _| 0.0,
 };
 
 /// What the terms that are on read, together (the added mass, an inertia rather than a
@@ -420,5 +432,73 @@ mod tests {
         }
         // Weight, viscous, history, normal, form and skin drag and contacts: all on.
         assert_eq!(checked, TERMS.len());
+    }
+
+    /// Each term's rate (what the automatic step reads) is the largest eigenvalue of its
+    /// damping block where the velocity relative to the water lies along the normal, and
+    /// bounds it at any other velocity; contacts say 0 (the automatic step weighs them apart).
+    #[test]
+    fn every_terms_rate_is_its_damping_blocks_largest() {
+        let mut m = Model::regular(RegularDrag::ViscousAndNormal);
+        m.history_drag = 2e-3;
+        m.water.viscous_drag = 3.0;
+        m.water.history_drag = 4.0;
+        m.water.normal_drag = 5.0;
+        m.water.form_drag = 1.2;
+        m.water.skin_drag = 0.7;
+        m.water.skin_drag_unsteady = 0.9;
+        m.water.skin_drag_memory = 1.0;
+        m.current = Vec3::new(0.05, -0.02, 0.01);
+        let c = Context {
+            model: &m,
+            gravity: crate::forces::body_acceleration(&m),
+            colliders: &[],
+        };
+        let (x, n, w0, area) = (Vec3::zeros(), Vec3::new(0.2, -0.3, 0.9).normalize(), 0.37, 1.5e-4);
+        let largest = |term: &Term, v: Vec3| {
+            let mut b = Blocks {
+                damping: Matrix3::zeros(),
+                stiffness: Matrix3::zeros(),
+            };
+            let p = Particle {
+                x: &x,
+                v: &v,
+                normal: &n,
+                w0,
+                area,
+            };
+            if let Some(lin) = term.linearise {
+                lin(&c, &p, &mut b);
+            }
+            let sym = 0.5 * (b.damping + b.damping.transpose());
+            sym.symmetric_eigen().eigenvalues.max()
+        };
+        let mut checked = 0;
+        for term in TERMS.iter().filter(|t| t.name != "contacts") {
+            let along = m.current + 0.3 * n;
+            let speed = (along - m.current).norm();
+            let rate = (term.rate)(&m, area, speed, w0);
+            let want = largest(term, along);
+            assert!(
+                (rate - want).abs() <= 1e-12 * want.abs().max(1e-9),
+                "{}: rate {rate} against {want}",
+                term.name
+            );
+            let across = m.current + Vec3::new(0.11, -0.23, 0.31);
+            let speed = (across - m.current).norm();
+            let bound = (term.rate)(&m, area, speed, w0);
+            assert!(
+                bound >= largest(term, across) * (1.0 - 1e-12),
+                "{}: {bound} below its block",
+                term.name
+            );
+            checked += 1;
+        }
+        assert_eq!(checked, TERMS.len() - 1);
+        let contacts = TERMS
+            .iter()
+            .find(|t| t.name == "contacts")
+            .map(|t| (t.rate)(&m, area, 1.0, w0));
+        assert_eq!(contacts, Some(0.0));
     }
 }
