@@ -62,8 +62,9 @@ pub unsafe extern "C" fn fc_cloth_save_snapshot(
 /// cloth exactly as it was. Beyond the checksum, the contents are checked for meaning: every
 /// number finite and within the float range, speeds within this cloth's `max_speed`, history
 /// times ordered and within the span the cloth has lived, step sizes positive; then a trial step
-/// (at the mean step the state was reached with, pins held; taken on the cloth itself and
-/// rolled back) must succeed, so a snapshot that loads can always be stepped. The message names what was refused (the
+/// (at the mean step the state was reached with, pins held, mesh colliders moving to where
+/// the host put them as the next call would move them; taken on the cloth itself and rolled
+/// back) must succeed, so a snapshot that loads can always be stepped. The message names what was refused (the
 /// half-derivative history when the trial succeeds without it).
 ///
 /// **What a snapshot carries.** The state: positions, velocities, pins and their targets,
