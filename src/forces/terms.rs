@@ -350,9 +350,8 @@ mod tests {
         j
     }
 
-    #[test]
-    fn every_terms_blocks_match_a_central_difference_of_its_force() {
-        // Every coefficient on, a current, and a plane the particle is inside the margin of.
+    /// A model with every drag coefficient on, and a current.
+    fn every_coefficient_on() -> Model {
         let mut m = Model::regular(RegularDrag::ViscousAndNormal);
         m.history_drag = 2e-3;
         m.water.viscous_drag = 3.0;
@@ -363,6 +362,13 @@ mod tests {
         m.water.skin_drag_unsteady = 0.9;
         m.water.skin_drag_memory = 1.0;
         m.current = Vec3::new(0.05, -0.02, 0.01);
+        m
+    }
+
+    #[test]
+    fn every_terms_blocks_match_a_central_difference_of_its_force() {
+        // Every coefficient on, a current, and a plane the particle is inside the margin of.
+        let m = every_coefficient_on();
         let plane = Collider::Plane(Plane {
             point: Vec3::new(0.0, -0.004, 0.0),
             normal: Vec3::new(0.1, 1.0, 0.2).normalize(),
@@ -439,16 +445,7 @@ mod tests {
     /// bounds it at any other velocity; contacts say 0 (the automatic step weighs them apart).
     #[test]
     fn every_terms_rate_is_its_damping_blocks_largest() {
-        let mut m = Model::regular(RegularDrag::ViscousAndNormal);
-        m.history_drag = 2e-3;
-        m.water.viscous_drag = 3.0;
-        m.water.history_drag = 4.0;
-        m.water.normal_drag = 5.0;
-        m.water.form_drag = 1.2;
-        m.water.skin_drag = 0.7;
-        m.water.skin_drag_unsteady = 0.9;
-        m.water.skin_drag_memory = 1.0;
-        m.current = Vec3::new(0.05, -0.02, 0.01);
+        let m = every_coefficient_on();
         let c = Context {
             model: &m,
             gravity: crate::forces::body_acceleration(&m),
