@@ -21,15 +21,24 @@ pub enum Integrator {
     /// (its amplification `2/(1 - z/2)^2 - 1/(1 - z)` is below 1 on the whole left half-plane
     /// and tends to 0 for stiff modes). Three linear solves per step.
     ExtrapolatedImplicit,
+    /// Symplectic Euler on every force but the stiff in-plane springs, which are compliant
+    /// distance constraints (XPBD: Macklin, Mueller & Chentanez 2016; "Small steps in physics
+    /// simulation", Macklin et al. 2019): a spring of stiffness k and damping c is the
+    /// constraint `|x_i - x_j| - r` of compliance `1/k` with Rayleigh damping c, projected once
+    /// a substep (`integrate/xpbd.rs`). The stretch and shear springs no longer bound the step,
+    /// so a frame takes a few substeps where symplectic Euler takes a dozen; first order.
+    /// Needs velocity (or no) spring damping. See `docs/realtime.md`.
+    Xpbd,
 }
 
 impl Integrator {
-    pub const ALL: [Integrator; 5] = [
+    pub const ALL: [Integrator; 6] = [
         Integrator::ExplicitEuler,
         Integrator::SymplecticEuler,
         Integrator::ImplicitEuler,
         Integrator::ExtrapolatedSymplectic,
         Integrator::ExtrapolatedImplicit,
+        Integrator::Xpbd,
     ];
 
     /// The first-order integrator a step is made of: itself, or the one an extrapolated
@@ -56,6 +65,12 @@ impl Integrator {
         }
     }
 
+    /// Whether its stiff in-plane springs are constraints projected after the explicit step
+    /// ([`Integrator::Xpbd`]).
+    pub fn is_constrained(&self) -> bool {
+        *self == Integrator::Xpbd
+    }
+
     /// Whether it is stable at frame-rate steps (implicit).
     pub fn is_implicit(&self) -> bool {
         self.base() == Integrator::ImplicitEuler
@@ -69,6 +84,7 @@ impl Integrator {
             Integrator::ImplicitEuler => "implicit Euler",
             Integrator::ExtrapolatedSymplectic => "extrapolated symplectic Euler (2nd order)",
             Integrator::ExtrapolatedImplicit => "extrapolated implicit Euler (2nd order)",
+            Integrator::Xpbd => "XPBD (compliant in-plane springs)",
         }
     }
 
@@ -77,7 +93,7 @@ impl Integrator {
     pub fn explicit_step_soa(&self) -> Option<StepSoa> {
         match self.base() {
             Integrator::ExplicitEuler => Some(explicit_euler_soa),
-            Integrator::SymplecticEuler => Some(symplectic_euler_soa),
+            Integrator::SymplecticEuler | Integrator::Xpbd => Some(symplectic_euler_soa),
             _ => None,
         }
     }
@@ -90,6 +106,7 @@ impl Integrator {
             Integrator::ImplicitEuler => "implicit",
             Integrator::ExtrapolatedSymplectic => "symplectic2",
             Integrator::ExtrapolatedImplicit => "implicit2",
+            Integrator::Xpbd => "xpbd",
         }
     }
 }

@@ -10,6 +10,7 @@ mod implicit_euler;
 mod integrator;
 mod symplectic_euler;
 mod tile_step;
+pub mod xpbd;
 
 pub use cg::{SolverSettings, SolverStats};
 pub use explicit_euler::explicit_euler_soa;
