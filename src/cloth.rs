@@ -9,12 +9,14 @@
 mod auto_step;
 mod colliders;
 mod collisions;
+mod constrained;
 mod extrapolate;
 mod histories;
 mod motion;
 mod pins;
 mod plan;
 mod prepass;
+mod rollback;
 mod scratch;
 mod snapshot;
 mod split;
@@ -24,8 +26,8 @@ mod step;
 use colliders::{checked_collider, ColliderSlot};
 use histories::Histories;
 use pins::check_weight;
+use rollback::Rollback;
 use scratch::StepScratch;
-use step::Rollback;
 
 pub use auto_step::{safety, StepStats, AUTO, MAX_RETRIES, SAFETY, SAFETY_SYMPLECTIC};
 pub use snapshot::SNAPSHOT_VERSION;

@@ -57,7 +57,7 @@ pub const SAFETY_SYMPLECTIC: f64 = 1.1;
 /// The fraction of the estimate the automatic step takes with `integrator`.
 pub fn safety(integrator: Integrator) -> f64 {
     match integrator.base() {
-        Integrator::SymplecticEuler => SAFETY_SYMPLECTIC,
+        Integrator::SymplecticEuler | Integrator::Xpbd => SAFETY_SYMPLECTIC,
         _ => SAFETY,
     }
 }
@@ -127,11 +127,99 @@ fn explicit_bound(m: &Model, spacing: f64) -> f64 {
     bound
 }
 
+/// The sums over the springs of particle `i` the estimate reads: stiffness (N/m), damping
+/// (N s/m; fractional damping at the current-rate weight `w0`) and the shortest rest length
+/// (m). XPBD (`constrained`): its constrained springs' stiffness bounds nothing, and neither
+/// does velocity damping, which its constraints carry.
+fn spring_sums(
+    m: &Model,
+    t: &crate::topology::Topology,
+    i: usize,
+    w0: f64,
+    constrained: bool,
+) -> (f64, f64, f64) {
+    let free = |kind| !(constrained && super::constrained::constrained(kind));
+    let carried = constrained && m.spring_damping_mode == crate::model::SpringDamping::Velocity;
+    let rate = damping_rate(m);
+    let (mut k, mut c, mut shortest) = (0.0, 0.0, f64::INFINITY);
+    for &e in t.vertex_springs.row(i) {
+        let s = &t.springs[(e / 2) as usize];
+        shortest = shortest.min(s.rest);
+        if free(s.kind) {
+            k += m.stiffness(s.kind, t.spacing);
+        }
+        if carried {
+            continue;
+        }
+        c += match rate {
+            DampingRate::Velocity => m.spring_damping_of(s.kind),
+            DampingRate::HalfDerivative => w0 * m.spring_damping_of(s.kind),
+            DampingRate::None => 0.0,
+        };
+    }
+    (k, c, shortest)
+}
+
+/// The terms' damping rate (1/s) of a particle of isotropic mass `mass` (kg) and `area` (m^2)
+/// at `speed` (m/s) relative to the water, as each term says (each in its own direction; the
+/// largest is what limits). XPBD (`constrained`): a term along the normal acts on the water
+/// carried there too.
+fn drag_rate(m: &Model, area: f64, speed: f64, w0: f64, mass: f64, constrained: bool) -> f64 {
+    let terms = &crate::forces::terms::TERMS;
+    let rate = |t: &crate::forces::terms::Term| (t.rate)(m, area, speed, w0);
+    if constrained {
+        let normal_mass = mass + m.water.added_mass * area;
+        let along = |normal| terms.iter().filter(move |t| t.along_normal == normal);
+        (along(false).map(rate).sum::<f64>() / mass).max(along(true).map(rate).sum::<f64>() / normal_mass)
+    } else {
+        terms.iter().map(rate).sum::<f64>() / mass
+    }
+}
+
+/// Every particle's [`spring_sums`] for the model and integrator they were summed for: they
+/// change only when those do, and summing them was most of the estimate's work. Kept only
+/// where they do not depend on the step (no fractional spring damping).
+#[derive(Clone, Debug, Default)]
+pub(super) struct SpringSums {
+    key: Option<(Model, Integrator)>,
+    sums: Vec<(f64, f64, f64)>,
+}
+
+impl SpringSums {
+    /// The sums for `m` and `integrator`, if kept.
+    fn get(&self, m: &Model, integrator: Integrator) -> Option<&[(f64, f64, f64)]> {
+        (self.key == Some((*m, integrator))).then_some(&self.sums[..])
+    }
+}
+
 impl Cloth {
+    /// Sums the springs of every particle again ([`SpringSums`]) when the model or the
+    /// integrator changed; fails with out-of-memory when the room cannot be had.
+    fn refresh_spring_sums(&mut self) -> Result<(), crate::error::Error> {
+        let (m, integrator) = (self.config.model, self.config.integrator.base());
+        let kept = &mut self.scratch.spring_sums;
+        if damping_rate(&m) == DampingRate::HalfDerivative || kept.get(&m, integrator).is_some() {
+            return Ok(());
+        }
+        kept.key = None;
+        kept.sums.clear();
+        let n = self.topology.vertex_count();
+        kept.sums.try_reserve_exact(n).map_err(|_| {
+            crate::error::Error::out_of_memory("automatic step: no room for the springs' sums")
+        })?;
+        let t = &self.topology;
+        let constrained = integrator.is_constrained();
+        kept.sums
+            .extend((0..n).map(|i| spring_sums(&m, t, i, 0.0, constrained)));
+        kept.key = Some((m, integrator));
+        Ok(())
+    }
+
     /// Advances by `dt` with the automatic step (module docs).
     pub(super) fn step_auto(&mut self, dt: f64) -> Result<(), crate::error::Error> {
         use crate::error::ErrorKind;
         self.measure_contact_weights()?;
+        self.refresh_spring_sums()?;
         let h = self.auto_substep(dt);
         let tracks = self.tracks_motion();
         if tracks {
@@ -241,34 +329,23 @@ impl Cloth {
             f64::INFINITY
         };
         let oscillator = if explicit { 0.5 } else { 1.0 };
+        let constrained = integrator.is_constrained();
         let ma = m.water.added_mass;
-        // Each term's own rate (an off term's coefficients, and so its rate, are 0).
-        let terms = &crate::forces::terms::TERMS;
-        let rate = damping_rate(m);
         let mut floor = f64::INFINITY;
+        let kept = self.scratch.spring_sums.get(m, integrator);
         for i in 0..self.state.x.len() {
             if self.pins.pinned[i] {
                 continue;
             }
             let inertia = Inertia::of(m, t.masses[i], t.areas[i], Vec3::z(), 0.0);
             let mass = inertia.isotropic();
-            let (mut k, mut c, mut shortest) = (0.0, 0.0, f64::INFINITY);
-            for &e in t.vertex_springs.row(i) {
-                let s = &t.springs[(e / 2) as usize];
-                k += m.stiffness(s.kind, t.spacing);
-                c += match rate {
-                    DampingRate::Velocity => m.spring_damping_of(s.kind),
-                    DampingRate::HalfDerivative => w0 * m.spring_damping_of(s.kind),
-                    DampingRate::None => 0.0,
-                };
-                shortest = shortest.min(s.rest);
-            }
+            let (k, c, shortest) = match kept {
+                Some(sums) => sums[i],
+                None => spring_sums(m, t, i, w0, constrained),
+            };
             let area = t.areas[i];
-            let rel = self.state.v[i] - m.current;
-            let speed = rel.norm();
-            // The terms' damping rates at the velocity the particle has now (each in its own
-            // direction; the largest is what limits), as each term says.
-            let drag = terms.iter().map(|t| (t.rate)(m, area, speed, w0)).sum::<f64>() / mass;
+            let speed = (self.state.v[i] - m.current).norm();
+            let drag = drag_rate(m, area, speed, w0, mass, constrained);
             let mut omega2 = 2.0 * k / mass;
             let mut gamma = 2.0 * c / mass + drag;
             // Contacts: every vertex may touch an analytic collider; the mesh colliders' by

@@ -61,4 +61,8 @@ pub(super) struct StepScratch {
     pub projected: Vec<f64>,
     pub force_pass: ForceScratch,
     pub implicit: ImplicitScratch,
+    /// The automatic step's sums over each particle's springs (`auto_step.rs`).
+    pub spring_sums: super::auto_step::SpringSums,
+    /// The XPBD route's constraints (`constrained.rs`).
+    pub constraints: super::constrained::ConstraintScratch,
 }

@@ -8,7 +8,6 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use super::plan::StepPlan;
-use super::state::State;
 use super::{prepass, Cloth, FAR_STEP, MAX_COORDINATE};
 use crate::error::Error;
 use crate::forces::{self, ForceInput, ForceScratch, Memory, SpringInputs, Weights, TILE};
@@ -33,6 +32,7 @@ pub(super) enum Advanced {
 /// |---|---|---|
 /// | explicit or symplectic Euler | each tile's totals, in cache, from the force pass ([`forces::for_each_tile`]; a grid's tiles read a window of the step's arrays, any other topology's are gathered per tile) | tile by tile, checked as it is written |
 /// | implicit Euler | one force array ([`forces::total_forces_with`]), then the linearised system solved by CG | whole arrays, checked after |
+/// | XPBD | as symplectic Euler, without the constrained springs' forces; then the constraints projected (`constrained.rs`) | tile by tile, then whole arrays, checked after |
 ///
 /// Friction, pins and the checks follow as passes of their own on every route.
 #[derive(Clone, Copy)]
@@ -41,44 +41,17 @@ pub(super) enum Route {
     ExplicitTiles(StepSoa),
     /// Linearised backward Euler on whole arrays.
     Implicit,
+    /// An explicit step without the constrained springs, then their constraints projected.
+    Constrained(StepSoa),
 }
 
 impl Route {
     pub(super) fn of(integrator: integrate::Integrator) -> Route {
         match integrator.explicit_step_soa() {
+            Some(step) if integrator.is_constrained() => Route::Constrained(step),
             Some(step) => Route::ExplicitTiles(step),
             None => Route::Implicit,
         }
-    }
-}
-
-/// What a refused call puts back: the [`State`] saved before a multi-substep call (and around
-/// the whole step of an extrapolated integrator), with self-collision's remembered pairs.
-#[derive(Clone, Debug, Default)]
-pub(super) struct Rollback {
-    /// The state as saved (none before the first save).
-    pub(super) state: Option<State>,
-    /// Self-collision's remembered pairs and sides (state: a snapshot carries them).
-    pub(super) self_collision: crate::collide::self_collision::SavedMemory,
-    /// Room for the pins' targets a snapshot's trial step sets aside (not saved or restored).
-    pub(super) targets: Vec<Vec3>,
-}
-
-impl Rollback {
-    /// Copies the state, or fails with an out-of-memory error when the copy of a history
-    /// that grew (the full history) cannot be allocated.
-    pub(super) fn save(&mut self, c: &Cloth) -> Result<(), Error> {
-        c.state.copy_into(&mut self.state, &c.topology)?;
-        c.self_collision.save_memory(&mut self.self_collision);
-        Ok(())
-    }
-
-    /// Puts the saved state back (the cloth's is kept here in exchange).
-    pub(super) fn restore(&mut self, c: &mut Cloth) {
-        if let Some(state) = &mut self.state {
-            std::mem::swap(&mut c.state, state);
-        }
-        c.self_collision.swap_memory(&mut self.self_collision);
     }
 }
 
@@ -86,8 +59,11 @@ impl Rollback {
 /// so that the pass may write the scratch's other buffers).
 macro_rules! force_input {
     ($c:ident, $s:ident, $weights:expr) => {
+        force_input!($c, $s, $weights, &$c.config.model)
+    };
+    ($c:ident, $s:ident, $weights:expr, $model:expr) => {
         ForceInput {
-            model: &$c.config.model,
+            model: $model,
             topology: &$c.topology,
             x: &$c.state.x,
             v: &$s.v_step,
@@ -184,8 +160,12 @@ impl Cloth {
         }
         let integrated_sound = match (fused, Route::of(self.config.integrator)) {
             (Some(step), _) => self.velocities_forces_and_explicit_step(&plan, weights, step),
-            (None, Route::ExplicitTiles(step)) => self.forces_and_explicit_step(h, weights, step),
+            (None, Route::ExplicitTiles(step)) => {
+                let model = self.config.model;
+                self.forces_and_explicit_step(h, weights, step, &model)
+            }
             (None, Route::Implicit) => self.forces_and_implicit_step(h, weights)?,
+            (None, Route::Constrained(step)) => self.constrained_step(h, weights, step)?,
         };
         let friction = self.friction(h) | self.contact_friction(h);
         let limited = match self.limit_collision_step(&plan) {
@@ -404,12 +384,19 @@ impl Cloth {
 
     /// The force pass with an explicit integrator stepping each tile in cache; returns whether
     /// every result it wrote was sound.
-    fn forces_and_explicit_step(&mut self, h: f64, weights: Weights, step: StepSoa) -> bool {
+    /// `model`: the cloth's, or the one its forces come from beside constraints.
+    pub(super) fn forces_and_explicit_step(
+        &mut self,
+        h: f64,
+        weights: Weights,
+        step: StepSoa,
+        model: &crate::Model,
+    ) -> bool {
         if self.scratch.coarse.is_some() {
-            return self.forces_coarse_and_explicit_step(h, weights, step);
+            return self.forces_coarse_and_explicit_step(h, weights, step, model);
         }
         let s = &mut self.scratch;
-        let input = force_input!(self, s, weights);
+        let input = force_input!(self, s, weights, model);
         explicit_tiles(
             &input,
             &mut s.force_pass,
@@ -422,12 +409,12 @@ impl Cloth {
         )
     }
 
-    /// The force pass into the one force array (`scratch.force_array`).
-    fn forces_into_array(&mut self, weights: Weights) {
+    /// The force pass of `model` into the one force array (`scratch.force_array`).
+    fn forces_into_array(&mut self, weights: Weights, model: &crate::Model) {
         let n = self.vertex_count();
         let s = &mut self.scratch;
         s.force_array.resize(n, Vec3::zeros());
-        let input = force_input!(self, s, weights);
+        let input = force_input!(self, s, weights, model);
         forces::total_forces_with(
             &input,
             &mut s.force_pass,
@@ -438,8 +425,14 @@ impl Cloth {
 
     /// The force pass into one array, the coarse water's Woodbury solve, then the explicit
     /// step tile by tile.
-    fn forces_coarse_and_explicit_step(&mut self, h: f64, weights: Weights, step: StepSoa) -> bool {
-        self.forces_into_array(weights);
+    fn forces_coarse_and_explicit_step(
+        &mut self,
+        h: f64,
+        weights: Weights,
+        step: StepSoa,
+        model: &crate::Model,
+    ) -> bool {
+        self.forces_into_array(weights, model);
         let n = self.vertex_count();
         let s = &mut self.scratch;
         let t = &self.topology;
@@ -486,7 +479,8 @@ impl Cloth {
     /// when the solver stops above its tolerance (unless accepted). The result is checked by
     /// [`Self::check`], so this returns false (not checked here).
     fn forces_and_implicit_step(&mut self, h: f64, weights: Weights) -> Result<bool, Error> {
-        self.forces_into_array(weights);
+        let model = self.config.model;
+        self.forces_into_array(weights, &model);
         let n = self.vertex_count();
         let s = &mut self.scratch;
         let input = force_input!(self, s, weights);

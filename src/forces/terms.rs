@@ -119,6 +119,9 @@ pub struct Term {
     /// an explicit step (`cloth/auto_step.rs`). Contacts say 0: the automatic step weighs them
     /// by where the colliders touch.
     pub rate: fn(m: &Model, area: f64, speed: f64, w0: f64) -> f64,
+    /// Whether it acts along the normal alone (so on the water carried there too, which the
+    /// XPBD route's bound reads).
+    pub along_normal: bool,
 }
 
 /// Every per-particle term, in the order it is added.
@@ -140,6 +143,7 @@ const WEIGHT: Term = Term {
     add: |c, t, f| add_weight_widest(f, t.masses, c.gravity),
     linearise: None,
     rate: |_, _, _, _| 0.0,
+    along_normal: false,
 };
 
 /// Viscous drag on the velocity relative to the water, Eq. 3.
@@ -153,6 +157,7 @@ const VISCOUS_DRAG: Term = Term {
         b.damping += per_particle(m.viscous_drag, m.water.viscous_drag, p.area) * Matrix3::identity()
     }),
     rate: |m, area, _, _| per_particle(m.viscous_drag, m.water.viscous_drag, area),
+    along_normal: false,
 };
 
 /// History (Basset) drag, Eq. 4.
@@ -180,6 +185,7 @@ const HISTORY_DRAG: Term = Term {
         }
     }),
     rate: |m, area, _, w0| w0 * per_particle(m.history_drag, m.water.history_drag, area),
+    along_normal: false,
 };
 
 /// Drag on the normal velocity (the paper's regular models, Fig. 7).
@@ -198,6 +204,7 @@ const NORMAL_DRAG: Term = Term {
             per_particle(m.normal_drag, m.water.normal_drag, p.area) * (p.normal * p.normal.transpose())
     }),
     rate: |m, area, _, _| per_particle(m.normal_drag, m.water.normal_drag, area),
+    along_normal: true,
 };
 
 /// Form drag on the velocity normal to the cloth relative to the water, quadratic:
@@ -224,6 +231,7 @@ const FORM_DRAG: Term = Term {
         b.damping += k * (p.normal * p.normal.transpose());
     }),
     rate: |m, area, speed, _| m.water_density * m.water.form_drag * area * speed,
+    along_normal: true,
 };
 
 /// Skin drag on the velocity along the cloth relative to the water, linear.
@@ -243,6 +251,7 @@ const SKIN_DRAG: Term = Term {
         b.damping += k * (Matrix3::identity() - p.normal * p.normal.transpose());
     }),
     rate: |m, area, _, _| (m.water.skin_drag + m.water.skin_drag_unsteady) * area,
+    along_normal: false,
 };
 
 /// Penalty contacts with the colliders.
@@ -264,6 +273,7 @@ const CONTACTS: Term = Term {
         }
     }),
     rate: |_, _, _, _| 0.0,
+    along_normal: false,
 };
 
 /// What the terms that are on read, together (the added mass, an inertia rather than a
