@@ -29,7 +29,7 @@ this add-on.
 bl_info = {
     "name": "fraccloth: underwater cloth",
     "author": "fraccloth developers",
-    "version": (0, 9, 31),
+    "version": (0, 9, 32),
     "blender": (4, 2, 0),
     "location": "Properties > Physics > fraccloth",
     "description": "Cloth that moves as if underwater (fractional mass-spring model), baked to a point cache",
@@ -60,6 +60,7 @@ INTEGRATOR_ITEMS = [
     ("IMPLICIT", "Implicit Euler", "Stable at large steps (a frame); first order, so it damps fast motion: with the automatic step it takes substeps short enough for the motion (a 1-2 Hz swing: up to 1.4 times as many as symplectic Euler, each several times dearer); at a fixed step of a frame a 1-2 Hz swing's free edge moves 15-70 % less than with symplectic Euler. For slow scenes"),
     ("SYMPLECTIC2", "Symplectic, 2nd order", "Extrapolated symplectic Euler: error shrinks with the square of the step; 3x the work per step"),
     ("IMPLICIT2", "Implicit, 2nd order", "Extrapolated implicit Euler: second order and stable at a frame; 3x the work per step"),
+    ("XPBD", "XPBD (fewer substeps)", "Stretch and shear springs as compliant constraints: with the automatic step a 60 fps frame takes about 3 substeps instead of 14; first order, it damps the smallest ripples of a brisk swing"),
 ]
 FORMAT_ITEMS = [("PC2", "PC2", "PC2 point cache"), ("MDD", "MDD", "MDD point cache")]
 COLLIDER_ITEMS = [
@@ -122,6 +123,7 @@ def _library_preset():
         fraccloth.INTEGRATOR_IMPLICIT_EULER: "IMPLICIT",
         fraccloth.INTEGRATOR_EXTRAPOLATED_SYMPLECTIC: "SYMPLECTIC2",
         fraccloth.INTEGRATOR_EXTRAPOLATED_IMPLICIT: "IMPLICIT2",
+        fraccloth.INTEGRATOR_XPBD: "XPBD",
     }
     fractional = d.history_drag or d.history_drag_per_area or d.spring_damping_mode in (
         fraccloth.SPRING_DAMPING_FRACTIONAL, fraccloth.SPRING_DAMPING_FRACTIONAL_STRAIN)
@@ -468,6 +470,7 @@ def describe(s, scene=None):
         "IMPLICIT": fraccloth.INTEGRATOR_IMPLICIT_EULER,
         "SYMPLECTIC2": fraccloth.INTEGRATOR_EXTRAPOLATED_SYMPLECTIC,
         "IMPLICIT2": fraccloth.INTEGRATOR_EXTRAPOLATED_IMPLICIT,
+        "XPBD": fraccloth.INTEGRATOR_XPBD,
     }[s.integrator]
     return desc
 
