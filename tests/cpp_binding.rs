@@ -160,4 +160,25 @@ fn engine_example_survives_a_refused_tick_and_never_shows_a_torn_frame() {
     assert_eq!(&seen[1..], ["torn", "0", "backwards", "0"]);
     assert_eq!(line(&first, "last tick "), ["120"]);
     assert_eq!(line(&first, "corner "), line(&second, "corner "));
+    // With XPBD: the same refusal and recovery, and the tick's cost reported (not asserted).
+    let xpbd = run(&exe, &["120", "--xpbd"]);
+    assert_eq!(
+        line(&xpbd, "ticks "),
+        ["120", "refused", "1", "published", "119"],
+        "{xpbd}"
+    );
+    assert_eq!(
+        &line(&xpbd, "render reads ")[1..],
+        ["torn", "0", "backwards", "0"]
+    );
+    let cost = line(&xpbd, "step_ms ");
+    assert!(
+        cost[1].parse::<f64>().unwrap() > 0.0 && cost[3].parse::<f64>().unwrap() > 0.0,
+        "{xpbd}"
+    );
+    assert_ne!(
+        line(&xpbd, "corner "),
+        line(&first, "corner "),
+        "XPBD steps its own way"
+    );
 }

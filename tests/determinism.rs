@@ -78,20 +78,37 @@ fn cases() -> Vec<(String, Box<dyn Fn() -> Cloth + Sync>)> {
         "large-131x129-underwater-symplectic".into(),
         Box::new(large_underwater),
     ));
+    // XPBD (its constraints projected on one thread in a fixed order; the force pass split).
+    v.push((
+        "swing-underwater-61x41-xpbd-auto".into(),
+        Box::new(|| {
+            let spec = SceneSpec {
+                integrator: Integrator::Xpbd,
+                ..SceneSpec::underwater_swing(61, 41, 1.0, 0.04, Model::underwater())
+            };
+            let mut s = spec.build().unwrap();
+            s.run_until(0.5).unwrap();
+            s.cloth
+        }),
+    ));
+    v.push((
+        "large-131x129-underwater-xpbd".into(),
+        Box::new(|| large_stepped(Model::underwater(), Integrator::Xpbd)),
+    ));
     v
 }
 
 fn large() -> Cloth {
-    large_with(Variant::Fractional.model(0.01))
+    large_stepped(Variant::Fractional.model(0.01), Integrator::SymplecticEuler)
 }
 
 fn large_underwater() -> Cloth {
-    large_with(Model::underwater())
+    large_stepped(Model::underwater(), Integrator::SymplecticEuler)
 }
 
 /// A 131 x 129 cloth of `model` hanging from its top row in a current, 30 steps of
-/// symplectic Euler.
-fn large_with(mut model: Model) -> Cloth {
+/// `integrator`.
+fn large_stepped(mut model: Model, integrator: Integrator) -> Cloth {
     let (w, h) = (131u32, 129u32);
     let t = GridSpec {
         width: w,
@@ -106,7 +123,7 @@ fn large_with(mut model: Model) -> Cloth {
         t,
         ClothConfig {
             model,
-            integrator: Integrator::SymplecticEuler,
+            integrator,
             ..ClothConfig::default()
         },
     )
