@@ -119,6 +119,7 @@ fn colour(i: Integrator) -> RGBColor {
         Integrator::ImplicitEuler => RGBColor(44, 160, 44),
         Integrator::ExtrapolatedSymplectic => RGBColor(148, 103, 189),
         Integrator::ExtrapolatedImplicit => RGBColor(255, 127, 14),
+        Integrator::Xpbd => RGBColor(23, 190, 207),
     }
 }
 

@@ -98,6 +98,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (Integrator::ImplicitEuler, Step::Auto),
         (Integrator::ExtrapolatedImplicit, Step::Fixed(1.0 / 120.0)),
         (Integrator::ExtrapolatedImplicit, Step::Auto),
+        (Integrator::Xpbd, Step::Fixed(1.0 / 120.0)),
+        (Integrator::Xpbd, Step::Auto),
     ];
     let mut rows = vec![];
     for size in sizes.split(',') {

@@ -4,7 +4,8 @@
  * preset's automatic step splits it into as few substeps as the cloth needs), and reads back
  * positions and normals as a renderer would; the index buffer is read once. Prints the mean and
  * worst time of a frame's cloth work against the 16.7 ms budget of a 60 Hz frame, and the mean
- * and largest substeps a frame took. Usage: realtime [frames] (default 600 = 10 s). */
+ * and largest substeps a frame took. Usage: realtime [frames] [integrator] (default 600 = 10 s; an
+ * FcIntegrator value in place of the preset's, e.g. 1 for symplectic Euler, to compare). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -23,6 +24,7 @@ int main(int argc, char **argv) {
     const double frame_dt = 1.0 / 60.0, budget_ms = 1000.0 / 60.0;
     FcClothDesc desc;
     if (frames <= 0 || fc_cloth_desc_preset(FC_PRESET_UNDERWATER, &desc) != FC_OK) return 2;
+    if (argc > 2) desc.integrator = (uint32_t)atoi(argv[2]);
     /* desc.max_substep is FC_MAX_SUBSTEP_AUTO in the preset: one fc_cloth_step per frame. */
     FcCloth *cloth = NULL;
     if (fc_cloth_create_grid(&desc, &cloth) != FC_OK) {
@@ -44,7 +46,8 @@ int main(int argc, char **argv) {
     for (uint32_t k = 0; k < 3 * w; ++k) rest[k] = xyz[k];
     fc_cloth_set_pinned(cloth, top, w);
 
-    double sum = 0.0, worst = 0.0;
+    double sum = 0.0, worst = 0.0, *times = malloc(frames * sizeof *times);
+    if (!times) return 1;
     int over = 0;
     unsigned long substeps_sum = 0;
     uint32_t substeps_most = 0;
@@ -69,6 +72,7 @@ int main(int argc, char **argv) {
         substeps_sum += substeps;
         if (substeps > substeps_most) substeps_most = substeps;
         sum += ms;
+        times[f] = ms;
         if (ms > worst) worst = ms;
         if (ms > budget_ms) ++over;
     }
@@ -76,11 +80,13 @@ int main(int argc, char **argv) {
     double depth = 0.0; /* how far the cloth was swung out of its plane, m */
     for (size_t k = 0; k < n; ++k) depth = fabs(xyz[3 * k + 2]) > depth ? fabs(xyz[3 * k + 2]) : depth;
     printf("cloth %zu vertices %zu triangles, %d frames of %.4f s\n", n, t, frames, frame_dt);
-    printf("frame_ms mean %.3f worst %.3f budget %.3f over %d\n", sum / frames, worst, budget_ms, over);
+    for (int a = 1; a < frames; ++a) /* sort the frame times for the median */
+        for (int b = a; b > 0 && times[b - 1] > times[b]; --b) { double x = times[b]; times[b] = times[b - 1]; times[b - 1] = x; }
+    printf("frame_ms mean %.3f median %.3f worst %.3f budget %.3f over %d\n", sum / frames, times[frames / 2], worst, budget_ms, over);
     printf("substeps mean %.2f most %u\n", (double)substeps_sum / frames, (unsigned)substeps_most);
     printf("corner %.5f %.5f %.5f normal %.4f %.4f %.4f\n", c[0], c[1], c[2], nc[0], nc[1], nc[2]);
     printf("largest_z %.5f\n", depth);
     fc_cloth_destroy(cloth);
-    free(xyz); free(normals); free(rest); free(target); free(indices); free(top);
+    free(times); free(xyz); free(normals); free(rest); free(target); free(indices); free(top);
     return 0;
 }

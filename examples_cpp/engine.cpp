@@ -5,15 +5,18 @@
 // thrown a kilometre away, as a broken animation would): the engine keeps the last good frame
 // on screen, reports the status and the library's message, puts the pins back and goes on.
 //
-// Prints the frames simulated, refused and published, what the renderer saw, and the last
-// published corner. Usage: engine [ticks] [--realtime]  (default 240 ticks, as fast as the CPU
-// goes; --realtime paces the ticks at 60 Hz as a game would).
+// Prints the frames simulated, refused and published, what the renderer saw, what a tick's step
+// cost (median and worst, ms; reported, never asserted) and the last published corner.
+// Usage: engine [ticks] [--realtime] [--xpbd]  (default 240 ticks, as fast as the CPU goes;
+// --realtime paces the ticks at 60 Hz as a game would; --xpbd steps the preset with
+// FC_INTEGRATOR_XPBD, about half the cost a tick: docs/realtime.md).
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <algorithm>
 #include <mutex>
 #include <numeric>
 #include <thread>
@@ -68,10 +71,15 @@ private:
 
 int main(int argc, char** argv) {
     const long ticks = argc > 1 ? std::atol(argv[1]) : 240;
-    const bool realtime = argc > 2 && std::strcmp(argv[2], "--realtime") == 0;
+    bool realtime = false, xpbd = false;
+    for (int a = 2; a < argc; ++a) {
+        realtime = realtime || std::strcmp(argv[a], "--realtime") == 0;
+        xpbd = xpbd || std::strcmp(argv[a], "--xpbd") == 0;
+    }
     if (ticks < 2) return 2;
     try {
         FcClothDesc desc = fraccloth::preset_desc(FC_PRESET_UNDERWATER);
+        if (xpbd) desc.integrator = FC_INTEGRATOR_XPBD;
         fraccloth::Cloth cloth = fraccloth::Cloth::grid(desc);
         // The engine's own threads: the cloth steps on the calling (simulation) thread only.
         cloth.set_threads(1);
@@ -110,6 +118,7 @@ int main(int argc, char** argv) {
         // The simulation thread (this one): one step per tick.
         std::vector<float> targets(3 * top.size());
         long refused = 0, published = 0;
+        std::vector<double> step_ms;
         const long broken = ticks / 2;  // the tick whose pins an animation bug throws away
         auto next = std::chrono::steady_clock::now();
         for (long tick = 1; tick <= ticks; ++tick) {
@@ -122,7 +131,9 @@ int main(int argc, char** argv) {
             }
             cloth.set_pin_targets(top, targets);
             try {
+                const auto begun = std::chrono::steady_clock::now();
                 cloth.step(kTick);
+                step_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begun).count());
             } catch (const fraccloth::Error& e) {
                 // Refused: the cloth is exactly as it was; the last good frame stays on screen.
                 ++refused;
@@ -148,6 +159,9 @@ int main(int argc, char** argv) {
         const std::size_t corner = floats / 3 - desc.width;
         std::printf("ticks %ld refused %ld published %ld\n", ticks, refused, published);
         std::printf("render reads %ld torn %ld backwards %ld\n", reads.load(), torn.load(), backwards.load());
+        std::sort(step_ms.begin(), step_ms.end());
+        if (!step_ms.empty())
+            std::printf("step_ms median %.3f worst %.3f\n", step_ms[step_ms.size() / 2], step_ms.back());
         std::printf("last tick %ld\n", last.tick);
         std::printf("corner %zu %.9g %.9g %.9g\n", corner, last.positions[3 * corner], last.positions[3 * corner + 1],
                     last.positions[3 * corner + 2]);

@@ -1,7 +1,8 @@
 /* icount.c: a host loop for instruction counts through the C ABI (docs/journal/2026-12-07-house.md).
  * cc -O2 -std=c99 -Iinclude scripts/icount.c -Ltarget/release -lfraccloth -lm -o target/icount
- * LD_LIBRARY_PATH=target/release valgrind --tool=callgrind target/icount PRESET WIDTH HEIGHT FRAMES
- * PRESET: 4 the underwater preset (frames of 1/60 s), -1 the library default (steps of 0.5 ms). */
+ * LD_LIBRARY_PATH=target/release valgrind --tool=callgrind target/icount PRESET WIDTH HEIGHT FRAMES [INTEGRATOR]
+ * PRESET: 4 the underwater preset (frames of 1/60 s), -1 the library default (steps of 0.5 ms).
+ * INTEGRATOR: an FcIntegrator value in place of the preset's (5: XPBD). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,6 +13,7 @@ int main(int argc, char **argv) {
     FcClothDesc desc = fc_cloth_desc_default();
     if (preset >= 0 && fc_cloth_desc_preset((FcPreset)preset, &desc) != FC_OK) return 2;
     desc.width = W; desc.height = H;
+    if (argc > 5) desc.integrator = (uint32_t)atoi(argv[5]);
     FcCloth *cloth = NULL;
     if (fc_cloth_create_grid(&desc, &cloth) != FC_OK) { fprintf(stderr, "%s\n", fc_last_error_message()); return 1; }
     fc_cloth_set_threads(cloth, 1);
