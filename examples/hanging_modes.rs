@@ -18,7 +18,13 @@ use fraccloth::topology::grid_index;
 use fraccloth::{Cloth, ClothConfig, GridSpec, Integrator, Model};
 
 /// The first five zeros of J0.
-const ALPHA: [f64; 5] = [2.404_825_557_7, 5.520_078_110_3, 8.653_727_912_9, 11.791_534_439_0, 14.930_917_708_5];
+const ALPHA: [f64; 5] = [
+    2.404_825_557_7,
+    5.520_078_110_3,
+    8.653_727_912_9,
+    11.791_534_439_0,
+    14.930_917_708_5,
+];
 
 /// Zero crossings read: three periods.
 const CROSSINGS: usize = 7;
@@ -78,7 +84,13 @@ fn main() {
 /// and `mu` kg/m^2 stepped with `integrator`: from its first [`CROSSINGS`] zero crossings (three
 /// periods, while the started mode still dominates the drags and the modes the bend springs mix
 /// in; 0 when it crossed fewer than twice).
-fn frequency(integrator: Integrator, (w, h, spacing, mu): (u32, u32, f64, f64), alpha: f64, amp: f64, seconds: f64) -> f64 {
+fn frequency(
+    integrator: Integrator,
+    (w, h, spacing, mu): (u32, u32, f64, f64),
+    alpha: f64,
+    amp: f64,
+    seconds: f64,
+) -> f64 {
     let t = GridSpec {
         width: w,
         height: h,
@@ -113,7 +125,10 @@ fn frequency(integrator: Integrator, (w, h, spacing, mu): (u32, u32, f64, f64), 
     let column = w / 2;
     let amplitude = |c: &Cloth| {
         let p = c.positions();
-        (0..h).map(|j| p[grid_index(w, column, j) as usize].z * shape[j as usize]).sum::<f64>() / norm
+        (0..h)
+            .map(|j| p[grid_index(w, column, j) as usize].z * shape[j as usize])
+            .sum::<f64>()
+            / norm
     };
     let (mut crossings, mut last) = (Vec::new(), (0.0, amplitude(&c)));
     let dt = 1.0 / 60.0;
