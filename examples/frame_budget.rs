@@ -65,12 +65,9 @@ struct Row {
 }
 
 fn main() {
-    let args: Vec<(String, String)> = std::env::args()
-        .skip(1)
-        .filter_map(|a| a.split_once('=').map(|(k, v)| (k.to_string(), v.to_string())))
-        .collect();
-    let get = |k: &str| args.iter().find(|(key, _)| key == k).map(|(_, v)| v.clone());
-    let num = |k: &str, d: f64| get(k).map_or(d, |v| v.parse().expect("a number"));
+    let args = fraccloth_tools::args::Args::from_env();
+    let get = |k: &str| args.get(k);
+    let num = |k: &str, d: f64| args.num(k, d);
     let list = |k: &str, d: &str| -> Vec<String> {
         get(k).unwrap_or(d.into()).split(',').map(String::from).collect()
     };
@@ -83,10 +80,7 @@ fn main() {
         .map(|f| f.parse().expect("frames/s"))
         .collect();
     let ways = list("ways", "symplectic,xpbd,xpbd_scaled,implicit_frame");
-    let (w, h) = get("size").map_or((61, 41), |s| {
-        let (a, b) = s.split_once('x').expect("COLSxROWS");
-        (a.parse().expect("cols"), b.parse().expect("rows"))
-    });
+    let (w, h) = args.size("size", (61, 41));
     let jittered = get("jittered").is_some();
     println!(
         "# {w}x{h}{}, one thread, {} s bakes; deviations against the first row of each drive and frame rate",

@@ -41,16 +41,9 @@ fn j0(z: f64) -> f64 {
 }
 
 fn main() {
-    let args: Vec<(String, String)> = std::env::args()
-        .skip(1)
-        .filter_map(|a| a.split_once('=').map(|(k, v)| (k.to_string(), v.to_string())))
-        .collect();
-    let get = |k: &str| args.iter().find(|(key, _)| key == k).map(|(_, v)| v.clone());
-    let num = |k: &str, d: f64| get(k).map_or(d, |v| v.parse().expect("a number"));
-    let (w, h): (u32, u32) = get("size").map_or((61, 41), |s| {
-        let (a, b) = s.split_once('x').expect("COLSxROWS");
-        (a.parse().expect("cols"), b.parse().expect("rows"))
-    });
+    let args = fraccloth_tools::args::Args::from_env();
+    let num = |k: &str, d: f64| args.num(k, d);
+    let (w, h) = args.size("size", (61, 41));
     let (seconds, amp) = (num("seconds", 32.0), num("amp", 0.005));
     let model = Model::underwater();
     let (spacing, mu) = (0.01, 1.0);

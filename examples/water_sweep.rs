@@ -23,12 +23,9 @@ use fraccloth_tools::look::measure;
 use fraccloth_tools::scenes::{Drive, SceneKind, SceneSpec, Variant};
 
 fn main() {
-    let args: Vec<(String, String)> = std::env::args()
-        .skip(1)
-        .filter_map(|a| a.split_once('=').map(|(k, v)| (k.to_string(), v.to_string())))
-        .collect();
-    let get = |k: &str| args.iter().find(|(key, _)| key == k).map(|(_, v)| v.clone());
-    let num = |k: &str, d: f64| get(k).map_or(d, |v| v.parse().expect("a number"));
+    let args = fraccloth_tools::args::Args::from_env();
+    let get = |k: &str| args.get(k);
+    let num = |k: &str, d: f64| args.num(k, d);
     let freqs: Vec<f64> = get("freq")
         .unwrap_or("0.25,0.5,1,2".into())
         .split(',')

@@ -79,9 +79,9 @@ fn the_jittered_mesh_takes_the_same_few_substeps() {
     );
 }
 
-/// A 31 x 21 underwater cloth hanging from its top row, with a sphere under it and
-/// self-collision on, stepped 1 s in 60 Hz frames.
-fn hanging(integrator: Integrator, seconds: f64) -> Cloth {
+/// A 31 x 21 cloth of `model` (1 cm, 1 kg/m^2) hanging from its top row, with the automatic
+/// step.
+fn pinned(model: Model, integrator: Integrator) -> Cloth {
     let (w, h) = (31u32, 21u32);
     let t = GridSpec {
         width: w,
@@ -91,8 +91,6 @@ fn hanging(integrator: Integrator, seconds: f64) -> Cloth {
     }
     .build()
     .unwrap();
-    let mut model = Model::underwater();
-    model.self_collision_relative = 0.4;
     let config = ClothConfig {
         model,
         integrator,
@@ -102,6 +100,15 @@ fn hanging(integrator: Integrator, seconds: f64) -> Cloth {
     let mut c = Cloth::new(t, config).unwrap();
     let top: Vec<u32> = (0..w).map(|i| grid_index(w, i, 0)).collect();
     c.set_pinned(&top).unwrap();
+    c
+}
+
+/// The underwater cloth of [`pinned`] with a sphere under it and self-collision on, stepped
+/// `seconds` in 60 Hz frames.
+fn hanging(integrator: Integrator, seconds: f64) -> Cloth {
+    let mut model = Model::underwater();
+    model.self_collision_relative = 0.4;
+    let mut c = pinned(model, integrator);
     c.add_collider(Collider::Sphere(Sphere {
         center: Vec3::new(0.15, -0.3, 0.05),
         radius: 0.06,
@@ -164,26 +171,9 @@ fn a_current_presses_it_on_a_mesh_wall_it_does_not_pass() {
 
 /// How far the cloth reaches along a 0.3 m/s current towards a mesh wall 3 cm in front of it.
 fn pressed_on_a_wall(integrator: Integrator) -> f64 {
-    let (w, h) = (31u32, 21u32);
-    let t = GridSpec {
-        width: w,
-        height: h,
-        spacing: 0.01,
-        total_mass: 1e-4 * f64::from(w * h),
-    }
-    .build()
-    .unwrap();
     let mut model = Model::underwater();
     model.current = Vec3::new(0.0, 0.0, 0.3);
-    let config = ClothConfig {
-        model,
-        integrator,
-        max_substep: fraccloth::cloth::AUTO,
-        ..ClothConfig::default()
-    };
-    let mut c = Cloth::new(t, config).unwrap();
-    let top: Vec<u32> = (0..w).map(|i| grid_index(w, i, 0)).collect();
-    c.set_pinned(&top).unwrap();
+    let mut c = pinned(model, integrator);
     // A wall of two triangles 3 cm in front of the cloth, across the current.
     let z = 0.03;
     let wall = [

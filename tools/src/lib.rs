@@ -13,6 +13,7 @@
 // Analysis loops walk several per-particle arrays with one index; that reads better than zips.
 #![allow(clippy::needless_range_loop)]
 
+pub mod args;
 pub mod look;
 pub mod oscillator;
 pub mod read;
