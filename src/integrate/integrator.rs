@@ -27,7 +27,8 @@ pub enum Integrator {
     /// constraint `|x_i - x_j| - r` of compliance `1/k` with Rayleigh damping c, projected once
     /// a substep (`integrate/xpbd.rs`). The stretch and shear springs no longer bound the step,
     /// so a frame takes a few substeps where symplectic Euler takes a dozen; first order.
-    /// Needs velocity (or no) spring damping. See `docs/realtime.md`.
+    /// Velocity spring damping rides on the constraints; fractional damping stays a force.
+    /// See `docs/realtime.md`.
     Xpbd,
 }
 
