@@ -7,12 +7,15 @@
 //! seconds, one `step` call per frame of `1/fps` s on one thread, as a game's loop does, and
 //! prints the median and worst wall time of a frame's call (ms), the substeps a frame took,
 //! and the look by the project's meter (half-waves, travel speed, mid ratio, hang) with each
-//! descriptor's deviation from the first row of the same drive and frame rate (the preset's
-//! symplectic Euler at its automatic step). Keys: `freq=0.5,1,2`, `fps=60`, `size=61x41`,
+//! descriptor's deviation from the first completed row of the same drive and frame rate (the
+//! preset's symplectic Euler at its automatic step unless `ways` leaves it out). Keys:
+//! `freq=0.5,1,2`, `fps=60`, `size=61x41`,
 //! `jittered=1` (the irregular triangle mesh of the same size), `amp=0.04`, `seconds=12`,
 //! `ways=symplectic,xpbd,xpbd_scaled,implicit_frame` (which ways of stepping; `xpbd_scaled`
 //! is XPBD with the form drag smoothed over 1.15 cm instead of 1 cm, `implicit_frame` implicit
-//! Euler at one step a frame).
+//! Euler at one step a frame), `substeps=8,10,15` (every way at that many equal substeps a frame
+//! instead of its own step, each drive's first row the preset at its automatic step for
+//! reference: what the look needs, and where a way stops being stable).
 
 use fraccloth::{Integrator, Model, Vec3};
 use fraccloth_tools::look::measure;
@@ -88,43 +91,90 @@ fn main() {
         num("seconds", 12.0)
     );
     println!("way | freq Hz | fps | median ms | worst ms | substeps | half-waves | travel m/s | mid | hang m | deviation (half-waves, travel, mid) | status");
+    let substeps: Vec<f64> = list("substeps", "0")
+        .iter()
+        .map(|n| n.parse().expect("substeps a frame"))
+        .collect();
     for &fps in &fps_list {
         for &f in &freqs {
+            let scene = |substeps: f64| Bake {
+                freq: f,
+                fps,
+                size: (w, h),
+                jittered,
+                amp: num("amp", 0.04),
+                seconds: num("seconds", 12.0),
+                substeps,
+            };
+            // With fixed substeps, the reference is the preset at its own step.
+            let fixed = substeps.iter().any(|&n| n > 0.0);
             let mut reference: Option<[f64; 3]> = None;
-            for way in WAYS.iter().filter(|w| ways.iter().any(|n| n == w.name)) {
-                let row = bake(
-                    way,
-                    f,
-                    fps,
-                    (w, h),
-                    jittered,
-                    num("amp", 0.04),
-                    num("seconds", 12.0),
-                );
-                let base = *reference.get_or_insert(row.look);
-                let dev = |k: usize| 100.0 * (row.look[k] / base[k] - 1.0);
-                println!(
-                    "{} | {f} | {fps} | {:.3} | {:.3} | {:.2} | {:.2} | {:.3} | {:.3} | {:.3} | {:+.1} %, {:+.1} %, {:+.1} % | {}",
-                    way.name,
-                    row.median_ms,
-                    row.worst_ms,
-                    row.substeps,
-                    row.look[0],
-                    row.look[1],
-                    row.look[2],
-                    row.hang,
-                    dev(0),
-                    dev(1),
-                    dev(2),
-                    row.status
-                );
+            if fixed {
+                let row = bake(&WAYS[0], &scene(0.0));
+                reference = (row.status == "ok").then_some(row.look);
+                print_row("symplectic (automatic step)", f, fps, &row, reference);
+            }
+            for &n in &substeps {
+                for way in WAYS.iter().filter(|w| ways.iter().any(|name| name == w.name)) {
+                    let row = bake(way, &scene(n));
+                    // Against the first row that completed (a way refused has no look).
+                    if row.status == "ok" && reference.is_none() {
+                        reference = Some(row.look);
+                    }
+                    print_row(way.name, f, fps, &row, reference);
+                }
             }
         }
     }
 }
 
+/// Prints one bake's row, its look's deviations from `reference`'s (percent).
+fn print_row(name: &str, f: f64, fps: f64, row: &Row, reference: Option<[f64; 3]>) {
+    let base = reference.unwrap_or([f64::NAN; 3]);
+    let dev = |k: usize| match row.status == "ok" {
+        true => format!("{:+.1} %", 100.0 * (row.look[k] / base[k] - 1.0)),
+        false => "-".to_string(),
+    };
+    println!(
+        "{name} | {f} | {fps} | {:.3} | {:.3} | {:.2} | {:.2} | {:.3} | {:.3} | {:.3} | {}, {}, {} | {}",
+        row.median_ms,
+        row.worst_ms,
+        row.substeps,
+        row.look[0],
+        row.look[1],
+        row.look[2],
+        row.hang,
+        dev(0),
+        dev(1),
+        dev(2),
+        row.status
+    );
+}
+
+/// One bake's scene: the drive (Hz), frame rate, grid size, mesh, swing (m), length (s) and
+/// substeps a frame (0: the way's own).
+#[derive(Clone, Copy)]
+struct Bake {
+    freq: f64,
+    fps: f64,
+    size: (u32, u32),
+    jittered: bool,
+    amp: f64,
+    seconds: f64,
+    substeps: f64,
+}
+
 /// Bakes the swing one way and measures it.
-fn bake(way: &Way, freq: f64, fps: f64, (w, h): (u32, u32), jittered: bool, amp: f64, seconds: f64) -> Row {
+fn bake(way: &Way, b: &Bake) -> Row {
+    let Bake {
+        freq,
+        fps,
+        size: (w, h),
+        jittered,
+        amp,
+        seconds,
+        substeps: fixed,
+    } = *b;
     let mut model = Model::underwater();
     model.water.form_drag_scale = way.scale;
     let spec = SceneSpec {
@@ -139,7 +189,11 @@ fn bake(way: &Way, freq: f64, fps: f64, (w, h): (u32, u32), jittered: bool, amp:
             current: Vec3::zeros(),
         },
         scheme: fraccloth::history::Scheme::DEFAULT,
-        max_substep: if way.auto { fraccloth::cloth::AUTO } else { 0.0 },
+        max_substep: match (fixed > 0.0, way.auto) {
+            (true, _) => 1.0 / (fps * fixed),
+            (false, true) => fraccloth::cloth::AUTO,
+            (false, false) => 0.0,
+        },
         model: Some(model),
         jittered,
         ..SceneSpec::paper(SceneKind::Swing, Variant::Underwater)
