@@ -10,6 +10,7 @@
 use super::Cloth;
 use crate::error::Error;
 use crate::forces::{Inertia, Weights};
+use crate::integrate::xpbd::runs::{self, RunPlan};
 use crate::integrate::xpbd::{self, Batches, Compliance, InverseMass, Link};
 use crate::integrate::StepSoa;
 use crate::math::Vec3;
@@ -42,17 +43,42 @@ pub(super) fn forces_model(m: &Model) -> Model {
     f
 }
 
-/// The constraints' buffers: the links (built once for the families that are on), each
-/// particle's inverse mass and each link's multiplier.
+/// The constraints' buffers: the links (built once for the families that are on) and each
+/// particle's inverse mass.
 #[derive(Clone, Debug, Default)]
 pub(super) struct ConstraintScratch {
     links: Batches,
+    /// On a grid, the links as runs of blocks (`xpbd/runs.rs`) instead, and the particles'
+    /// component arrays they are projected on.
+    runs: Option<RunPlan>,
+    particles: runs::Particles,
     /// Which families the links were built for (`None`: not built yet).
     built_for: Option<[bool; 3]>,
     inverse: Vec<InverseMass>,
 }
 
 impl ConstraintScratch {
+    /// One pass over the links on the predicted positions `x` (`start`: where the substep
+    /// began), as runs on a grid, as batches otherwise.
+    fn project(&mut self, params: &[Compliance; 3], start: &[Vec3], x: &mut [Vec3]) {
+        let Some(plan) = &self.runs else {
+            xpbd::project(&self.links, params, &self.inverse, start, x);
+            return;
+        };
+        let p = &mut self.particles;
+        let each = self.inverse.iter().zip(x.iter().zip(start));
+        for (i, (inv, (xi, si))) in each.enumerate() {
+            for k in 0..3 {
+                (p.x[k][i], p.start[k][i], p.u[k][i]) = (xi[k], si[k], inv.u[k]);
+            }
+            p.w[i] = inv.w;
+        }
+        runs::project(plan, params, p);
+        for (i, xi) in x.iter_mut().enumerate() {
+            *xi = Vec3::new(p.x[0][i], p.x[1][i], p.x[2][i]);
+        }
+    }
+
     /// Builds the links of the families `on` (by [`SpringKind`] index) in the topology's spring
     /// order, unless they are built already; fails with out-of-memory when the room cannot be had.
     fn build(&mut self, t: &Topology, on: [bool; 3]) -> Result<(), Error> {
@@ -71,7 +97,27 @@ impl ConstraintScratch {
             rest: s.rest,
             family: s.kind as u8,
         }));
-        self.links = Batches::of(&links, n).ok_or_else(|| room("constraints' batches"))?;
+        // A grid's links as runs of blocks (`xpbd/runs.rs`); any other mesh's as batches.
+        (self.links, self.runs) = (Batches::default(), None);
+        if t.grid_faces.is_some() {
+            let on_runs = t.spring_runs.iter().filter(|r| on[usize::from(r.kind)]);
+            let plan = RunPlan::of(
+                on_runs.map(|r| runs::Run {
+                    i0: r.first_vertex as usize,
+                    offset: r.offset as usize,
+                    rest: &t.spring_rest[r.first_spring as usize..(r.first_spring + r.len) as usize],
+                    family: r.kind,
+                }),
+                n,
+            )
+            .ok_or_else(|| room("constraints' runs"))?;
+            self.particles
+                .ready(n)
+                .ok_or_else(|| room("constraints' arrays"))?;
+            self.runs = Some(plan);
+        } else {
+            self.links = Batches::of(&links, n).ok_or_else(|| room("constraints' batches"))?;
+        }
         self.inverse
             .try_reserve_exact(n)
             .map_err(|_| room("inverse masses"))?;
@@ -128,7 +174,7 @@ impl Cloth {
                 s.x_new[p as usize] = s.pins.goal[p as usize];
             }
         }
-        xpbd::project(&c.links, &params, &c.inverse, &self.state.x, &mut s.x_new);
+        c.project(&params, &self.state.x, &mut s.x_new);
         let x = &self.state.x;
         for (i, (v, xn)) in s.v_new.iter_mut().zip(s.x_new.iter()).enumerate() {
             if !self.pins.pinned[i] {

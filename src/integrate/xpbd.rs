@@ -23,11 +23,16 @@
 //! The inverse mass carries the water along the normal ([`InverseMass`]): a particle moves
 //! `1 - beta` as far along its normal as along the cloth for the same impulse, as the
 //! explicit step's `M^{-1}` does (`forces/inertia.rs`).
+//!
+//! Two ways through the links, the same step for each (`link_update`): a grid's links come
+//! as runs, projected in blocks on component arrays without gathers (`xpbd/runs.rs`); any other
+//! mesh's are ordered into [`Batches`] and projected four at a time with AVX2 gathers.
 
 use crate::math::Vec3;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+pub mod runs;
 
 /// One constraint: the pair, its rest length (m) and its family's index in the parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -225,31 +230,53 @@ fn project_one(
     x: &mut [Vec3],
 ) {
     let (i, j) = (link.i as usize, link.j as usize);
-    let (xi, xj, si, sj) = (x[i], x[j], start[i], start[j]);
+    let v = |a: Vec3| [a.x, a.y, a.z];
     let (a, b) = (inverse[i], inverse[j]);
-    let p = params[link.family as usize];
+    let (ni, nj) = link_update(
+        v(x[i]),
+        v(x[j]),
+        (v(start[i]), v(start[j])),
+        (a.w, v(a.u)),
+        (b.w, v(b.u)),
+        params[link.family as usize],
+        link.rest,
+    );
+    x[i] = Vec3::from(ni);
+    x[j] = Vec3::from(nj);
+}
+
+/// The step of one link (module docs) from its ends' positions `xi`, `xj`, where they began
+/// the substep, and their inverse masses (`w`, `u`): the ends' new positions. Every pass
+/// (scalar, AVX2, runs) takes these operations in this order: the same bits.
+#[inline(always)]
+fn link_update(
+    xi: [f64; 3],
+    xj: [f64; 3],
+    (si, sj): ([f64; 3], [f64; 3]),
+    (wa, ua): (f64, [f64; 3]),
+    (wb, ub): (f64, [f64; 3]),
+    p: Compliance,
+    rest: f64,
+) -> ([f64; 3], [f64; 3]) {
     let d: [f64; 3] = std::array::from_fn(|c| xi[c] - xj[c]);
     let moved: [f64; 3] = std::array::from_fn(|c| (xi[c] - si[c]) - (xj[c] - sj[c]));
     let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
     let l2 = dot(d, d);
-    let l = l2.sqrt();
     // Zero length: no direction, no move.
+    let l = l2.sqrt();
     let inv_l = if l2 > 0.0 { 1.0 / l } else { 0.0 };
     let g = d.map(|dc| dc * inv_l);
-    let (ua, ub) = ([a.u.x, a.u.y, a.u.z], [b.u.x, b.u.y, b.u.z]);
     let (ag, bg, along) = (dot(ua, g), dot(ub, g), dot(g, moved));
     // g^T W g for a unit g: w - (u . g)^2 for each end.
-    let weight = (a.w - ag * ag) + (b.w - bg * bg);
-    let step = (-p.kappa * (l - link.rest) - p.delta * along) / ((p.kappa + p.delta) * weight + 1.0);
+    let weight = (wa - ag * ag) + (wb - bg * bg);
+    let step = (-p.kappa * (l - rest) - p.delta * along) / ((p.kappa + p.delta) * weight + 1.0);
     // No weight (both ends held) or no direction: no move (NaN fails the test too).
     let dl = if weight > 0.0 && l2 > 0.0 { step } else { 0.0 };
-    let (wa, wb, aa, bb) = (dl * a.w, dl * b.w, dl * ag, dl * bg);
-    x[i] = Vec3::from(std::array::from_fn::<f64, 3, _>(|c| {
-        xi[c] + wa * g[c] - aa * ua[c]
-    }));
-    x[j] = Vec3::from(std::array::from_fn::<f64, 3, _>(|c| {
-        xj[c] - wb * g[c] + bb * ub[c]
-    }));
+    let (a, b, aa, bb) = (dl * wa, dl * wb, dl * ag, dl * bg);
+    (
+        std::array::from_fn(|c| xi[c] + a * g[c] - aa * ua[c]),
+        std::array::from_fn(|c| xj[c] - b * g[c] + bb * ub[c]),
+    )
 }
 
 #[cfg(test)]
