@@ -36,8 +36,8 @@ pub struct RunPlan {
     rest: Vec<f64>,
 }
 
-/// A run of links for [`RunPlan::of`]: `len` links from first end `i0`, second ends `offset`
-/// further (`offset >= 1`), their rest lengths (m) and family index.
+/// A run of links for [`RunPlan::of`]: one link per rest length (m), the first from particle
+/// `i0`, each second end `offset` further (`offset >= 1`), and the links' family index.
 pub struct Run<'a> {
     pub i0: usize,
     pub offset: usize,
