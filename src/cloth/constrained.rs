@@ -88,15 +88,6 @@ impl ConstraintScratch {
         self.built_for = None;
         let room = |what: &str| Error::out_of_memory(format!("XPBD: no room for the {what}"));
         let n = t.vertex_count();
-        let mut links = Vec::new();
-        let count = t.springs.iter().filter(|s| on[s.kind as usize]).count();
-        links.try_reserve_exact(count).map_err(|_| room("constraints"))?;
-        links.extend(t.springs.iter().filter(|s| on[s.kind as usize]).map(|s| Link {
-            i: s.i,
-            j: s.j,
-            rest: s.rest,
-            family: s.kind as u8,
-        }));
         // A grid's links as runs of blocks (`xpbd/runs.rs`); any other mesh's as batches.
         (self.links, self.runs) = (Batches::default(), None);
         if t.grid_faces.is_some() {
@@ -116,6 +107,15 @@ impl ConstraintScratch {
                 .ok_or_else(|| room("constraints' arrays"))?;
             self.runs = Some(plan);
         } else {
+            let mut links = Vec::new();
+            let count = t.springs.iter().filter(|s| on[s.kind as usize]).count();
+            links.try_reserve_exact(count).map_err(|_| room("constraints"))?;
+            links.extend(t.springs.iter().filter(|s| on[s.kind as usize]).map(|s| Link {
+                i: s.i,
+                j: s.j,
+                rest: s.rest,
+                family: s.kind as u8,
+            }));
             self.links = Batches::of(&links, n).ok_or_else(|| room("constraints' batches"))?;
         }
         self.inverse

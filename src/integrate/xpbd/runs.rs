@@ -117,11 +117,6 @@ impl RunPlan {
     pub fn is_empty(&self) -> bool {
         self.blocks.is_empty()
     }
-
-    /// The particles it was made for.
-    pub fn particles(&self) -> usize {
-        self.n
-    }
 }
 
 /// The particles on component arrays for a pass: positions (moved), positions where the
