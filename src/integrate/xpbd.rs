@@ -16,9 +16,15 @@
 //! `alpha~ = 1 / (k h^2)`, `gamma = c / (k h)` and the multiplier from 0, multiplied through by
 //! `k h^2` so that a spring may carry damping alone (`k = 0`: its damping implicit, its
 //! stiffness left to the forces). The stiffness no longer bounds the step: a stiff spring is a
-//! small compliance. With one pass the springs act softer than `k` in fast motion, and the
-//! pass damps what moves faster than the step resolves (exact at rest: a weight hangs at
-//! `m g / k`, tested below); that is what XPBD trades for its step.
+//! small compliance. What one pass trades for its step: a spring alone rests exactly where
+//! its stiffness holds it (a weight hangs at `m g / k`, tested below), but a chain of them is
+//! held softer, because each link is projected on positions its neighbours' corrections have
+//! not yet reached. A chain of springs `k` between particles of mass `m` rests stretched about
+//! `1 + (omega h)^2` times as far as its springs hold it, `omega^2 = k / m` (measured below:
+//! 1.01, 2.0 and 4.0 at `(omega h)^2` = 0.01, 1 and 3.1), and moves as that softer chain
+//! would; the pass also damps what moves faster than the step resolves. The underwater
+//! preset's stretch springs at three substeps a 60 Hz frame have `(omega h)^2 = 3.1`
+//! (`docs/realtime.md` says what that does to a tall cloth).
 //!
 //! The inverse mass carries the water along the normal ([`InverseMass`]): a particle moves
 //! `1 - beta` as far along its normal as along the cloth for the same impulse, as the
@@ -319,6 +325,60 @@ mod tests {
         let want = -0.1 - m * 9.81 / k;
         assert!((x.y - want).abs() < 1e-9, "{} against {want}", x.y);
         assert!(v.norm() < 1e-9);
+    }
+
+    /// A chain of `links` particles of mass `m` hung from a held one by springs of stiffness
+    /// `k` (rest 1 cm), stepped under gravity `h` at a time (symplectic prediction, one pass a
+    /// substep) until it rests: its stretch over the stretch its springs hold (each link the
+    /// weight of the particles below it).
+    fn chain_stretch(links: usize, m: f64, k: f64, h: f64) -> f64 {
+        let (n, r, g) = (links + 1, 0.01, 9.81);
+        let chain: Vec<Link> = (0..links)
+            .map(|i| Link {
+                i: i as u32,
+                j: i as u32 + 1,
+                rest: r,
+                family: 0,
+            })
+            .collect();
+        let batches = Batches::of(&chain, n).unwrap();
+        // Damping makes it rest (where it rests does not depend on it).
+        let params = [Compliance::of(k, 0.05 * (k * m).sqrt(), h); 3];
+        let mut inverse = vec![InverseMass::of(m, 0.0, Vec3::z()); n];
+        inverse[0] = InverseMass::default();
+        let mut x: Vec<Vec3> = (0..n).map(|i| Vec3::new(0.0, -r * i as f64, 0.0)).collect();
+        let mut v = vec![Vec3::zeros(); n];
+        for _ in 0..(40.0 / h) as usize {
+            let start = x.clone();
+            for i in 1..n {
+                v[i].y -= h * g;
+                x[i] += h * v[i];
+            }
+            project(&batches, &params, &inverse, &start, &mut x);
+            for i in 1..n {
+                v[i] = (x[i] - start[i]) / h;
+            }
+        }
+        let stretch = -x[links].y - r * links as f64;
+        let held: f64 = (0..links).map(|j| (links - j) as f64 * m * g / k).sum();
+        stretch / held
+    }
+
+    #[test]
+    fn one_pass_holds_a_chain_softer_than_its_springs_the_longer_the_step() {
+        // The module docs' figures: a chain of 20 rests stretched about `1 + (omega h)^2` times
+        // what its springs hold (measured 1.011, 1.995, 4.02), as springs that much softer
+        // would hold it; one link alone rests exactly where its spring holds it.
+        let (m, k): (f64, f64) = (1e-4, 10.0);
+        let omega = (k / m).sqrt();
+        let one = chain_stretch(1, m, k, 1.76 / omega);
+        let fine = chain_stretch(20, m, k, 0.1 / omega);
+        let unit = chain_stretch(20, m, k, 1.0 / omega);
+        let coarse = chain_stretch(20, m, k, 1.76 / omega);
+        assert!((one - 1.0).abs() < 1e-6, "one link: {one}");
+        assert!((fine - 1.01).abs() < 0.01, "(omega h)^2 = 0.01: {fine}");
+        assert!((unit - 2.0).abs() < 0.05, "(omega h)^2 = 1: {unit}");
+        assert!((coarse - 4.1).abs() < 0.2, "(omega h)^2 = 3.1: {coarse}");
     }
 
     #[test]
