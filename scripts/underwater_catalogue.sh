@@ -2,14 +2,24 @@
 # The underwater preset's catalogue of scenes (docs/underwater.md): bakes each scene with the
 # baker into OUT (default out/catalogue), one folder per scene, and prints its look (driven
 # scenes) or its lean and flutter (still scenes in a current). About a minute.
-# Usage: bash scripts/underwater_catalogue.sh [OUT]
+# Usage: bash scripts/underwater_catalogue.sh [OUT] [INTEGRATOR]
+# With INTEGRATOR (e.g. xpbd) every scene is baked with it at the automatic step (a fixed --dt
+# below is dropped), to compare with the preset's own catalogue.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT="${1:-out/catalogue}"
+INTEGRATOR="${2:-}"
 cargo build --release --quiet -p fraccloth-cli
 BIN=target/release/fraccloth
 bake() {  # name, then the baker's options
   local name="$1"; shift
+  if [ -n "$INTEGRATOR" ]; then
+    local kept=()
+    while [ $# -gt 0 ]; do
+      if [ "$1" = --dt ]; then shift 2; else kept+=("$1"); shift; fi
+    done
+    set -- "${kept[@]}" --integrator "$INTEGRATOR"
+  fi
   "$BIN" --quiet --out "$OUT/$name" "$@" > "$OUT/$name.txt" 2>&1 || { echo "$name: refused"; tail -3 "$OUT/$name.txt"; return 0; }
   echo "== $name ($*)"
   grep -E "^(half-waves|travel|mid / bottom|zigzag|hang depth|streaming angle|flutter|look) " "$OUT/$name.txt" | sed 's/^/   /' || true
