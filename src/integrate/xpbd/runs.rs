@@ -317,7 +317,13 @@ mod tests {
 
     #[test]
     fn the_pass_gives_the_bits_of_its_links_one_by_one() {
-        let (w, h) = (9, 6);
+        // Short rows, and rows of many blocks in their strided phases.
+        for (w, h) in [(9, 6), (37, 5)] {
+            pass_against_links(w, h);
+        }
+    }
+
+    fn pass_against_links(w: usize, h: usize) {
         let n = w * h;
         let (plan, links) = plan_of(w, h);
         let mut p = Particles::default();
