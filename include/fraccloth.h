@@ -16,7 +16,7 @@
 
 #define FC_VERSION_MAJOR 0
 #define FC_VERSION_MINOR 9
-#define FC_VERSION_PATCH 33
+#define FC_VERSION_PATCH 34
 /* Equals fc_version() of the library this header belongs to. */
 #define FC_VERSION (FC_VERSION_MAJOR * 1000000 + FC_VERSION_MINOR * 1000 + FC_VERSION_PATCH)
 

@@ -29,7 +29,7 @@ this add-on.
 bl_info = {
     "name": "fraccloth: underwater cloth",
     "author": "fraccloth developers",
-    "version": (0, 9, 33),
+    "version": (0, 9, 34),
     "blender": (4, 2, 0),
     "location": "Properties > Physics > fraccloth",
     "description": "Cloth that moves as if underwater (fractional mass-spring model), baked to a point cache",
