@@ -21,8 +21,8 @@
 //! held softer, because each link is projected on positions its neighbours' corrections have
 //! not yet reached. A chain of springs `k` between particles of mass `m` rests stretched about
 //! `1 + (omega h)^2` times as far as its springs hold it, `omega^2 = k / m` (measured below:
-//! 1.01, 2.0 and 4.0 at `(omega h)^2` = 0.01, 1 and 3.1), and moves as that softer chain
-//! would; the pass also damps what moves faster than the step resolves. The underwater
+//! 1.01, 2.0 and 4.0 at `(omega h)^2` = 0.01, 1 and 3.1); the pass also damps what moves
+//! faster than the step resolves. The underwater
 //! preset's stretch springs at three substeps a 60 Hz frame have `(omega h)^2 = 3.1`
 //! (`docs/realtime.md` says what that does to a tall cloth).
 //!
